@@ -1,0 +1,80 @@
+"""The one source of truth for every array layout shared by C and Python.
+
+Each layout is an ordered tuple of field names; `derive.emit` turns them into C
+``enum`` constants (``PDW_X_THETA1`` ...) in ``generated/pdw_model.h`` and into
+the Python module ``pdw/_layout.py``. No other file may hard-code an index.
+"""
+
+# State x = [q, qdot] (paper Eq. 1), slope frame: X downhill along the slope, Y normal, up.
+STATE = ("x_o", "y_o", "theta1", "theta2", "xd_o", "yd_o", "thetad1", "thetad2")
+NQ = 4
+
+# Physical parameters (paper Tables 1-3, MODEL.md section 1), in this order.
+PARAMS = (
+    "l", "c", "w", "r", "J_l", "m_h", "m_l", "k_hip", "d_hip", "gamma", "g",
+    "k_n", "d_n", "k_t", "d_t", "v_s", "v_d", "mu_s", "mu_d",
+)
+# Derived constants appended to the parameter vector once per simulation
+# (`pdw_precompute`), so that no kernel evaluates a transcendental of a parameter.
+DERIVED = ("sin_gamma", "cos_gamma")
+
+# Per-foot contact kinematics (MODEL.md section 2, Eqs. 4, 5, 8, 9), for the kernel's variant.
+KIN = (
+    "x_D",    # contact point, along the slope [m] (Eq. 4)
+    "y_D",    # contact point height above the slope [m]; depth delta = -y_D (Eq. 4)
+    "v_x",    # slip velocity of the foot's material point [m/s] (Eq. 9)
+    "v_y",    # normal rate of the variant [m/s] (Eq. 5); delta_dot = -v_y
+    "s",      # rolling coordinate x_o + (l-r) sin(theta) + r theta [m]; ds/dt = v_x
+    "xi",     # tangential deformation of the variant [m] (Eqs. 8, 11)
+)
+
+# Per-foot contact forces and their partial derivatives (MODEL.md section 4, Eqs. 3, 6, 7, 10, 11).
+CONTACT = (
+    "F_n",          # normal force, +Y [N]
+    "F_t",          # tangential force, +X [N] (spring-damper + friction)
+    "mu",           # friction coefficient mu(v_t) of Eq. 10 (0 when not in contact)
+    "dFn_ddelta",   # partial F_n / partial delta
+    "dFn_ddeltad",  # partial F_n / partial delta_dot
+    "dFt_dxi",      # partial F_t / partial xi
+    "dFt_dv",       # partial F_t / partial v_x (includes F_n dmu/dv)
+)
+
+# Energies (MODEL.md section 3).
+ENERGY = ("T", "V_gravity", "V_hip")
+
+# Contact flags carried as discrete state by every simulation.
+FLAGS = ("leg1", "leg2")
+
+
+# --- simulation records (the compiled time loops) -------------------------------------------
+# One contact event (a support-flag change, MODEL.md section 5), a row of doubles.
+EVENT = ("t", "leg", "kind", "x_D", "y_D")
+EVENT_KIND = ("lift_off", "touch_down")
+# Contact forces recorded per sample: foot-major.
+RECORD_CONTACT = ("F_n1", "F_t1", "F_n2", "F_t2")
+# Why a time loop returned.
+STATUS = (
+    "running",      # not finished (internal)
+    "done",         # reached t_end (or the requested number of steps)
+    "fell",         # the walker fell (hip too low, or a foot through the ground)
+    "diverged",     # non-finite or runaway state
+    "events_full",  # event buffer full: the caller grows it and resumes (internal)
+    "singular",     # the step's linear system was singular
+    "periodic",     # stopped because successive steps agree (gait converged)
+)
+
+
+def work_layout():
+    """Offsets of the per-evaluation scratch array ``work`` (all stage outputs).
+
+    Returns
+    -------
+    list of (name, size)
+    """
+    return [
+        ("kin", 2 * len(KIN)),
+        ("contact", 2 * len(CONTACT)),
+        ("M", NQ * NQ),
+        ("f", NQ),
+        ("qdd", NQ),
+    ]

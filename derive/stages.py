@@ -1,0 +1,131 @@
+"""Per-kernel stage expressions, ready for C emission.
+
+A *kernel* is one specialization of the model: a contact variant (MODEL.md
+section 6) and the set of force elements present. Absent elements are folded to
+zero here, before common-subexpression elimination, so that a kernel never
+evaluates a force its scene switched off.
+
+Stage data flow (each one a C function; all arrays caller-allocated)::
+
+    trig         x                          -> trig      sin/cos of the leg angles
+    kinematics   x, trig, p, anchors        -> kin       Eqs. 4, 5, 8, 9 per foot
+    contact      kin, flags, p              -> contact   Eqs. 3, 6, 7, 10, 11 per foot
+    dynamics     x, trig, p, contact        -> M, f      f = Q_f - C qd - G   (Eq. 2)
+    (solve)      M, f                       -> qdd       Schur complement, C code
+    jacobian     x, trig, p, contact, qdd   -> A         A = df/dx - (dM/dx) qdd
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+
+from . import layout
+from . import model as mdl
+
+
+@dataclass(frozen=True)
+class KernelSpec:
+    """One generated kernel: a variant and the force elements it contains."""
+
+    variant: str
+    features: tuple = mdl.FEATURES
+
+    @property
+    def name(self):
+        missing = [f for f in mdl.FEATURES if f not in self.features]
+        return self.variant + "".join("_no_" + f for f in missing)
+
+    @property
+    def feature_mask(self):
+        return sum(1 << i for i, f in enumerate(mdl.FEATURES) if f in self.features)
+
+
+TRIG = {}
+for _i, _th in enumerate(mdl.Q[2:]):
+    TRIG[sp.sin(_th)] = mdl._real("sin_theta%d" % (_i + 1))
+    TRIG[sp.cos(_th)] = mdl._real("cos_theta%d" % (_i + 1))
+TRIG_NAMES = tuple(s.name for s in TRIG.values())
+
+
+def _trig(expr):
+    out = expr.xreplace(TRIG)
+    leftover = [a for a in out.atoms(sp.sin, sp.cos) if a.args[0] in mdl.Q]
+    if leftover:
+        raise AssertionError("trigonometric terms left after substitution: %s" % leftover)
+    return out
+
+
+def kinematics(spec: KernelSpec):
+    """Expressions of `layout.KIN` for both feet (foot-major order)."""
+    return [_trig(e) for i in range(2) for e in mdl.contact_kinematics(i, spec.variant).values()]
+
+
+def contact(spec: KernelSpec):
+    """Expressions of `layout.CONTACT` for one penetrating support foot."""
+    return list(mdl.contact_laws(spec.variant, spec.features).values())
+
+
+_MECH = None
+
+
+def _mechanics():
+    global _MECH
+    if _MECH is None:
+        _MECH = mdl.mechanics()
+    return _MECH
+
+
+def forcing(spec: KernelSpec) -> sp.Matrix:
+    """f = Q_f - C qd - G with the contact forces as symbols (4x1, untrigged)."""
+    mech = _mechanics()
+    G = mdl.fold_parameters(mech.G, spec.features)
+    return mdl.generalized_forces(spec.features) - mech.Cqd - G
+
+
+def dynamics(spec: KernelSpec):
+    """M (row-major 16) then f (4)."""
+    M = _mechanics().M
+    return [_trig(e) for e in list(M) + list(forcing(spec))]
+
+
+def cdm_terms(spec: KernelSpec):
+    """M (16), the appendix C matrix (16) and Q_f - G (4), for the central difference method."""
+    mech = _mechanics()
+    QmG = mdl.generalized_forces(spec.features) - mdl.fold_parameters(mech.G, spec.features)
+    return [_trig(e) for e in list(mech.M) + list(mech.C) + list(QmG)]
+
+
+def contact_partial_symbols():
+    """Symbols standing for the contact stage's outputs of foot i: {(i, field): Symbol}."""
+    return {(i, f): mdl._real("%s_%d" % (f, i + 1)) for i in range(2) for f in layout.CONTACT}
+
+
+def dynamics_jacobian(spec: KernelSpec):
+    """A = df/dx + sum_i (df/dF_i)(dF_i/dx) - (dM/dx) qdd, a 4x8 matrix, row-major (32).
+
+    dF/dx of each foot is assembled by the chain rule from the contact stage's
+    partials (symbols) and the symbolic gradients of delta, delta_dot, xi, v_x.
+    """
+    sym = contact_partial_symbols()
+    f = forcing(spec)
+    M = _mechanics().M
+    x = mdl.X
+    A = f.jacobian(x)
+    for i in range(2):
+        kin = mdl.contact_kinematics(i, spec.variant)
+        grad = lambda e: sp.Matrix([[sp.diff(e, xj) for xj in x]])  # noqa: E731
+        dFn = sym[i, "dFn_ddelta"] * grad(-kin["y_D"]) + sym[i, "dFn_ddeltad"] * grad(-kin["v_y"])
+        dFt = sym[i, "dFt_dxi"] * grad(kin["xi"]) + sym[i, "dFt_dv"] * grad(kin["v_x"]) \
+            + sym[i, "mu"] * dFn
+        A += f.diff(mdl.F_N[i]) * dFn + f.diff(mdl.F_T[i]) * dFt
+    qdd = sp.Matrix(mdl.QDD)
+    for k, xk in enumerate(x):
+        A[:, k] -= M.diff(xk) * qdd
+    return [_trig(sp.expand(e)) for e in A]
+
+
+def energies(spec: KernelSpec):
+    """T, V_gravity, V_hip (MODEL.md section 3)."""
+    mech = _mechanics()
+    return [_trig(e) for e in (mech.T, mech.V_gravity, mdl.fold_parameters(mech.V_hip, spec.features))]

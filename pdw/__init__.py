@@ -1,0 +1,22 @@
+"""pdw: the flexible planar passive walker on compliant ground (JMST 2018).
+
+Public API
+----------
+Params                  model parameters and presets (MODEL.md section 1)
+rhs, jacobian           f(x) of Eq. A.4 and its Jacobian, compiled from the symbolic derivation
+mass_matrix             M(q) of Eq. 2
+contact_forces          contact kinematics and forces of both feet (Eqs. 3-11)
+energies                kinetic and potential energies
+STATE, VARIANTS         the state layout and the contact variants (MODEL.md section 6)
+"""
+from ._layout import INPUT_HASH
+from .model import (STATE, VARIANTS, ContactState, contact_forces, energies, jacobian,
+                    mass_matrix, rhs)
+from .params import Params
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "Params", "rhs", "jacobian", "mass_matrix", "contact_forces", "ContactState", "energies",
+    "STATE", "VARIANTS", "INPUT_HASH",
+]

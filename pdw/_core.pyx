@@ -1,0 +1,276 @@
+# cython: language_level=3
+"""Thin Cython layer over the generated C model and the compiled time loops.
+
+Private: the public API is in `pdw.model` and `pdw.simulation`. Every function
+takes caller-allocated, C-contiguous float64 arrays (typed memoryviews; no NumPy
+C headers). Time loops release the GIL and are entered once per simulation.
+"""
+import numpy as np
+
+from libc.string cimport memset, memcpy
+
+
+cdef extern from "pdw_model.h":
+    enum:
+        PDW_NX, PDW_NQ, PDW_NP, PDW_NPARAM, PDW_NKIN, PDW_NCONTACT, PDW_NENERGY, PDW_NWORK
+        PDW_NKERNELS, PDW_NEVENT, PDW_NREC
+        PDW_WORK_TRIG, PDW_WORK_KIN, PDW_WORK_CONTACT, PDW_WORK_M, PDW_WORK_F, PDW_WORK_QDD
+        PDW_STATUS_RUNNING, PDW_STATUS_EVENTS_FULL
+    ctypedef struct pdw_kernel:
+        const char *name
+        int variant
+        unsigned features
+        void (*kinematics)(const double *x, const double *trig, const double *p,
+                           const double *anchors, double *kin) noexcept nogil
+        void (*contact)(const double *kin, const int *flags, const double *p,
+                        double *contact) noexcept nogil
+        void (*contact_partials)(const double *kin, const int *flags, const double *p,
+                                 double *contact) noexcept nogil
+        void (*dynamics)(const double *x, const double *trig, const double *p,
+                         const double *contact, double *M, double *f) noexcept nogil
+        void (*cdm_terms)(const double *x, const double *trig, const double *p,
+                          const double *contact, double *M, double *C, double *QmG) noexcept nogil
+        void (*dynamics_jacobian)(const double *x, const double *trig, const double *p,
+                                  const double *contact, const double *qdd, double *A) noexcept nogil
+        void (*energies)(const double *x, const double *trig, const double *p,
+                         double *e) noexcept nogil
+        void (*rhs)(const double *x, const double *p, const int *flags, const double *anchors,
+                    double *xdot, double *work) noexcept nogil
+        void (*jacobian)(const double *x, const double *p, const int *flags,
+                         const double *anchors, double *J, double *work) noexcept nogil
+    const pdw_kernel pdw_kernels[]
+    void pdw_precompute(const double *params, double *p) noexcept nogil
+    void pdw_trig(const double *x, double *trig) noexcept nogil
+
+
+cdef extern from "pdw_sim.h":
+    ctypedef struct pdw_discrete:
+        int flags[2]
+        int armed[2]
+        double anchors[2]
+    ctypedef struct pdw_failure:
+        double t
+        double x[8]
+        int leg
+        int reason
+    ctypedef struct pdw_sim:
+        const pdw_kernel *kernel
+        double p[32]
+        double dt
+        long n_steps
+        long record_every
+        double fall_hip_height
+        double fall_depth
+        double max_speed
+        double t_end
+        double rtol, atol
+        double h_max
+        double *rec_t
+        double *rec_x
+        int *rec_flags
+        double *rec_contact
+        long rec_capacity, n_rec
+        double *events
+        long ev_capacity, n_events
+        long n
+        double t
+        double h
+        double x[8]
+        double u_prev[4]
+        int started
+        pdw_discrete disc
+        double work[1]
+        long n_rhs, n_jac, n_rejected
+        int status
+        pdw_failure failure
+    ctypedef int (*pdw_advance_fn)(pdw_sim *s) noexcept nogil
+    ctypedef struct pdw_method:
+        const char *name
+        int order
+        int adaptive
+        pdw_advance_fn advance
+    const pdw_method pdw_methods[]
+    const int pdw_nmethods
+    void pdw_discrete_init(const pdw_kernel *k, const double *p, const double *x,
+                           const int *flags0, pdw_discrete *d, double *work) noexcept nogil
+
+
+cdef extern from "pdw_bench.h":
+    double pdw_bench_rhs(const pdw_kernel *k, const double *x0, const double *p, const int *flags,
+                         const double *anchors, long n, double *work, double *sink) noexcept nogil
+    double pdw_bench_jacobian(const pdw_kernel *k, const double *x0, const double *p,
+                              const int *flags, const double *anchors, long n, double *work,
+                              double *sink) noexcept nogil
+
+
+NX = PDW_NX
+NQ = PDW_NQ
+NP = PDW_NP
+NWORK = PDW_NWORK
+
+
+def kernel_table():
+    """[(name, variant index, feature mask)] in the order of the C table."""
+    return [(pdw_kernels[i].name.decode(), pdw_kernels[i].variant, pdw_kernels[i].features)
+            for i in range(PDW_NKERNELS)]
+
+
+cdef const pdw_kernel *_kernel(int k) except NULL:
+    if k < 0 or k >= PDW_NKERNELS:
+        raise IndexError("kernel index %d out of range [0, %d)" % (k, PDW_NKERNELS))
+    return &pdw_kernels[k]
+
+
+def precompute(const double[::1] params, double[::1] p):
+    """Fill the kernel parameter vector p (NP,) from the physical parameters (NPARAM,)."""
+    assert params.shape[0] == PDW_NPARAM and p.shape[0] == PDW_NP
+    pdw_precompute(&params[0], &p[0])
+
+
+def rhs_batch(int k, const double[:, ::1] x, const double[::1] p, const int[:, ::1] flags,
+              const double[:, ::1] anchors, double[:, ::1] xdot, double[:, ::1] work):
+    """f(x) (Eq. A.4) for each row; work (N, NWORK) receives every stage's output."""
+    cdef const pdw_kernel *kern = _kernel(k)
+    cdef Py_ssize_t i, n = x.shape[0]
+    with nogil:
+        for i in range(n):
+            kern.rhs(&x[i, 0], &p[0], &flags[i, 0], &anchors[i, 0], &xdot[i, 0], &work[i, 0])
+
+
+def jacobian_batch(int k, const double[:, ::1] x, const double[::1] p, const int[:, ::1] flags,
+                   const double[:, ::1] anchors, double[:, ::1] J, double[:, ::1] work):
+    """df/dx (8x8 row-major per row of J, shape (N, 64)); work as in rhs_batch, with partials."""
+    cdef const pdw_kernel *kern = _kernel(k)
+    cdef Py_ssize_t i, n = x.shape[0]
+    with nogil:
+        for i in range(n):
+            kern.jacobian(&x[i, 0], &p[0], &flags[i, 0], &anchors[i, 0], &J[i, 0], &work[i, 0])
+
+
+def energies_batch(int k, const double[:, ::1] x, const double[::1] p, double[:, ::1] e):
+    """T, V_gravity, V_hip for each row of x."""
+    cdef const pdw_kernel *kern = _kernel(k)
+    cdef Py_ssize_t i, n = x.shape[0]
+    cdef double trig[4]
+    with nogil:
+        for i in range(n):
+            pdw_trig(&x[i, 0], trig)
+            kern.energies(&x[i, 0], trig, &p[0], &e[i, 0])
+
+
+def cdm_terms(int k, const double[::1] x, const double[::1] p, const double[::1] contact,
+              double[::1] M, double[::1] C, double[::1] QmG):
+    """M, the appendix C matrix and Q_f - G at x for given contact forces (central difference)."""
+    cdef const pdw_kernel *kern = _kernel(k)
+    cdef double trig[4]
+    pdw_trig(&x[0], trig)
+    kern.cdm_terms(&x[0], trig, &p[0], &contact[0], &M[0], &C[0], &QmG[0])
+
+
+def bench(int k, str what, const double[::1] x, const double[::1] p, int f1, int f2,
+          double a1, double a2, long n):
+    """Mean ns per evaluation of `what` ("rhs" or "jacobian") over n calls in a C loop."""
+    cdef const pdw_kernel *kern = _kernel(k)
+    cdef int flags[2]
+    cdef double anchors[2]
+    cdef double work[PDW_NWORK]
+    cdef double sink = 0.0, ns
+    flags[0] = f1; flags[1] = f2; anchors[0] = a1; anchors[1] = a2
+    if what == "rhs":
+        with nogil:
+            ns = pdw_bench_rhs(kern, &x[0], &p[0], flags, anchors, n, work, &sink)
+    elif what == "jacobian":
+        with nogil:
+            ns = pdw_bench_jacobian(kern, &x[0], &p[0], flags, anchors, n, work, &sink)
+    else:
+        raise ValueError("what must be 'rhs' or 'jacobian', got %r" % what)
+    return ns
+
+
+def method_table():
+    """[(name, order, adaptive)] of the compiled integrators, in method-id order."""
+    return [(pdw_methods[i].name.decode(), pdw_methods[i].order, bool(pdw_methods[i].adaptive))
+            for i in range(pdw_nmethods)]
+
+
+def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, int f2,
+        double dt, long n_steps, long record_every, bint record_contact,
+        double fall_hip_height, double fall_depth, double max_speed,
+        double rtol=1e-6, double atol=1e-8, double h_max=0.0, long max_records=0,
+        long event_capacity=256):
+    """Run one simulation in compiled code (GIL released). Returns a dict of arrays and status.
+
+    Fixed-step methods take n_steps steps of dt; adaptive ones integrate to n_steps*dt with
+    first step dt. The record buffer holds max_records samples (default: n_steps/record_every+2).
+    """
+    cdef pdw_sim s
+    cdef int flags0[2]
+    cdef long n_rec_cap = (n_steps // record_every + 2) if record_every > 0 else 0
+    if max_records > 0 and record_every > 0:
+        n_rec_cap = max_records
+    if method < 0 or method >= pdw_nmethods:
+        raise ValueError("method id %d out of range [0, %d)" % (method, pdw_nmethods))
+    cdef pdw_advance_fn advance = pdw_methods[method].advance
+    memset(&s, 0, sizeof(pdw_sim))
+    s.kernel = _kernel(k)
+    s.t_end = n_steps * dt
+    s.rtol = rtol
+    s.atol = atol
+    s.h_max = h_max if h_max > 0 else s.t_end
+    s.h = dt
+    memcpy(s.p, &p[0], PDW_NP * sizeof(double))
+    s.dt = dt
+    s.n_steps = n_steps
+    s.record_every = record_every
+    s.fall_hip_height = fall_hip_height
+    s.fall_depth = fall_depth
+    s.max_speed = max_speed
+    rec_t = np.zeros(n_rec_cap)
+    rec_x = np.zeros((n_rec_cap, PDW_NX))
+    rec_flags = np.zeros((n_rec_cap, 2), dtype=np.intc)
+    rec_contact = np.zeros((n_rec_cap if record_contact else 0, PDW_NREC))
+    events = np.zeros((max(event_capacity, 4), PDW_NEVENT))
+    cdef double[::1] v_t = rec_t
+    cdef double[:, ::1] v_x = rec_x
+    cdef int[:, ::1] v_f = rec_flags
+    cdef double[:, ::1] v_c = rec_contact
+    cdef double[:, ::1] v_e = events
+    if n_rec_cap > 0:
+        s.rec_t = &v_t[0]
+        s.rec_x = &v_x[0, 0]
+        s.rec_flags = &v_f[0, 0]
+        if record_contact:
+            s.rec_contact = &v_c[0, 0]
+    s.rec_capacity = n_rec_cap
+    s.events = &v_e[0, 0]
+    s.ev_capacity = events.shape[0]
+    memcpy(s.x, &x0[0], PDW_NX * sizeof(double))
+    flags0[0] = f1; flags0[1] = f2
+    pdw_discrete_init(s.kernel, s.p, s.x, flags0, &s.disc, s.work)
+    cdef int status
+    while True:
+        with nogil:
+            status = advance(&s)
+        if status != PDW_STATUS_EVENTS_FULL:
+            break
+        grown = np.zeros((2 * events.shape[0], PDW_NEVENT))
+        grown[:events.shape[0]] = events
+        events = grown
+        v_e = events
+        s.events = &v_e[0, 0]
+        s.ev_capacity = events.shape[0]
+    n_rec = s.n_rec
+    return {
+        "status": status,
+        "t": rec_t[:n_rec], "x": rec_x[:n_rec], "flags": rec_flags[:n_rec],
+        "contact": rec_contact[:n_rec] if record_contact else None,
+        "events": events[:s.n_events].copy(),
+        "n_steps": s.n,
+        "t_final": s.t,
+        "stats": {"steps": s.n, "rhs": s.n_rhs, "jacobians": s.n_jac, "rejected": s.n_rejected},
+        "x_final": np.array(<double[:PDW_NX]> s.x),
+        "flags_final": (s.disc.flags[0], s.disc.flags[1]),
+        "anchors_final": (s.disc.anchors[0], s.disc.anchors[1]),
+        "failure": {"t": s.failure.t, "x": np.array(<double[:PDW_NX]> s.failure.x),
+                    "leg": s.failure.leg, "reason": s.failure.reason},
+    }

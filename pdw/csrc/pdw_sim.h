@@ -1,0 +1,109 @@
+/* The compiled time loops: discrete contact state, recording, stop conditions.
+ *
+ * A pdw_sim holds everything one simulation needs. The caller (pdw/_core.pyx) allocates
+ * every array; the loops allocate nothing. A loop advances until it finishes, fails, or
+ * fills its event buffer; in the last case the caller grows the buffer and calls again,
+ * and the loop resumes exactly where it stopped (all loop state lives in the struct). */
+#ifndef PDW_SIM_H
+#define PDW_SIM_H
+
+#include "pdw_model.h"
+
+/* Discrete state carried by every loop (MODEL.md sections 5 and 6). */
+typedef struct pdw_discrete {
+    int flags[2];       /* 1 = support, 0 = swing */
+    int armed[2];       /* swing foot has been above ground while ahead of the other foot */
+    double anchors[2];  /* rolling coordinate s_i at touch-down (consistent variant's xi) */
+} pdw_discrete;
+
+/* Why and where a loop failed. */
+typedef struct pdw_failure {
+    double t;           /* time of the last good state [s] */
+    double x[PDW_NX];   /* that state */
+    int leg;            /* leg involved (fell through the ground), or -1 */
+    int reason;         /* PDW_REASON_* */
+} pdw_failure;
+
+enum {
+    PDW_REASON_NONE = 0,
+    PDW_REASON_NONFINITE = 1,     /* a NaN or infinity in the new state */
+    PDW_REASON_SPEED = 2,         /* a velocity above max_speed */
+    PDW_REASON_HIP_LOW = 3,       /* hip below fall_hip_height */
+    PDW_REASON_FOOT_DEEP = 4,     /* a foot deeper than fall_depth below the ground */
+    PDW_REASON_SINGULAR = 5       /* singular step matrix */
+};
+
+typedef struct pdw_sim {
+    /* --- model and settings (inputs) --- */
+    const pdw_kernel *kernel;
+    double p[PDW_NP];           /* parameters + derived constants (pdw_precompute) */
+    double dt;                  /* step [s] */
+    long n_steps;               /* number of steps to take */
+    long record_every;          /* record every k-th step; 0 = record nothing */
+    double fall_hip_height;     /* fell when y_o < this [m] */
+    double fall_depth;          /* fell when a foot is deeper than this [m] */
+    double max_speed;           /* diverged when |qd_i| > this [m/s, rad/s] */
+    double t_end;               /* end time [s] (adaptive methods; = n_steps*dt for fixed) */
+    double rtol, atol;          /* tolerances of adaptive methods */
+    double h_max;               /* largest step of adaptive methods [s] */
+    /* --- outputs (caller-allocated) --- */
+    double *rec_t;              /* (rec_capacity,) */
+    double *rec_x;              /* (rec_capacity, PDW_NX) */
+    int *rec_flags;             /* (rec_capacity, 2) */
+    double *rec_contact;        /* (rec_capacity, PDW_NREC), may be NULL */
+    long rec_capacity, n_rec;
+    double *events;             /* (ev_capacity, PDW_NEVENT) */
+    long ev_capacity, n_events;
+    /* --- loop state --- */
+    long n;                     /* steps taken (accepted) */
+    double t;                   /* time of x [s] */
+    double h;                   /* next step size of adaptive methods [s] */
+    double x[PDW_NX];           /* state at step n: [U_n, U'_n] */
+    double u_prev[PDW_NQ];      /* U_{n-1} (central difference) */
+    int started;
+    pdw_discrete disc;
+    double work[PDW_NWORK];
+    /* --- work counters (every method) --- */
+    long n_rhs, n_jac, n_rejected;
+    /* --- termination --- */
+    int status;                 /* PDW_STATUS_* */
+    pdw_failure failure;
+} pdw_sim;
+
+/* Initialise the discrete state for x0 and initial flags: anchors of support legs at x0. */
+void pdw_discrete_init(const pdw_kernel *k, const double *p, const double *x,
+                       const int flags0[2], pdw_discrete *d, double *work);
+
+/* Update flags and arming once (MODEL.md section 5); appends events to sim. Returns 0, or
+ * -1 when the event buffer is full (nothing changed then). */
+int pdw_update_flags(pdw_sim *s, double t);
+
+/* Check a new state; on failure sets s->status and s->failure and returns nonzero. */
+int pdw_check_state(pdw_sim *s, const double *xnew, double t);
+
+/* Store sample n (time t) if it is a recording step. */
+void pdw_record(pdw_sim *s, double t);
+
+/* --- the integrators: one module each, all behind this contract ---------------------------
+ * advance(s): take steps from s->x (time s->t, step count s->n) until s->t reaches t_end (or
+ * n_steps for fixed-step methods), updating the discrete state once per step through
+ * pdw_update_flags, recording through pdw_record, checking each new state with
+ * pdw_check_state, counting work in n_rhs / n_jac / n_rejected. Returns s->status:
+ * PDW_STATUS_DONE, a failure, or PDW_STATUS_EVENTS_FULL (the caller grows s->events and
+ * calls again; the method resumes where it stopped). */
+typedef int (*pdw_advance_fn)(pdw_sim *s);
+
+typedef struct pdw_method {
+    const char *name;
+    int order;          /* order of accuracy of the state on smooth problems */
+    int adaptive;       /* 1: uses rtol/atol and t_end; 0: fixed step dt, n_steps */
+    pdw_advance_fn advance;
+} pdw_method;
+
+extern const pdw_method pdw_methods[];
+extern const int pdw_nmethods;
+
+/* The paper's central difference method (MODEL.md section 7). Returns s->status. */
+int pdw_cdm_advance(pdw_sim *s);
+
+#endif /* PDW_SIM_H */
