@@ -126,7 +126,8 @@ def check_state(x0, name="x0"):
 
 def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
              flags0=(0, 1), record_every=1, record_forces=True, on_failure="raise",
-             fall_hip_height=None, fall_depth=None, max_speed=1e3):
+             fall_hip_height=None, fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8,
+             h_max=None):
     """Simulate the walker from ``x0`` for ``t_end`` seconds.
 
     Parameters
@@ -159,6 +160,11 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
         ... or when a foot is deeper than this below the ground [m]; default 0.25 l.
     max_speed : float
         Diverged when any velocity component exceeds this [m/s or rad/s].
+    rtol, atol : float
+        Relative and absolute error tolerances of adaptive methods (ignored by fixed-step
+        ones); for adaptive methods ``dt`` is the first trial step.
+    h_max : float, optional
+        Largest step of adaptive methods [s] (default: no limit).
 
     Returns
     -------
@@ -191,12 +197,15 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     hip = 0.5 * params.l if fall_hip_height is None else float(fall_hip_height)
     depth = 0.25 * params.l if fall_depth is None else _check_positive("fall_depth", fall_depth)
     max_speed = _check_positive("max_speed", max_speed)
+    rtol = _check_positive("rtol", rtol)
+    atol = _check_positive("atol", atol)
+    h_max = 0.0 if h_max is None else _check_positive("h_max", h_max)
 
     k = kernel_index(variant)
     p = parameter_vector(params)
     start = time.perf_counter()
     raw = _core.run(k, METHODS.index(method), x, p, f0[0], f0[1], dt, n_steps, int(record_every),
-                    bool(record_forces), hip, depth, max_speed)
+                    bool(record_forces), hip, depth, max_speed, rtol, atol, h_max)
     wall = time.perf_counter() - start
     return _result(raw, params, variant, method, dt, t_end, wall, on_failure)
 
