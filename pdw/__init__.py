@@ -7,16 +7,25 @@ rhs, jacobian           f(x) of Eq. A.4 and its Jacobian, compiled from the symb
 mass_matrix             M(q) of Eq. 2
 contact_forces          contact kinematics and forces of both feet (Eqs. 3-11)
 energies                kinetic and potential energies
+simulate, Result        one compiled simulation (support flags, events, status)
+steps                   per-step gait descriptors (MODEL.md section 8)
+PdwError, SimulationError, DivergedError, InvalidInputError   the error hierarchy
 STATE, VARIANTS         the state layout and the contact variants (MODEL.md section 6)
 """
 from ._layout import INPUT_HASH
 from .model import (STATE, VARIANTS, ContactState, contact_forces, energies, jacobian,
                     mass_matrix, rhs)
+from .errors import (DivergedError, FellError, InvalidInputError, PdwError, SimulationError,
+                     SingularSystemError)
+from .gait import Steps, steps
 from .params import Params
+from .simulation import METHODS, X0_DISTURBED, X0_PAPER, Event, Result, simulate
 
 __version__ = "0.1.0"
 
 __all__ = [
     "Params", "rhs", "jacobian", "mass_matrix", "contact_forces", "ContactState", "energies",
-    "STATE", "VARIANTS", "INPUT_HASH",
+    "STATE", "VARIANTS", "INPUT_HASH", "simulate", "Result", "Event", "METHODS", "X0_PAPER",
+    "X0_DISTURBED", "steps", "Steps", "PdwError", "SimulationError", "DivergedError",
+    "SingularSystemError", "FellError", "InvalidInputError",
 ]
