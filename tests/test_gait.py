@@ -1,0 +1,83 @@
+"""Gait descriptors on hand-built event sequences (MODEL.md section 8 definitions)."""
+import math
+
+import numpy as np
+import pytest
+
+import pdw
+from pdw import Event
+from pdw.report import stance_forces
+
+
+def _events():
+    # leg 2 in stance from the start; leg 1 swings, touches down, then leg 2 lifts off ...
+    return [
+        Event(0.00, 2, "touch_down", 0.00, -0.001),
+        Event(0.05, 1, "lift_off", -0.10, 0.0001),
+        Event(0.60, 1, "touch_down", 0.40, -0.0001),
+        Event(0.62, 2, "lift_off", 0.15, 0.0002),
+        Event(1.20, 2, "touch_down", 0.81, -0.0001),
+        Event(1.23, 1, "lift_off", 0.55, 0.0002),
+        Event(1.80, 1, "touch_down", 1.20, -0.0001),
+    ]
+
+
+def test_descriptors_follow_the_definitions():
+    st = pdw.steps(_events())
+    assert len(st) == 3
+    np.testing.assert_array_equal(st["leg"], [1, 2, 1])
+    # step 1: leg 1 lands at 0.40; leg 2's own last touch-down was at 0.00
+    assert st["L"][0] == pytest.approx(0.40)
+    assert st["travel"][0] == pytest.approx(0.40 - (-0.10))
+    assert st["P"][0] == pytest.approx(0.55)
+    assert st["v"][0] == pytest.approx(0.40 / 0.55)
+    assert st["cycle"][0] == pytest.approx(0.60)
+    assert st["double_support"][0] == pytest.approx(0.02)
+    assert st["ds_fraction"][0] == pytest.approx(0.02 / 0.60)
+    # step 2: leg 2 lands at 0.81, leg 1's touch-down at 0.40
+    assert st["L"][1] == pytest.approx(0.41)
+    assert st["travel"][1] == pytest.approx(0.81 - 0.15)
+    assert st["P"][1] == pytest.approx(1.20 - 0.62)
+    assert st["double_support"][1] == pytest.approx(0.03)
+    # last step: the other leg has not lifted off yet -> NaN
+    assert math.isnan(st["double_support"][2])
+    sd = st.steady(2)
+    assert sd["L"] == pytest.approx((0.41 + 0.39) / 2)
+    assert sd["spread_L"] == pytest.approx(0.02)
+
+
+def test_first_partial_step_is_skipped_and_order_does_not_matter():
+    ev = _events()
+    a = pdw.steps(ev)
+    b = pdw.steps(list(reversed(ev)))
+    for k in a.table:
+        np.testing.assert_array_equal(a.table[k], b.table[k])
+    assert pdw.steps(ev[:3]).table["L"].tolist() == pytest.approx([0.40])
+    assert len(pdw.steps(ev[:2])) == 0
+
+
+def test_text_table_lists_every_step():
+    txt = pdw.steps(_events()).to_text().splitlines()
+    assert len(txt) == 4 and "L [m]" in txt[0]
+    assert txt[1].split()[4] == "0.4000"
+
+
+def test_typical_gait_descriptors_are_close_to_the_paper():
+    """paper_steady (MODEL.md section 8): footprint L and P within about 10 % of the paper's."""
+    r = pdw.simulate(t_end=12.0, params=pdw.Params.paper_steady(), record_every=0)
+    sd = pdw.steps(r).steady(4)
+    assert sd["L"] == pytest.approx(0.397, rel=0.12)
+    assert sd["P"] == pytest.approx(0.621, rel=0.12)
+    assert sd["travel"] == pytest.approx(0.6, rel=0.1)
+    assert 0.01 < sd["double_support"] < 0.03
+
+
+def test_stance_forces_peak_settle_and_friction_sign_change():
+    r = pdw.simulate(t_end=2.1)
+    s = stance_forces(r)
+    assert len(s) >= 2
+    for st in s:
+        assert st["Fn_peak"] > 2 * st["weight"]                      # impact peak
+        assert st["Fn_settled"] == pytest.approx(st["weight"], rel=0.06)
+        assert st["Ft_early"] < 0 < st["Ft_late"]                     # friction - to +
+        assert any(d == "-+" for _, d in st["Ft_sign_changes"])
