@@ -33,12 +33,13 @@ int pdw_cdm_advance(pdw_sim *s)
     }
     while (s->n < s->n_steps) {
         const double t = s->n * dt;
+        /* flags from (U_n, U'_n); this also leaves trig and kin of x_n in work (at n = 0 the
+         * start-up's update and right-hand side did) */
         if (s->n > 0 && pdw_update_flags(s, t)) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
-        pdw_trig(s->x, trig);
-        k->kinematics(s->x, trig, s->p, s->disc.anchors, kin);
+        if (pdw_check_feet(s, t)) return s->status;
         k->contact(kin, s->disc.flags, s->p, contact);
         k->cdm_terms(s->x, trig, s->p, contact, M, C, QmG);
-        if (s->n > 0) pdw_record(s, t);
+        if (s->n > 0) pdw_record(s, t);  /* sample 0 was recorded at the start */
         for (int i = 0; i < PDW_NQ; ++i) {
             double mu = 0.0, ku = 0.0;
             for (int j = 0; j < PDW_NQ; ++j) {
@@ -69,8 +70,6 @@ int pdw_cdm_advance(pdw_sim *s)
     /* final sample: flags and forces at t_end */
     if (pdw_update_flags(s, s->n * dt)) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
     if (s->record_every > 0 && s->n % s->record_every == 0) {
-        pdw_trig(s->x, trig);
-        k->kinematics(s->x, trig, s->p, s->disc.anchors, kin);
         k->contact(kin, s->disc.flags, s->p, contact);
         pdw_record(s, s->n * dt);
     }

@@ -23,6 +23,15 @@ void pdw_discrete_init(const pdw_kernel *k, const double *p, const double *x,
     }
 }
 
+static void fail(pdw_sim *s, int status, int reason, int leg, double t)
+{
+    s->status = status;
+    s->failure.reason = reason;
+    s->failure.leg = leg;
+    s->failure.t = t;
+    memcpy(s->failure.x, s->x, sizeof s->x);
+}
+
 static void push_event(pdw_sim *s, double t, int leg, int kind, const double *ki)
 {
     double *e = s->events + s->n_events * PDW_NEVENT;
@@ -38,6 +47,7 @@ int pdw_update_flags(pdw_sim *s, double t)
 {
     pdw_discrete *d = &s->disc;
     double *kin = s->work + PDW_WORK_KIN;
+    int changed = 0;
     if (s->n_events + 2 > s->ev_capacity) return -1;
     kinematics(s->kernel, s->p, s->x, d->anchors, s->work);
     for (int i = 0; i < 2; ++i) {
@@ -59,18 +69,24 @@ int pdw_update_flags(pdw_sim *s, double t)
             d->armed[i] = 0;
             d->anchors[i] = ki[PDW_KIN_S];
             push_event(s, t, i, PDW_EVKIND_TOUCH_DOWN, ki);
+            changed = 1;
         }
     }
+    /* a new anchor changes xi: refresh the kinematics (trig stays valid) */
+    if (changed) s->kernel->kinematics(s->x, s->work + PDW_WORK_TRIG, s->p, d->anchors, kin);
     return 0;
 }
 
-static void fail(pdw_sim *s, int status, int reason, int leg, double t)
+int pdw_check_feet(pdw_sim *s, double t)
 {
-    s->status = status;
-    s->failure.reason = reason;
-    s->failure.leg = leg;
-    s->failure.t = t;
-    memcpy(s->failure.x, s->x, sizeof s->x);
+    const double *kin = s->work + PDW_WORK_KIN;
+    for (int i = 0; i < 2; ++i) {
+        if (kin[i*PDW_NKIN + PDW_KIN_Y_D] < -s->fall_depth) {
+            fail(s, PDW_STATUS_FELL, PDW_REASON_FOOT_DEEP, i, t);
+            return 1;
+        }
+    }
+    return 0;
 }
 
 int pdw_check_state(pdw_sim *s, const double *xnew, double t)
@@ -84,14 +100,6 @@ int pdw_check_state(pdw_sim *s, const double *xnew, double t)
     if (xnew[PDW_X_Y_O] < s->fall_hip_height) {
         fail(s, PDW_STATUS_FELL, PDW_REASON_HIP_LOW, -1, t);
         return 1;
-    }
-    {
-        const double *p = s->p;
-        const double lr = p[PDW_P_L] - p[PDW_P_R];
-        for (int i = 0; i < 2; ++i) {
-            const double yD = xnew[PDW_X_Y_O] - p[PDW_P_R] - lr*cos(xnew[PDW_X_THETA1 + i]);
-            if (yD < -s->fall_depth) { fail(s, PDW_STATUS_FELL, PDW_REASON_FOOT_DEEP, i, t); return 1; }
-        }
     }
     return 0;
 }

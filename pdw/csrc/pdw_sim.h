@@ -74,11 +74,16 @@ typedef struct pdw_sim {
 void pdw_discrete_init(const pdw_kernel *k, const double *p, const double *x,
                        const int flags0[2], pdw_discrete *d, double *work);
 
-/* Update flags and arming once (MODEL.md section 5); appends events to sim. Returns 0, or
+/* Update flags and arming once from s->x (MODEL.md section 5); appends events to sim.
+ * Leaves the trig and kinematics of s->x (with the new anchors) in s->work. Returns 0, or
  * -1 when the event buffer is full (nothing changed then). */
 int pdw_update_flags(pdw_sim *s, double t);
 
-/* Check a new state; on failure sets s->status and s->failure and returns nonzero. */
+/* After pdw_update_flags: fell if a foot is deeper than fall_depth (sets status, returns 1). */
+int pdw_check_feet(pdw_sim *s, double t);
+
+/* Check a new state (finite, speeds, hip height); on failure sets s->status and s->failure
+ * and returns nonzero. */
 int pdw_check_state(pdw_sim *s, const double *xnew, double t);
 
 /* Store sample n (time t) if it is a recording step. */

@@ -1,0 +1,50 @@
+"""Micro-benchmark of the generated model: ns per right-hand side and per Jacobian, timed in a
+compiled loop (no Python in the loop), and the operation counts of the generated stages.
+
+Run: `make bench` (or `.venv/bin/python benchmarks/bench_model.py`). Prints a table and writes
+benchmarks/results/model.txt.
+"""
+import pathlib
+import platform
+import statistics
+
+import numpy as np
+
+import pdw
+from pdw import _core, _layout
+from pdw.model import kernel_index, parameter_vector
+
+N = 2_000_000
+REPEATS = 7
+
+
+def main():
+    p = parameter_vector(pdw.Params.paper())
+    x0 = np.array(pdw.X0_PAPER)
+    cases = [("stance (flags 0,1)", (0, 1)), ("double support (1,1)", (1, 1)), ("flight (0,0)", (0, 0))]
+    lines = ["pdw model micro-benchmark (%s, %s)" % (platform.processor() or platform.machine(),
+                                                       platform.python_version()),
+             "mean ns per evaluation over %d calls, median of %d repeats" % (N, REPEATS), ""]
+    lines.append("%-12s %-22s %10s %12s" % ("kernel", "state", "rhs [ns]", "jacobian [ns]"))
+    for variant in pdw.VARIANTS:
+        k = kernel_index(variant)
+        for label, (f1, f2) in cases:
+            rhs = statistics.median(_core.bench(k, "rhs", x0, p, f1, f2, 0.0, 0.01, N)
+                                    for _ in range(REPEATS))
+            jac = statistics.median(_core.bench(k, "jacobian", x0, p, f1, f2, 0.0, 0.01, N // 10)
+                                    for _ in range(REPEATS))
+            lines.append("%-12s %-22s %10.1f %12.1f" % (variant, label, rhs, jac))
+    lines += ["", "operation counts of the generated stages (SymPy count_ops after CSE):"]
+    stages = list(next(iter(_layout.OPS.values())))
+    lines.append("%-12s " % "kernel" + " ".join("%18s" % s for s in stages))
+    for name, ops in _layout.OPS.items():
+        lines.append("%-12s " % name + " ".join("%18d" % ops[s] for s in stages))
+    text = "\n".join(lines)
+    print(text)
+    out = pathlib.Path(__file__).parent / "results"
+    out.mkdir(exist_ok=True)
+    (out / "model.txt").write_text(text + "\n")
+
+
+if __name__ == "__main__":
+    main()
