@@ -70,7 +70,7 @@ def _walk(args):
     (out / "report.txt").write_text(text + "\n")
     st = steps(res)
     (out / "steps.csv").write_text(",".join(st.table) + "\n" + "\n".join(
-        ",".join(repr(float(st.table[k][i])) for k in st.table) for i in range(len(st))) + "\n")
+        ",".join(str(st.table[k][i].item()) for k in st.table) for i in range(len(st))) + "\n")
     meta = {k: (v if not isinstance(v, np.ndarray) else v.tolist()) for k, v in cfg.items()}
     meta.update(status=res.status, params=params.as_dict(), wall_time_s=res.wall_time,
                 failure=None if res.failure is None else
