@@ -74,11 +74,18 @@ def _discrete(flags, anchors, n):
     return np.ascontiguousarray(f), np.ascontiguousarray(a)
 
 
+def _folded(params, features):
+    """Parameters with absent force elements zeroed: a specialized kernel, or the general
+    kernel's fallback, then computes exactly the requested forces."""
+    params = Params.paper() if params is None else params
+    return params if features is None else params.without(features)
+
+
 def _evaluate(x, params, flags, anchors, variant, features=None):
     X, single = _states(x)
     k = kernel_index(variant, features)
     f, a = _discrete(flags, anchors, len(X))
-    p = parameter_vector(params)
+    p = parameter_vector(_folded(params, features))
     xdot = np.empty_like(X)
     work = np.empty((len(X), _core.NWORK))
     _core.rhs_batch(k, X, p, f, a, xdot, work)
@@ -121,7 +128,7 @@ def jacobian(x, params=None, flags=(0, 1), anchors=(0.0, 0.0), variant="paper", 
     f, a = _discrete(flags, anchors, len(X))
     J = np.empty((len(X), _core.NX * _core.NX))
     work = np.empty((len(X), _core.NWORK))
-    _core.jacobian_batch(k, X, parameter_vector(params), f, a, J, work)
+    _core.jacobian_batch(k, X, parameter_vector(_folded(params, features)), f, a, J, work)
     J = J.reshape(len(X), _core.NX, _core.NX)
     return J[0] if single else J
 

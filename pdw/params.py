@@ -32,7 +32,7 @@ class Params:
     r: float = _f(0.2, "m", "radius of the arc foot (0 = point foot); r < l", lo=0.0, lo_open=False)
     J_l: float = _f(0.0398, "kg m^2", "leg moment of inertia about its centre of mass", lo=0.0,
                     lo_open=False)
-    m_h: float = _f(2.0, "kg", "hip (torso) mass", lo=0.0, lo_open=False)
+    m_h: float = _f(2.0, "kg", "hip (torso) mass", lo=0.0)
     m_l: float = _f(1.0, "kg", "mass of each leg", lo=0.0)
     k_hip: float = _f(0.95, "N m/rad", "hip torsional spring stiffness", lo=0.0, lo_open=False)
     d_hip: float = _f(0.018, "N m s/rad", "hip torsional damping", lo=0.0, lo_open=False)
@@ -70,6 +70,9 @@ class Params:
         if self.r >= self.l:
             raise ValueError("Params.r = %r must be smaller than Params.l = %r (0 <= r < l)"
                              % (self.r, self.l))
+        if self.J_l == 0.0 and self.c == 0.0 and self.w == 0.0:
+            raise ValueError("Params.J_l = 0 with c = w = 0 gives a leg without inertia about the "
+                             "hip (singular mass matrix): need J_l > 0 or c**2 + w**2 > 0")
         if self.v_s >= self.v_d:
             raise ValueError("Params.v_s = %r must be smaller than Params.v_d = %r "
                              "(0 < v_s < v_d, Eq. 10)" % (self.v_s, self.v_d))
@@ -92,6 +95,20 @@ class Params:
         if name not in presets:
             raise ValueError("unknown preset %r; allowed: %s" % (name, ", ".join(presets)))
         return presets[name](**overrides)
+
+    def without(self, features) -> "Params":
+        """A copy with the parameters of the force elements *not* in ``features`` set to zero
+        (hip_spring: k_hip; hip_damper: d_hip; normal_damping: d_n; tangential: k_t, d_t;
+        friction: mu_s, mu_d). The general kernel with these parameters equals a kernel
+        specialized for ``features``."""
+        zero = {"hip_spring": ("k_hip",), "hip_damper": ("d_hip",), "normal_damping": ("d_n",),
+                "tangential": ("k_t", "d_t"), "friction": ("mu_s", "mu_d")}
+        unknown = set(features) - set(zero)
+        if unknown:
+            raise ValueError("unknown feature(s) %s; allowed: %s"
+                             % (", ".join(sorted(unknown)), ", ".join(zero)))
+        return self.replace(**{n: 0.0 for f, names in zero.items() if f not in features
+                               for n in names})
 
     def replace(self, **changes) -> "Params":
         """A copy with some fields changed (validated)."""
