@@ -30,7 +30,7 @@ const pdw_rk_tableau pdw_tableau_dopri5 = {
     {71.0/57600.0, 0.0, -71.0/16695.0, 71.0/1920.0, -17253.0/339200.0, 22.0/525.0, -1.0/40.0},
 };
 
-/* RODAS4 (Hairer & Wanner, Solving ODEs II, Sec. VI.4, Table 4.? "RODAS" with METH=1 of the
+/* RODAS4 (Hairer & Wanner, Solving ODEs II, Sec. VI.4, "RODAS", METH=1 of the
  * authors' code rodas.f): 6 stages, order 4, embedded order 3, stiffly accurate and L-stable.
  * In the transformed form the solution is the point where stage 6 would be evaluated plus u_6:
  *   x_new = x + a61..a64 u + u_5 + u_6   (a6j = a5j, a65 = 1), error = u_6.               */
