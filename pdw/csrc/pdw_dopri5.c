@@ -22,7 +22,7 @@ static double dopri5_step(pdw_sim *s, void *ctx, const double *fx, double h, int
 }
 
 static const pdw_adaptive_method dopri5 = {
-    dopri5_step, 1.0/5.0, 0.04, 0.9, 0.2, 10.0,
+    dopri5_step, 1.0/5.0, 0.04, 0.9, 0.2, 10.0, 0,
 };
 
 int pdw_dopri5_advance(pdw_sim *s) { return pdw_adaptive_advance(s, &dopri5, NULL); }

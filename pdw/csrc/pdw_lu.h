@@ -1,7 +1,9 @@
 /* Dense LU factorisation with partial (row) pivoting for the small n x n systems of the
  * linearly implicit methods (n = PDW_NX = 8: the Rosenbrock matrix I/(gamma h) - J).
- * Row-major arrays; the factors overwrite A (unit lower L below the diagonal, U on and above).
- * Allocation-free, static inline: the loops call these once per step. */
+ * Row-major arrays; the factors overwrite A: the unit lower L below the diagonal, U above it,
+ * and on the diagonal the reciprocals 1/U_kk (the solves multiply: no division chain).
+ * Allocation-free, static inline (n a compile-time constant at the call sites, so the loops
+ * unroll): the loops factor once per step and solve once per stage. */
 #ifndef PDW_LU_H
 #define PDW_LU_H
 
@@ -26,11 +28,11 @@ static inline int pdw_lu_factor(int n, double *restrict A, int *restrict piv)
             }
         }
         const double inv = 1.0 / A[k*n + k];
+        A[k*n + k] = inv;
         for (int i = k + 1; i < n; ++i) {
             const double l = A[i*n + k] * inv;
             A[i*n + k] = l;
-            if (l != 0.0)
-                for (int j = k + 1; j < n; ++j) A[i*n + j] -= l * A[k*n + j];
+            for (int j = k + 1; j < n; ++j) A[i*n + j] -= l * A[k*n + j];
         }
     }
     return 0;
@@ -51,7 +53,7 @@ static inline void pdw_lu_solve(int n, const double *restrict LU, const int *res
     for (int i = n - 1; i >= 0; --i) {
         double s = b[i];
         for (int j = i + 1; j < n; ++j) s -= LU[i*n + j] * b[j];
-        b[i] = s / LU[i*n + i];
+        b[i] = s * LU[i*n + i];
     }
 }
 

@@ -155,6 +155,7 @@ int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx)
         s->t = 0.0;
         s->n = 0;
         s->err_prev = 1e-4;
+        s->h_prev = 0.0;
         s->cache_valid = 0;
         if (settle_flags(s, 0.0)) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
         s->started = 1;
@@ -190,6 +191,14 @@ int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx)
         double fac = m->safety * pow(fmax(err, 1e-10), -alpha);
         if (m->pi_beta > 0.0) fac *= pow(s->err_prev, m->pi_beta);
         fac = fmin(m->fac_max, fmax(m->fac_min, fac));
+        if (m->predictive && s->h_prev > 0.0) {
+            /* Gustafsson (1994): h_new/h = safety (h/h_prev) (err_prev / err^2)^(1/(q+1)),
+             * the smaller of this and the I controller's (Hairer & Wanner II, Eq. IV.8.21) */
+            double g = m->safety * (h / s->h_prev)
+                     * pow(s->err_prev / (fmax(err, 1e-10) * fmax(err, 1e-10)), m->err_exponent);
+            g = fmin(m->fac_max, fmax(m->fac_min, g));
+            fac = fmin(fac, g);
+        }
         if (last_rejected) fac = fmin(fac, 1.0);
         const double h_next = h * fac;
         if (!fnew_valid) { pdw_ode_f(s, xnew, fnew); fnew_valid = 1; }
@@ -219,7 +228,8 @@ int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx)
         s->cache_valid = 1;
         s->t = last ? t_end : s->t + h_acc;
         s->n++;
-        s->err_prev = fmax(err, 1e-4);
+        s->err_prev = m->predictive ? fmax(err, 1e-2) : fmax(err, 1e-4);
+        s->h_prev = h;
         s->h = h_next;
         new_point = 1;
         last_rejected = 0;

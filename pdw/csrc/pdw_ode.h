@@ -53,6 +53,7 @@ typedef struct pdw_adaptive_method {
     double pi_beta;         /* PI controller's beta (Hairer's DOPRI5: 0.04); 0: I controller */
     double safety;          /* 0.9 */
     double fac_min, fac_max;/* bounds of h_new/h */
+    int predictive;         /* 1: Gustafsson's predictive controller (as Hairer's RODAS) */
 } pdw_adaptive_method;
 
 int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx);

@@ -66,7 +66,7 @@ static double rodas4_step(pdw_sim *s, void *vctx, const double *fx, double h, in
 }
 
 static const pdw_adaptive_method rodas4 = {
-    rodas4_step, 1.0/4.0, 0.0, 0.9, 0.2, 6.0,
+    rodas4_step, 1.0/4.0, 0.0, 0.9, 0.2, 6.0, 1,
 };
 
 int pdw_rodas4_advance(pdw_sim *s)

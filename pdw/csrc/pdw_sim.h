@@ -73,7 +73,8 @@ typedef struct pdw_sim {
     double work[PDW_NWORK];
     double cache[PDW_NX];       /* method-private: f(x) (FSAL) or verlet's a_n, for exact resumption */
     int cache_valid;            /* cache holds a value for the current x and discrete state */
-    double err_prev;            /* adaptive methods: previous accepted error (PI controller) */
+    double err_prev;            /* adaptive methods: previous accepted error (step controllers) */
+    double h_prev;              /* adaptive methods: previous accepted step (0: none yet) */
     /* --- work counters (every method) --- */
     long n_rhs, n_jac, n_rejected;
     /* --- termination --- */
