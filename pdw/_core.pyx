@@ -65,6 +65,7 @@ cdef extern from "pdw_sim.h":
         double t_end
         double rtol, atol
         double h_max
+        double event_tol
         double *rec_t
         double *rec_x
         int *rec_flags
@@ -93,6 +94,31 @@ cdef extern from "pdw_sim.h":
     const int pdw_nmethods
     void pdw_discrete_init(const pdw_kernel *k, const double *p, const double *x,
                            const int *flags0, pdw_discrete *d, double *work) noexcept nogil
+    enum:
+        PDW_STATUS_RECORDS_FULL
+
+
+cdef extern from "pdw_tableaus.h":
+    enum:
+        PDW_RK_MAXSTAGES, PDW_ROS_MAXSTAGES
+    ctypedef struct pdw_rk_tableau:
+        const char *name
+        int stages, order, embedded_order, fsal
+        double c[7]
+        double a[7][7]
+        double b[7]
+        double e[7]
+    ctypedef struct pdw_ros_tableau:
+        const char *name
+        int stages, order, embedded_order
+        double gamma
+        double a[6][6]
+        double C[6][6]
+        double m[6]
+        double e[6]
+    const pdw_rk_tableau pdw_tableau_rk4
+    const pdw_rk_tableau pdw_tableau_dopri5
+    const pdw_ros_tableau pdw_tableau_rodas4
 
 
 cdef extern from "pdw_bench.h":
@@ -193,15 +219,55 @@ def method_table():
             for i in range(pdw_nmethods)]
 
 
+def rk_tableau(str name):
+    """The Butcher tableau the compiled loops use for ``name`` ("rk4" or "dopri5"): a dict with
+    stages, order, embedded_order, fsal and arrays c (s,), A (s, s), b (s,), e = b - bhat (s,)."""
+    cdef const pdw_rk_tableau *T
+    if name == "rk4":
+        T = &pdw_tableau_rk4
+    elif name == "dopri5":
+        T = &pdw_tableau_dopri5
+    else:
+        raise ValueError("no explicit Runge-Kutta tableau %r (rk4, dopri5)" % name)
+    n = T.stages
+    return {"name": T.name.decode(), "stages": n, "order": T.order,
+            "embedded_order": T.embedded_order, "fsal": bool(T.fsal),
+            "c": np.array([T.c[i] for i in range(n)]),
+            "A": np.array([[T.a[i][j] for j in range(n)] for i in range(n)]),
+            "b": np.array([T.b[i] for i in range(n)]),
+            "e": np.array([T.e[i] for i in range(n)])}
+
+
+def ros_tableau(str name="rodas4"):
+    """The Rosenbrock tableau (Hairer-Wanner transformed form, see pdw_tableaus.h) of ``name``:
+    a dict with stages, order, embedded_order, gamma and arrays a, C (s, s), m, e (s,)."""
+    cdef const pdw_ros_tableau *T
+    if name == "rodas4":
+        T = &pdw_tableau_rodas4
+    else:
+        raise ValueError("no Rosenbrock tableau %r (rodas4)" % name)
+    n = T.stages
+    return {"name": T.name.decode(), "stages": n, "order": T.order,
+            "embedded_order": T.embedded_order, "gamma": T.gamma,
+            "a": np.array([[T.a[i][j] for j in range(n)] for i in range(n)]),
+            "C": np.array([[T.C[i][j] for j in range(n)] for i in range(n)]),
+            "m": np.array([T.m[i] for i in range(n)]),
+            "e": np.array([T.e[i] for i in range(n)])}
+
+
 def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, int f2,
         double dt, long n_steps, long record_every, bint record_contact,
         double fall_hip_height, double fall_depth, double max_speed,
         double rtol=1e-6, double atol=1e-8, double h_max=0.0, long max_records=0,
-        long event_capacity=256):
+        long event_capacity=256, double event_tol=1e-9):
     """Run one simulation in compiled code (GIL released). Returns a dict of arrays and status.
 
     Fixed-step methods take n_steps steps of dt; adaptive ones integrate to n_steps*dt with
-    first step dt. The record buffer holds max_records samples (default: n_steps/record_every+2).
+    first step dt, locating flag switches to within event_tol [s]. The record buffer first holds
+    max_records samples (default: n_steps/record_every+2, exact for fixed-step methods; for
+    adaptive ones at most 4096 to start with). When a loop fills the event or the record buffer
+    it returns PDW_STATUS_EVENTS_FULL / PDW_STATUS_RECORDS_FULL; this function then doubles that
+    buffer and calls the loop again, which resumes where it stopped: no sample is dropped.
     """
     cdef pdw_sim s
     cdef int flags0[2]
@@ -211,6 +277,8 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     if method < 0 or method >= pdw_nmethods:
         raise ValueError("method id %d out of range [0, %d)" % (method, pdw_nmethods))
     cdef pdw_advance_fn advance = pdw_methods[method].advance
+    if pdw_methods[method].adaptive and max_records <= 0 and n_rec_cap > 4096:
+        n_rec_cap = 4096        # adaptive: the number of steps is unknown; grown on demand
     memset(&s, 0, sizeof(pdw_sim))
     s.kernel = _kernel(k)
     s.t_end = n_steps * dt
@@ -218,6 +286,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     s.atol = atol
     s.h_max = h_max if h_max > 0 else s.t_end
     s.h = dt
+    s.event_tol = event_tol
     memcpy(s.p, &p[0], PDW_NP * sizeof(double))
     s.dt = dt
     s.n_steps = n_steps
@@ -251,14 +320,35 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     while True:
         with nogil:
             status = advance(&s)
-        if status != PDW_STATUS_EVENTS_FULL:
+        if status == PDW_STATUS_EVENTS_FULL:
+            grown = np.zeros((2 * events.shape[0], PDW_NEVENT))
+            grown[:events.shape[0]] = events
+            events = grown
+            v_e = events
+            s.events = &v_e[0, 0]
+            s.ev_capacity = events.shape[0]
+        elif status == PDW_STATUS_RECORDS_FULL:
+            # adaptive methods only: double the record arrays (copying what is there) and resume
+            n_rec_cap = 2 * max(n_rec_cap, 1)
+            rec_t = np.concatenate([rec_t, np.zeros(n_rec_cap - rec_t.shape[0])])
+            rec_x = np.concatenate([rec_x, np.zeros((n_rec_cap - rec_x.shape[0], PDW_NX))])
+            rec_flags = np.concatenate([rec_flags,
+                                        np.zeros((n_rec_cap - rec_flags.shape[0], 2), dtype=np.intc)])
+            if record_contact:
+                rec_contact = np.concatenate(
+                    [rec_contact, np.zeros((n_rec_cap - rec_contact.shape[0], PDW_NREC))])
+            v_t = rec_t
+            v_x = rec_x
+            v_f = rec_flags
+            s.rec_t = &v_t[0]
+            s.rec_x = &v_x[0, 0]
+            s.rec_flags = &v_f[0, 0]
+            if record_contact:
+                v_c = rec_contact
+                s.rec_contact = &v_c[0, 0]
+            s.rec_capacity = n_rec_cap
+        else:
             break
-        grown = np.zeros((2 * events.shape[0], PDW_NEVENT))
-        grown[:events.shape[0]] = events
-        events = grown
-        v_e = events
-        s.events = &v_e[0, 0]
-        s.ev_capacity = events.shape[0]
     n_rec = s.n_rec
     return {
         "status": status,

@@ -33,6 +33,7 @@ _REASONS = {
     3: "the hip dropped below fall_hip_height",
     4: "a foot sank deeper than fall_depth below the ground",
     5: "the step's linear system was singular",
+    6: "the adaptive step size underflowed (the error test never passed)",
 }
 
 
@@ -127,7 +128,7 @@ def check_state(x0, name="x0"):
 def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
              flags0=(0, 1), record_every=1, record_forces=True, on_failure="raise",
              fall_hip_height=None, fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8,
-             h_max=None):
+             h_max=None, event_tol=1e-9):
     """Simulate the walker from ``x0`` for ``t_end`` seconds.
 
     Parameters
@@ -144,7 +145,9 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     variant : {"paper", "consistent"}
         Contact reading of MODEL.md section 6.
     method : str
-        Integrator; ``"cdm"`` is the paper's central difference method (MODEL.md section 7).
+        Integrator (`pdw.integrators.INTEGRATORS`, docs/integrators.md): ``"cdm"`` is the
+        paper's central difference method (MODEL.md section 7); ``"verlet"``, ``"rk4"`` are
+        fixed-step, ``"dopri5"`` and ``"rodas4"`` (stiff, recommended) adaptive.
     flags0 : (int, int)
         Initial support flags of legs 1, 2 (the paper's start: leg 1 swing, leg 2 support).
     record_every : int
@@ -165,6 +168,10 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
         ones); for adaptive methods ``dt`` is the first trial step.
     h_max : float, optional
         Largest step of adaptive methods [s] (default: no limit).
+    event_tol : float
+        Adaptive methods locate each flag switch (touch-down, lift-off, arming) to within this
+        time [s] and end a step there (docs/integrators.md); fixed-step methods switch at step
+        boundaries.
 
     Returns
     -------
@@ -200,12 +207,14 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     rtol = _check_positive("rtol", rtol)
     atol = _check_positive("atol", atol)
     h_max = 0.0 if h_max is None else _check_positive("h_max", h_max)
+    event_tol = _check_positive("event_tol", event_tol)
 
     k = kernel_index(variant)
     p = parameter_vector(params)
     start = time.perf_counter()
     raw = _core.run(k, METHODS.index(method), x, p, f0[0], f0[1], dt, n_steps, int(record_every),
-                    bool(record_forces), hip, depth, max_speed, rtol, atol, h_max)
+                    bool(record_forces), hip, depth, max_speed, rtol, atol, h_max,
+                    event_tol=event_tol)
     wall = time.perf_counter() - start
     return _result(raw, params, variant, method, dt, t_end, wall, on_failure)
 

@@ -104,9 +104,37 @@ int pdw_check_state(pdw_sim *s, const double *xnew, double t)
     return 0;
 }
 
+int pdw_switch_pending(const pdw_sim *s, const double *x, double *work)
+{
+    /* keep in step with pdw_update_flags above */
+    const pdw_discrete *d = &s->disc;
+    const double *kin = work + PDW_WORK_KIN;
+    int mask = 0;
+    kinematics(s->kernel, s->p, x, d->anchors, work);
+    for (int i = 0; i < 2; ++i) {
+        const double *ki = kin + i*PDW_NKIN, *kj = kin + (1 - i)*PDW_NKIN;
+        const double y = ki[PDW_KIN_Y_D], vy = ki[PDW_KIN_V_Y];
+        if (d->flags[i]) {
+            if (y > 0.0 && vy > 0.0) mask |= 1 << i;           /* lift-off */
+            continue;
+        }
+        int armed = d->armed[i];
+        if (ki[PDW_KIN_X_D] <= kj[PDW_KIN_X_D]) armed = 0;
+        else if (y > 0.0) armed = 1;
+        if (armed != d->armed[i] || (armed && y < 0.0 && vy < 0.0)) mask |= 1 << i;
+    }
+    return mask;
+}
+
 void pdw_record(pdw_sim *s, double t)
 {
-    if (s->record_every <= 0 || s->n % s->record_every != 0 || s->n_rec >= s->rec_capacity) return;
+    if (s->record_every <= 0 || s->n % s->record_every != 0) return;
+    pdw_record_now(s, t);
+}
+
+void pdw_record_now(pdw_sim *s, double t)
+{
+    if (s->n_rec >= s->rec_capacity) return;
     const long r = s->n_rec++;
     s->rec_t[r] = t;
     memcpy(s->rec_x + r*PDW_NX, s->x, sizeof s->x);

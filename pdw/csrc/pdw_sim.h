@@ -30,8 +30,15 @@ enum {
     PDW_REASON_SPEED = 2,         /* a velocity above max_speed */
     PDW_REASON_HIP_LOW = 3,       /* hip below fall_hip_height */
     PDW_REASON_FOOT_DEEP = 4,     /* a foot deeper than fall_depth below the ground */
-    PDW_REASON_SINGULAR = 5       /* singular step matrix */
+    PDW_REASON_SINGULAR = 5,      /* singular step matrix */
+    PDW_REASON_STEP_SIZE = 6      /* adaptive step size underflow (error test never passed) */
 };
+
+/* A loop status beyond the generated PDW_STATUS_*: the record buffer is full. Like
+ * PDW_STATUS_EVENTS_FULL it never reaches Python's result: _core.run grows the record arrays
+ * and calls advance again, which resumes where it stopped. Only adaptive methods (whose
+ * number of samples is not known in advance) return it. */
+enum { PDW_STATUS_RECORDS_FULL = 64 };
 
 typedef struct pdw_sim {
     /* --- model and settings (inputs) --- */
@@ -46,6 +53,7 @@ typedef struct pdw_sim {
     double t_end;               /* end time [s] (adaptive methods; = n_steps*dt for fixed) */
     double rtol, atol;          /* tolerances of adaptive methods */
     double h_max;               /* largest step of adaptive methods [s] */
+    double event_tol;           /* adaptive methods: a flag switch is located to within this [s] */
     /* --- outputs (caller-allocated) --- */
     double *rec_t;              /* (rec_capacity,) */
     double *rec_x;              /* (rec_capacity, PDW_NX) */
@@ -63,6 +71,10 @@ typedef struct pdw_sim {
     int started;
     pdw_discrete disc;
     double work[PDW_NWORK];
+    double cache[PDW_NX];       /* method-private: f(x) (FSAL) or verlet's a_n, for exact resumption */
+    int cache_valid;            /* cache holds a value for the current x and discrete state */
+    double err_prev;            /* adaptive methods: previous accepted error (step controllers) */
+    double h_prev;              /* adaptive methods: previous accepted step (0: none yet) */
     /* --- work counters (every method) --- */
     long n_rhs, n_jac, n_rejected;
     /* --- termination --- */
@@ -89,6 +101,15 @@ int pdw_check_state(pdw_sim *s, const double *xnew, double t);
 /* Store sample n (time t) if it is a recording step. */
 void pdw_record(pdw_sim *s, double t);
 
+/* Store a sample of s->x at time t now, whatever n (if there is room); the contact forces are
+ * taken from s->work's contact block, which the caller must have filled for s->x. */
+void pdw_record_now(pdw_sim *s, double t);
+
+/* Would pdw_update_flags change the discrete state (flag, arming) at state x? Returns a bit
+ * mask (bit i: leg i), 0 if nothing would change. Mirrors pdw_update_flags's rules exactly;
+ * adaptive methods use it to locate switches inside a step. work: PDW_NWORK scratch. */
+int pdw_switch_pending(const pdw_sim *s, const double *x, double *work);
+
 /* --- the integrators: one module each, all behind this contract ---------------------------
  * advance(s): take steps from s->x (time s->t, step count s->n) until s->t reaches t_end (or
  * n_steps for fixed-step methods), updating the discrete state once per step through
@@ -110,5 +131,11 @@ extern const int pdw_nmethods;
 
 /* The paper's central difference method (MODEL.md section 7). Returns s->status. */
 int pdw_cdm_advance(pdw_sim *s);
+
+/* Integrators beyond the paper's (docs/integrators.md); one module each. */
+int pdw_verlet_advance(pdw_sim *s);   /* pdw_verlet.c: velocity Verlet, order 2, fixed step */
+int pdw_rk4_advance(pdw_sim *s);      /* pdw_rk4.c: classical Runge-Kutta, order 4, fixed step */
+int pdw_dopri5_advance(pdw_sim *s);   /* pdw_dopri5.c: Dormand-Prince 5(4), adaptive */
+int pdw_rodas4_advance(pdw_sim *s);   /* pdw_rodas4.c: Rosenbrock RODAS4(3), adaptive, stiff */
 
 #endif /* PDW_SIM_H */

@@ -1,0 +1,244 @@
+/* Drivers and helpers shared by the fixed-step and adaptive integrators (see pdw_ode.h). */
+#include <float.h>
+#include <math.h>
+#include <string.h>
+#include "pdw_ode.h"
+
+void pdw_rk_stages(pdw_sim *s, const pdw_rk_tableau *T, const double *x, double h,
+                   double (*k)[PDW_NX], double *xnew, double *errv)
+{
+    double xs[PDW_NX];
+    for (int i = 1; i < T->stages; ++i) {
+        for (int c = 0; c < PDW_NX; ++c) {
+            double acc = 0.0;
+            for (int j = 0; j < i; ++j) acc += T->a[i][j] * k[j][c];
+            xs[c] = x[c] + h * acc;
+        }
+        pdw_ode_f(s, xs, k[i]);
+    }
+    for (int c = 0; c < PDW_NX; ++c) {
+        double acc = 0.0, err = 0.0;
+        for (int j = 0; j < T->stages; ++j) {
+            acc += T->b[j] * k[j][c];
+            err += T->e[j] * k[j][c];
+        }
+        xnew[c] = x[c] + h * acc;
+        if (errv) errv[c] = h * err;
+    }
+    /* FSAL: the last stage point is the new solution up to rounding; use that exact point so
+     * that k[stages-1] is f(xnew) bit for bit */
+    if (T->fsal) memcpy(xnew, xs, sizeof xs);
+}
+
+double pdw_err_norm(const pdw_sim *s, const double *x, const double *xnew, const double *errv)
+{
+    double acc = 0.0;
+    for (int i = 0; i < PDW_NX; ++i) {
+        const double sc = s->atol + s->rtol * fmax(fabs(x[i]), fabs(xnew[i]));
+        const double r = errv[i] / sc;
+        acc += r * r;
+    }
+    return sqrt(acc / PDW_NX);
+}
+
+/* Contact forces of s->x into s->work (for the recorded sample), then store the sample. */
+static void sample(pdw_sim *s)
+{
+    const pdw_kernel *k = s->kernel;
+    pdw_trig(s->x, s->work + PDW_WORK_TRIG);
+    k->kinematics(s->x, s->work + PDW_WORK_TRIG, s->p, s->disc.anchors, s->work + PDW_WORK_KIN);
+    k->contact(s->work + PDW_WORK_KIN, s->disc.flags, s->p, s->work + PDW_WORK_CONTACT);
+    pdw_record_now(s, s->t);
+}
+
+/* Did the part of the discrete state that f depends on change? */
+static int forces_changed(const pdw_discrete *a, const pdw_discrete *b)
+{
+    return a->flags[0] != b->flags[0] || a->flags[1] != b->flags[1]
+        || a->anchors[0] != b->anchors[0] || a->anchors[1] != b->anchors[1];
+}
+
+/* ---------------------------------------------------------------- fixed step ------------- */
+
+int pdw_fixed_advance(pdw_sim *s, pdw_fixed_step_fn step)
+{
+    const double dt = s->dt;
+    double xnew[PDW_NX];
+    s->status = PDW_STATUS_RUNNING;
+    if (!s->started) {
+        if (pdw_update_flags(s, 0.0)) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
+        s->started = 1;
+        s->n = 0;
+        s->t = 0.0;
+        s->cache_valid = 0;
+        if (s->record_every > 0) sample(s);
+    }
+    while (s->n < s->n_steps) {
+        if (s->n > 0) {
+            /* flags from (U_n, U'_n) before step n, as the paper's loop (Fig. 3) */
+            const pdw_discrete before = s->disc;
+            if (pdw_update_flags(s, s->t)) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
+            if (forces_changed(&before, &s->disc)) s->cache_valid = 0;
+            if (s->record_every > 0 && s->n % s->record_every == 0) sample(s);
+        }
+        if (step(s, dt, xnew)) return s->status;
+        if (pdw_check_state(s, xnew, s->t)) return s->status;
+        memcpy(s->x, xnew, sizeof xnew);
+        s->n++;
+        s->t = s->n * dt;
+    }
+    if (pdw_update_flags(s, s->t)) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
+    if (s->record_every > 0 && s->n % s->record_every == 0) sample(s);
+    s->status = PDW_STATUS_DONE;
+    return s->status;
+}
+
+/* ---------------------------------------------------------------- adaptive --------------- */
+
+/* Apply pdw_update_flags until nothing changes (a lift-off can arm the same leg at once), so
+ * that no switch is pending at the start of the next step. Needs room for 6 events. */
+static int settle_flags(pdw_sim *s, double t)
+{
+    for (int it = 0; it < 3; ++it) {
+        const pdw_discrete before = s->disc;
+        if (pdw_update_flags(s, t)) return -1;
+        if (memcmp(&before, &s->disc, sizeof before) == 0) break;
+    }
+    return 0;
+}
+
+/* Cubic Hermite interpolant on [0, h] at theta in [0, 1] (Hairer, Norsett & Wanner I, II.6). */
+static void hermite(const double *x0, const double *f0, const double *x1, const double *f1,
+                    double h, double th, double *out)
+{
+    for (int i = 0; i < PDW_NX; ++i)
+        out[i] = (1.0 - th)*x0[i] + th*x1[i]
+               + th*(th - 1.0)*((1.0 - 2.0*th)*(x1[i] - x0[i]) + (th - 1.0)*h*f0[i] + th*h*f1[i]);
+}
+
+/* Bisection of the switch predicate (pdw_switch_pending) on the Hermite extension of the step
+ * [t, t + h]: false at 0, true at h. Returns tb in (0, h], the right end of a bracket of
+ * width <= event_tol with the predicate true at tb. */
+static double locate_switch(pdw_sim *s, const double *x0, const double *f0, const double *x1,
+                            const double *f1, double h)
+{
+    double ta = 0.0, tb = h, xi[PDW_NX];
+    while (tb - ta > s->event_tol) {
+        const double tm = 0.5 * (ta + tb);
+        if (tm <= ta || tm >= tb) break;
+        hermite(x0, f0, x1, f1, h, tm / h, xi);
+        if (pdw_switch_pending(s, xi, s->work)) tb = tm; else ta = tm;
+    }
+    return tb;
+}
+
+static int fail_step_size(pdw_sim *s)
+{
+    s->status = PDW_STATUS_DIVERGED;
+    s->failure.reason = PDW_REASON_STEP_SIZE;
+    s->failure.leg = -1;
+    s->failure.t = s->t;
+    memcpy(s->failure.x, s->x, sizeof s->x);
+    return s->status;
+}
+
+int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx)
+{
+    double xnew[PDW_NX], fnew[PDW_NX];
+    const double alpha = m->err_exponent - 0.75 * m->pi_beta;
+    const double t_end = s->t_end;
+    int new_point = 1, last_rejected = 0;
+
+    s->status = PDW_STATUS_RUNNING;
+    if (s->event_tol <= 0.0) s->event_tol = 1e-9;
+    if (!s->started) {
+        s->t = 0.0;
+        s->n = 0;
+        s->err_prev = 1e-4;
+        s->h_prev = 0.0;
+        s->cache_valid = 0;
+        if (settle_flags(s, 0.0)) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
+        s->started = 1;
+        if (s->record_every > 0) sample(s);
+    }
+    while (s->t < t_end) {
+        /* room for what an accepted step may append; return here only (before a step), so
+         * that a resumed call continues exactly */
+        if (s->n_events + 6 > s->ev_capacity) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
+        if (s->record_every > 0 && s->n_rec + 1 > s->rec_capacity) {
+            s->status = PDW_STATUS_RECORDS_FULL;
+            return s->status;
+        }
+        if (!s->cache_valid) { pdw_ode_f(s, s->x, s->cache); s->cache_valid = 1; }
+
+        double h = fmin(s->h, s->h_max);
+        int last = 0;
+        const double rem = t_end - s->t;
+        if (h >= rem - 1e-12 * fmax(1.0, t_end)) { h = rem; last = 1; }
+        if (!(h > 8.0 * DBL_EPSILON * fmax(fabs(s->t), 1e-3))) return fail_step_size(s);
+
+        int fnew_valid = 0;
+        const double err = m->step(s, ctx, s->cache, h, new_point, xnew, fnew, &fnew_valid);
+        new_point = 0;
+        if (!(err <= 1.0)) {                               /* rejected (or NaN / singular) */
+            double fac = m->fac_min;
+            if (isfinite(err)) fac = fmax(m->fac_min, m->safety * pow(err, -m->err_exponent));
+            s->h = h * fmin(1.0, fac);
+            s->n_rejected++;
+            last_rejected = 1;
+            continue;
+        }
+        double fac = m->safety * pow(fmax(err, 1e-10), -alpha);
+        if (m->pi_beta > 0.0) fac *= pow(s->err_prev, m->pi_beta);
+        fac = fmin(m->fac_max, fmax(m->fac_min, fac));
+        if (m->predictive && s->h_prev > 0.0) {
+            /* Gustafsson (1994): h_new/h = safety (h/h_prev) (err_prev / err^2)^(1/(q+1)),
+             * the smaller of this and the I controller's (Hairer & Wanner II, Eq. IV.8.21) */
+            double g = m->safety * (h / s->h_prev)
+                     * pow(s->err_prev / (fmax(err, 1e-10) * fmax(err, 1e-10)), m->err_exponent);
+            g = fmin(m->fac_max, fmax(m->fac_min, g));
+            fac = fmin(fac, g);
+        }
+        if (last_rejected) fac = fmin(fac, 1.0);
+        const double h_next = h * fac;
+        if (!fnew_valid) { pdw_ode_f(s, xnew, fnew); fnew_valid = 1; }
+
+        /* a flag switch inside the step: locate it on the step's continuous extension, then
+         * redo the step to end just after it (within event_tol) */
+        double h_acc = h;
+        if (pdw_switch_pending(s, xnew, s->work)) {
+            const double tb = locate_switch(s, s->x, s->cache, xnew, fnew, h);
+            if (tb < h) {
+                fnew_valid = 0;
+                const double e2 = m->step(s, ctx, s->cache, tb, 0, xnew, fnew, &fnew_valid);
+                if (!isfinite(e2)) {                        /* could not redo: retry shorter */
+                    s->h = tb;
+                    s->n_rejected++;
+                    last_rejected = 1;
+                    continue;
+                }
+                if (!fnew_valid) { pdw_ode_f(s, xnew, fnew); fnew_valid = 1; }
+                h_acc = tb;
+                last = 0;
+            }
+        }
+        if (pdw_check_state(s, xnew, s->t)) return s->status;
+        memcpy(s->x, xnew, sizeof xnew);
+        memcpy(s->cache, fnew, sizeof fnew);
+        s->cache_valid = 1;
+        s->t = last ? t_end : s->t + h_acc;
+        s->n++;
+        s->err_prev = m->predictive ? fmax(err, 1e-2) : fmax(err, 1e-4);
+        s->h_prev = h;
+        s->h = h_next;
+        new_point = 1;
+        last_rejected = 0;
+
+        const pdw_discrete before = s->disc;
+        settle_flags(s, s->t);                              /* room checked above */
+        if (forces_changed(&before, &s->disc)) s->cache_valid = 0;
+        if (s->record_every > 0 && (s->n % s->record_every == 0 || s->t >= t_end)) sample(s);
+    }
+    s->status = PDW_STATUS_DONE;
+    return s->status;
+}
