@@ -79,6 +79,7 @@ int pdw_fixed_advance(pdw_sim *s, pdw_fixed_step_fn step)
             const pdw_discrete before = s->disc;
             if (pdw_update_flags(s, s->t)) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
             if (forces_changed(&before, &s->disc)) s->cache_valid = 0;
+            if (pdw_check_feet(s, s->t)) return s->status;
             if (s->record_every > 0 && s->n % s->record_every == 0) sample(s);
         }
         if (step(s, dt, xnew)) return s->status;
@@ -237,6 +238,7 @@ int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx)
         const pdw_discrete before = s->disc;
         settle_flags(s, s->t);                              /* room checked above */
         if (forces_changed(&before, &s->disc)) s->cache_valid = 0;
+        if (pdw_check_feet(s, s->t)) return s->status;
         if (s->record_every > 0 && (s->n % s->record_every == 0 || s->t >= t_end)) sample(s);
     }
     s->status = PDW_STATUS_DONE;
