@@ -7,11 +7,14 @@ from setuptools import Extension, setup
 
 # Portable, reproducible optimisation; no -march=native or -ffast-math unless asked for.
 extra = ["-O3", "-std=c99", "-fno-math-errno"] + os.environ.get("PDW_CFLAGS", "").split()
-sources = ["pdw/_core.pyx", "generated/pdw_model.c"] + sorted(glob.glob("pdw/csrc/*.c"))
+hybrid = ["pdw/_hybrid.pyx", "generated/pdw_model.c", "generated/pdw_hybrid.c", "pdw/csrc/pdw_hybrid_sim.c"]
+sources = ["pdw/_core.pyx", "generated/pdw_model.c"] + sorted(set(glob.glob("pdw/csrc/*.c")) - set(hybrid))
 
 setup(
     ext_modules=cythonize(
         [Extension("pdw._core", sources=sources, include_dirs=["generated", "pdw/csrc"],
+                   extra_compile_args=extra, libraries=["m"]),
+         Extension("pdw._hybrid", sources=hybrid, include_dirs=["generated", "pdw/csrc"],
                    extra_compile_args=extra, libraries=["m"])],
         compiler_directives={"language_level": "3", "boundscheck": False, "wraparound": False,
                              "cdivision": True, "initializedcheck": False},

@@ -11,7 +11,7 @@ import pathlib
 
 import sympy as sp
 
-from . import layout
+from . import hybrid, layout
 from . import model as mdl
 from . import stages
 from .printer import c_block
@@ -334,4 +334,4 @@ def write_all(root: pathlib.Path):
     for path, text in files.items():
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(text)
-    return list(files)
+    return list(files) + hybrid.write(root, h, BANNER.format(sympy=sp.__version__, hash=h))
