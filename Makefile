@@ -46,6 +46,7 @@ check-generated: $(STAMP)
 bench: $(STAMP)
 	$(PY) benchmarks/bench_model.py
 	$(PY) benchmarks/bench_simulate.py
+	$(PY) benchmarks/bench_integrators.py
 
 ## study: slow studies (marked slow in tests/)
 study: $(STAMP)

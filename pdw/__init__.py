@@ -9,6 +9,7 @@ contact_forces          contact kinematics and forces of both feet (Eqs. 3-11)
 energies                kinetic and potential energies
 simulate, Result        one compiled simulation (support flags, events, status)
 steps                   per-step gait descriptors (MODEL.md section 8)
+hybrid                  the rigid-ground impact-momentum model (MODEL.md section 9): find_gait, ...
 PdwError, SimulationError, DivergedError, InvalidInputError   the error hierarchy
 STATE, VARIANTS         the state layout and the contact variants (MODEL.md section 6)
 """
@@ -19,6 +20,8 @@ from .errors import (DivergedError, FellError, InvalidInputError, PdwError, Simu
                      SingularSystemError)
 from .gait import Steps, steps
 from .params import Params
+from . import hybrid
+from .gait_types import Gait
 from .simulation import METHODS, X0_DISTURBED, X0_PAPER, Event, Result, simulate
 
 __version__ = "0.1.0"
@@ -27,5 +30,5 @@ __all__ = [
     "Params", "rhs", "jacobian", "mass_matrix", "contact_forces", "ContactState", "energies",
     "STATE", "VARIANTS", "INPUT_HASH", "simulate", "Result", "Event", "METHODS", "X0_PAPER",
     "X0_DISTURBED", "steps", "Steps", "PdwError", "SimulationError", "DivergedError",
-    "SingularSystemError", "FellError", "InvalidInputError",
+    "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait",
 ]
