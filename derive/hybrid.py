@@ -76,19 +76,9 @@ def hip_force() -> sp.Matrix:
     return Qd
 
 
-_MECH = None
-
-
-def _mechanics():
-    global _MECH
-    if _MECH is None:
-        _MECH = mdl.mechanics()
-    return _MECH
-
-
 def reduced_dynamics(method: str = "projection"):
     """(M_r 2x2, f_r 2x1) of the stance phase, M_r phidd = f_r, in the symbols `Y` and `model.P`."""
-    mech = _mechanics()
+    mech = mdl.mechanics()
     sub = _subs()
     Phi, B = embedding()
     Qh = hip_force()
@@ -119,7 +109,7 @@ def ground_force():
     for (x_o, y_o) the identity, so lambda is those rows of the left side, evaluated with
     q'' = B phidd + Bdot phid; phidd appears as the symbols `PHIDD`.
     """
-    mech = _mechanics()
+    mech = mdl.mechanics()
     sub = _subs()
     _, B = embedding()
     Bdot_phid = sp.Matrix(4, 1, lambda i, _: sum(
@@ -141,7 +131,7 @@ def swing_foot():
 
 def energies():
     """T, V_gravity, V_hip of the stance phase (V_gravity with s0 = 0)."""
-    mech = _mechanics()
+    mech = mdl.mechanics()
     sub = _subs()
     return [sp.simplify(e.xreplace(sub)) for e in (mech.T, mech.V_gravity, mech.V_hip)]
 
@@ -155,7 +145,7 @@ def full_state():
 def impact_terms():
     """M(q) (16, row-major) and the material-point Jacobians J_1, J_2 (2x4 each, foot-major,
     row-major) in the full coordinates: the data of the impact's KKT system."""
-    M = _mechanics().M
+    M = mdl.mechanics().M
     J = []
     for foot in range(2):
         v = mdl.material_velocity(foot)

@@ -20,6 +20,7 @@ Stages, in data-flow order:
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import sympy as sp
@@ -86,8 +87,10 @@ def _time_derivative(expr):
     return sum(sp.diff(expr, qi) * qdi for qi, qdi in zip(Q, QD))
 
 
+@functools.lru_cache(maxsize=None)
 def mechanics() -> Mechanics:
-    """Lagrange's equations from T and V of MODEL.md section 3."""
+    """Lagrange's equations from T and V of MODEL.md section 3 (computed once, cached: treat
+    the returned matrices as read-only)."""
     m_h, m_l, J_l, g, k_hip = P["m_h"], P["m_l"], P["J_l"], P["g"], P["k_hip"]
     sg, cg = P["sin_gamma"], P["cos_gamma"]
     H, Gs, _ = points()

@@ -66,32 +66,22 @@ def contact(spec: KernelSpec):
     return list(mdl.contact_laws(spec.variant, spec.features).values())
 
 
-_MECH = None
-
-
-def _mechanics():
-    global _MECH
-    if _MECH is None:
-        _MECH = mdl.mechanics()
-    return _MECH
-
-
 def forcing(spec: KernelSpec) -> sp.Matrix:
     """f = Q_f - C qd - G with the contact forces as symbols (4x1, untrigged)."""
-    mech = _mechanics()
+    mech = mdl.mechanics()
     G = mdl.fold_parameters(mech.G, spec.features)
     return mdl.generalized_forces(spec.features) - mech.Cqd - G
 
 
 def dynamics(spec: KernelSpec):
     """M (row-major 16) then f (4)."""
-    M = _mechanics().M
+    M = mdl.mechanics().M
     return [_trig(e) for e in list(M) + list(forcing(spec))]
 
 
 def cdm_terms(spec: KernelSpec):
     """M (16), the appendix C matrix (16) and Q_f - G (4), for the central difference method."""
-    mech = _mechanics()
+    mech = mdl.mechanics()
     QmG = mdl.generalized_forces(spec.features) - mdl.fold_parameters(mech.G, spec.features)
     return [_trig(e) for e in list(mech.M) + list(mech.C) + list(QmG)]
 
@@ -109,7 +99,7 @@ def dynamics_jacobian(spec: KernelSpec):
     """
     sym = contact_partial_symbols()
     f = forcing(spec)
-    M = _mechanics().M
+    M = mdl.mechanics().M
     x = mdl.X
     A = f.jacobian(x)
     for i in range(2):
@@ -127,5 +117,5 @@ def dynamics_jacobian(spec: KernelSpec):
 
 def energies(spec: KernelSpec):
     """T, V_gravity, V_hip (MODEL.md section 3)."""
-    mech = _mechanics()
+    mech = mdl.mechanics()
     return [_trig(e) for e in (mech.T, mech.V_gravity, mdl.fold_parameters(mech.V_hip, spec.features))]
