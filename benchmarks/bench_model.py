@@ -4,13 +4,13 @@ compiled loop (no Python in the loop), and the operation counts of the generated
 Run: `make bench` (or `.venv/bin/python benchmarks/bench_model.py`). Prints a table and writes
 benchmarks/results/model.txt.
 """
-import pathlib
 import platform
 import statistics
 
 import numpy as np
 
 import pdw
+from _results import publish
 from pdw import _core, _layout
 from pdw.model import kernel_index, parameter_vector
 
@@ -39,11 +39,7 @@ def main():
     lines.append("%-12s " % "kernel" + " ".join("%18s" % s for s in stages))
     for name, ops in _layout.OPS.items():
         lines.append("%-12s " % name + " ".join("%18d" % ops[s] for s in stages))
-    text = "\n".join(lines)
-    print(text)
-    out = pathlib.Path(__file__).parent / "results"
-    out.mkdir(exist_ok=True)
-    (out / "model.txt").write_text(text + "\n")
+    publish("model.txt", lines)
 
 
 if __name__ == "__main__":

@@ -5,12 +5,12 @@ Run: `make bench` (or `.venv/bin/python benchmarks/bench_simulate.py`). Prints a
 writes benchmarks/results/simulate.txt. Wall times are medians of repeated runs in this one
 process; the reference is the issue's 2-4 ms for a compiled central-difference loop.
 """
-import pathlib
 import statistics
 import time
 import tracemalloc
 
 import pdw
+from _results import publish
 
 REPEATS = 31
 REFERENCE_MS = (2.0, 4.0)
@@ -49,11 +49,7 @@ def main():
         lines.append("%-50s %9.2f %9.1f %5.2f-%5.2fx %9.2f MB" % (
             label, 1e3 * t, 1e9 * t / r.n_steps, 1e3 * t / REFERENCE_MS[1], 1e3 * t / REFERENCE_MS[0],
             mem / 2**20))
-    text = "\n".join(lines)
-    print(text)
-    out = pathlib.Path(__file__).parent / "results"
-    out.mkdir(exist_ok=True)
-    (out / "simulate.txt").write_text(text + "\n")
+    publish("simulate.txt", lines)
 
 
 if __name__ == "__main__":
