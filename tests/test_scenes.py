@@ -344,3 +344,14 @@ def test_pdw_run_reports_a_fall_with_code_3(tmp_path, capsys):
 
 def test_pdw_walk_still_works(tmp_path, capsys):
     assert cli.main(["walk", "--t-end", "0.5", "--no-figures", "--out", str(tmp_path)]) == 0
+
+
+def test_docs_list_every_scene_key():
+    import dataclasses
+    from pdw.scene import SECTION_TYPES
+    text = (ROOT / "docs" / "scenes.md").read_text()
+    for f in dataclasses.fields(Scene):
+        assert "`%s`" % f.name in text or "[%s]" % f.name in text, f.name
+    for section, cls in SECTION_TYPES.items():
+        for f in dataclasses.fields(cls):
+            assert "`%s.%s`" % (section, f.name) in text or "`%s`" % f.name in text, f.name
