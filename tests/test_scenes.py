@@ -355,3 +355,26 @@ def test_docs_list_every_scene_key():
     for section, cls in SECTION_TYPES.items():
         for f in dataclasses.fields(cls):
             assert "`%s.%s`" % (section, f.name) in text or "`%s`" % f.name in text, f.name
+
+
+def test_random_scenes_round_trip():
+    from hypothesis import given, settings, strategies as st
+    finite = st.floats(allow_nan=False, allow_infinity=False, width=64)
+    positive = st.floats(min_value=1e-300, max_value=1e300)
+
+    @settings(max_examples=150, deadline=None)
+    @given(name=st.text(st.characters(blacklist_categories=("Cs",)), max_size=30),
+           x0=st.lists(finite, min_size=8, max_size=8),
+           flags=st.lists(st.integers(0, 1), min_size=2, max_size=2),
+           k_hip=st.floats(0.0, 10.0), dt=positive, every=st.integers(0, 10**9),
+           steps=st.integers(0, 10**6), tol=positive, method=st.sampled_from(METHODS),
+           bools=st.lists(st.booleans(), min_size=5, max_size=5),
+           h_max=st.none() | positive)
+    def check(name, x0, flags, k_hip, dt, every, steps, tol, method, bools, h_max):
+        sc = Scene(name=name, x0=x0, flags0=flags, params={"k_hip": k_hip},
+                   integrator=Integrator(method=method, dt=dt, h_max=h_max),
+                   forces=Forces(*bools), record=Record(every=every),
+                   stop=Stop(t_end=max(dt, 1.0), steps=steps, periodic_tol=tol))
+        assert Scene.from_toml(sc.to_toml()) == sc
+
+    check()
