@@ -45,27 +45,22 @@ CASES = [
 ]
 
 
-def timed(scene, repeats=REPEATS):
-    pdw.run(scene)                                  # warm up
-    ts = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        r = pdw.run(scene)
-        ts.append(time.perf_counter() - t0)
-    return statistics.median(ts), r
-
-
 def timed_interleaved(scenes, repeats=REPEATS):
-    """Median and minimum wall time of each scene, the scenes run in turn in every round so
-    that a change of machine load affects them alike. Returns [(median, min, result)]."""
+    """Median wall time and median CPU time (of this thread, which runs the compiled loop) of
+    each scene; the scenes run in turn in every round so that a change of machine load affects
+    them alike. Returns [(wall, cpu, result)]."""
     results = [pdw.run(sc) for sc in scenes]        # warm up
-    ts = [[] for _ in scenes]
+    wall = [[] for _ in scenes]
+    cpu = [[] for _ in scenes]
     for _ in range(repeats):
         for i, sc in enumerate(scenes):
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.thread_time()
             results[i] = pdw.run(sc)
-            ts[i].append(time.perf_counter() - t0)
-    return [(statistics.median(t), min(t), r) for t, r in zip(ts, results)]
+            c1, t1 = time.thread_time(), time.perf_counter()
+            wall[i].append(t1 - t0)
+            cpu[i].append(c1 - c0)
+    return [(statistics.median(w), statistics.median(c), r)
+            for w, c, r in zip(wall, cpu, results)]
 
 
 def peak_memory(scene):
@@ -84,27 +79,30 @@ def _mem(b):
 def main():
     lines = ["scenes of decreasing needs: Params.paper_steady(), X0_PAPER, method cdm, dt = 1e-4, "
              "t_end = %g s (%d steps)" % (T_END, round(T_END / 1e-4)),
-             "wall: median of %d runs of pdw.run(scene) in one process (Python set-up and result "
-             "included); memory: tracemalloc peak" % REPEATS,
+             "median of %d rounds of pdw.run(scene), the scenes in turn (Python set-up and result "
+             "included): wall time, and CPU time of the running thread (robust to other jobs); "
+             "memory: tracemalloc peak" % REPEATS,
              "python %s" % sys.version.split()[0], "",
              "%-54s %8s %6s %7s %7s %7s %5s %10s %8s" % (
-                 "scene", "status", "t_end", "ms", "min ms", "ns/step", "steps", "peak mem",
+                 "scene", "status", "t_end", "wall ms", "cpu ms", "ns/step", "steps", "peak mem",
                  "speed-up")]
     scenes = [BASE.replace(**changes) for _, changes in CASES]
     rows = []
-    for (label, _), sc, (t, t_min, r) in zip(CASES, scenes, timed_interleaved(scenes)):
+    for (label, _), sc, (wall, cpu, r) in zip(CASES, scenes, timed_interleaved(scenes)):
         assert r.walked, (label, r.status)
-        rows.append((label, r, t, t_min, peak_memory(sc)))
-    t_full = rows[0][2]
-    for label, r, t, t_min, mem in rows:
+        rows.append((label, r, wall, cpu, peak_memory(sc)))
+    full_wall, full_cpu = rows[0][2], rows[0][3]
+    for label, r, wall, cpu, mem in rows:
         lines.append("%-54s %8s %6.3f %7.2f %7.2f %7.1f %5d %10s %7.2fx" % (
-            label, r.status, r.t_final, 1e3 * t, 1e3 * t_min, 1e9 * t / r.n_steps,
-            r.n_gait_steps, _mem(mem), t_full / t))
-    by = {label: t for label, _, t, _, _ in rows}
+            label, r.status, r.t_final, 1e3 * wall, 1e3 * cpu, 1e9 * cpu / r.n_steps,
+            r.n_gait_steps, _mem(mem), full_cpu / cpu))
+    lines.append("(ns/step and speed-up from the CPU time; wall-time speed-ups: %s)"
+                 % ", ".join("%.2fx" % (full_wall / w) for _, _, w, _, _ in rows))
+    by = {label: c for label, _, _, c, _ in rows}
     t_desc = by["gait descriptors only"]
-    lines += ["", "descriptors only vs full recording: %.2fx faster (target 1.5x); vs state+forces+"
-              "events without energies: %.2fx; vs events only: %.2fx"
-              % (t_full / t_desc, by[CASES[1][0]] / t_desc, by["events only"] / t_desc)]
+    lines += ["", "descriptors only (CPU time) vs full recording: %.2fx faster (target 1.5x); vs "
+              "state+forces+events without energies: %.2fx; vs events only: %.2fx"
+              % (full_cpu / t_desc, by[CASES[1][0]] / t_desc, by["events only"] / t_desc)]
     # O(1) memory of a descriptors-only run
     lines += ["", "descriptors-only memory against run length (tracemalloc peak, steady gait):"]
     desc = BASE.replace(record=Record.descriptors_only())
@@ -112,11 +110,36 @@ def main():
         sc = desc.replace(stop={"t_end": t_end})
         pdw.run(sc)
         mem = peak_memory(sc)
-        t, r = timed(sc, repeats=3 if t_end > 10 else 11)
+        ((wall, cpu, r),) = timed_interleaved([sc], repeats=3 if t_end > 10 else 11)
         assert r.walked
-        lines.append("  %8d steps (%5.1f s, %3d gait steps): peak %s, %.1f ms" % (
-            r.n_steps, t_end, r.n_gait_steps, _mem(mem), 1e3 * t))
+        lines.append("  %8d steps (%5.1f s, %3d gait steps): peak %s, %.1f ms (cpu %.1f ms)" % (
+            r.n_steps, t_end, r.n_gait_steps, _mem(mem), 1e3 * wall, 1e3 * cpu))
+    lines += ["", "the generated kernels: CPU ns per evaluation at a double-support state (both feet "
+              "penetrating), best of 9 x 2e5 (rhs) / 5e4 (Jacobian) calls:"]
+    lines += kernel_costs()
     publish("scenes.txt", lines)
+
+
+def kernel_costs():
+    import numpy as np
+    from pdw import _core
+    from pdw.model import parameter_vector
+    x = np.array(pdw.X0_PAPER)
+    x[1] -= 0.002                                   # both feet ~5 mm deep
+    p = parameter_vector(pdw.Params.paper())
+    out = []
+    for k, (name, _, _) in enumerate(_core.kernel_table()):
+        cost = {}
+        for what, n in (("rhs", 200000), ("jacobian", 50000)):
+            ts = []
+            for _ in range(9):
+                c0 = time.thread_time()
+                _core.bench(k, what, x, p, 1, 1, 0.0, 0.01, n)
+                ts.append((time.thread_time() - c0) / n)
+            cost[what] = min(ts)
+        out.append("  %-54s rhs %6.1f ns   jacobian %6.1f ns" % (
+            name, 1e9 * cost["rhs"], 1e9 * cost["jacobian"]))
+    return out
 
 
 if __name__ == "__main__":
