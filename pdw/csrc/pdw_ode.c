@@ -246,8 +246,8 @@ int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx)
 
         const pdw_discrete before = s->disc;
         if (settle_flags(s, s->t) > 0) {                    /* room checked above */
-            pdw_record_final(s, s->t);                      /* a stop condition */
-            return s->status;
+            if (s->record_every > 0) sample(s);             /* a stop condition: like t_end, */
+            return s->status;                               /* the final state is recorded */
         }
         if (forces_changed(&before, &s->disc)) s->cache_valid = 0;
         if (pdw_check_feet(s, s->t)) return s->status;

@@ -159,7 +159,8 @@ int pdw_switch_pending(const pdw_sim *s, const double *x, double *work);
  * n_steps for fixed-step methods), updating the discrete state once per step through
  * pdw_update_flags, recording through pdw_record, checking each new state with
  * pdw_check_state, counting work in n_rhs / n_jac / n_rejected. When pdw_update_flags reports
- * a stop condition (returns 1) the method calls pdw_record_final and returns s->status at once.
+ * a stop condition (returns 1) the method stores the final sample (fixed step: pdw_record_final;
+ * adaptive: always, as at t_end) and returns s->status at once.
  * Returns s->status: PDW_STATUS_DONE, PDW_STATUS_PERIODIC, a failure, or
  * PDW_STATUS_EVENTS_FULL (the caller grows s->events and calls again; the method resumes where
  * it stopped). */
