@@ -10,6 +10,9 @@ energies                kinetic and potential energies
 simulate, Result        one compiled simulation (support flags, events, status)
 steps                   per-step gait descriptors (MODEL.md section 8)
 hybrid                  the rigid-ground impact-momentum model (MODEL.md section 9): find_gait, ...
+find_gait               period-one gait of the continuous model: Newton shooting on the touch-down
+                        Poincare map, Floquet multipliers (pdw.limit_cycle; cell mapping:
+                        pdw.cell_mapping)
 PdwError, SimulationError, DivergedError, InvalidInputError   the error hierarchy
 STATE, VARIANTS         the state layout and the contact variants (MODEL.md section 6)
 """
@@ -23,6 +26,8 @@ from .params import Params
 from . import hybrid
 from .gait_types import Gait
 from .simulation import METHODS, X0_DISTURBED, X0_PAPER, Event, Result, simulate
+from . import limit_cycle, cell_mapping
+from .limit_cycle import find_gait
 
 __version__ = "0.1.0"
 
@@ -31,4 +36,5 @@ __all__ = [
     "STATE", "VARIANTS", "INPUT_HASH", "simulate", "Result", "Event", "METHODS", "X0_PAPER",
     "X0_DISTURBED", "steps", "Steps", "PdwError", "SimulationError", "DivergedError",
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait",
+    "limit_cycle", "cell_mapping", "find_gait",
 ]
