@@ -100,9 +100,11 @@ def main(argv=None):
     w.add_argument("--record-every", dest="record_every", type=int, help="record every k-th step")
     w.add_argument("--out", help="output folder (default out/typical_gait)")
     w.add_argument("--no-figures", action="store_true", help="skip the figures and the GIF")
+    from .sweep import add_cli as _add_sweep    # ``pdw sweep STUDY.toml`` (pdw/sweep.py)
+    _add_sweep(sub)
     args = ap.parse_args(argv)
     try:
-        return _walk(args)
+        return args.func(args) if hasattr(args, "func") else _walk(args)
     except PdwError as e:
         print("pdw: error: %s" % e, file=sys.stderr)
         return 2
