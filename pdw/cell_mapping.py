@@ -259,37 +259,34 @@ def cell_map(params=None, variant="paper", phi=(0.69, 0.81, 80), thetad2=(-3.2, 
                    info=dict(reference=z_ref, evaluations=N, options=opts, method=method))
 
 
-def plot_basin(cm: CellMap, ax=None, fixed_point=None, title=None):
-    """Draw the cell map: basins of the periodic groups (colour), sink cells (grey, darker for
-    falls than for leaving the grid), periodic cells (black), and a Newton fixed point
-    (``fixed_point`` = (phi, thetad2), a white cross). Returns the axes."""
+def plot_basin(cm: CellMap, ax=None, fixed_point=None, title=None, max_steps=8):
+    """Draw the cell map: the basins of the periodic groups (blue shades: darker = fewer
+    steps to the periodic cells, up to ``max_steps``), the sink (dark grey: the walker falls
+    from the cell itself; light grey: later, or the image leaves the grid), the periodic cells
+    (black squares) and a Newton fixed point (``fixed_point`` = (phi, thetad2), a cross).
+    Returns the axes."""
     import matplotlib.pyplot as plt
     from matplotlib.colors import ListedColormap
 
     if ax is None:
         _, ax = plt.subplots(figsize=(6.4, 5))
     na, nb = cm.shape
-    grid = np.full(cm.group.shape, np.nan)
-    cols = ["#4d4d4d", "#a6a6a6"] + ["#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b"]
-    fell = (cm.group == SINK)
-    # sink cells: darker if the walker falls from the cell itself, lighter if later / left
-    grid[fell] = np.where(cm.status[fell] == "ok", 1, np.where(cm.status[fell] == "left", 1, 0))
-    for k in range(len(cm.periodic)):
-        grid[cm.group == k] = 2 + (k % 5)
-    ax.pcolormesh(cm.a_edges, cm.b_edges, grid.reshape(na, nb).T, cmap=ListedColormap(cols),
-                  vmin=-0.5, vmax=len(cols) - 0.5, shading="flat")
-    # steps to reach the attractor as contours inside the basins
+    sink = cm.group == SINK
+    at_once = sink & ~np.isin(cm.status, ("ok", "left"))
+    grey = np.where(sink, np.where(at_once, 0.0, 1.0), np.nan).reshape(na, nb).T
+    ax.pcolormesh(cm.a_edges, cm.b_edges, grey, cmap=ListedColormap(["#4d4d4d", "#b0b0b0"]),
+                  vmin=-0.5, vmax=1.5, shading="flat")
+    steps = np.where(~sink, np.minimum(cm.steps, max_steps), np.nan).reshape(na, nb).T
+    mesh = ax.pcolormesh(cm.a_edges, cm.b_edges, steps, cmap="Blues_r", vmin=0,
+                         vmax=max_steps + 2, shading="flat")
+    cb = plt.colorbar(mesh, ax=ax, ticks=range(0, max_steps + 1, 2))
+    cb.set_label("steps to the periodic cell (basin)")
     A, B = cm.centers()
-    st = np.where(cm.group >= 0, cm.steps, np.nan).reshape(na, nb).T
-    if np.isfinite(st).sum() > 4 and np.nanmax(st) > 1:
-        cs = ax.contour(A.reshape(na, nb).T, B.reshape(na, nb).T, st,
-                        levels=[1.5, 2.5, 3.5, 5.5], colors="w", linewidths=0.6)
-        ax.clabel(cs, fmt=lambda v: "%d" % (v + 0.5), fontsize=7)
     for g in cm.periodic:
         ax.plot(A[g], B[g], "ks", ms=3)
     if fixed_point is not None:
         ax.plot(*fixed_point, "wx", ms=9, mew=2)
-        ax.plot(*fixed_point, "kx", ms=7, mew=1)
+        ax.plot(*fixed_point, "rx", ms=7, mew=1)
     ax.set_xlabel(r"inter-leg angle at touch-down $\phi = \theta_2 - \theta_1$ [rad]")
     ax.set_ylabel(r"swing leg's rate at touch-down $\dot\theta_2$ [rad/s]")
     if title:

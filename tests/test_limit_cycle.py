@@ -163,3 +163,17 @@ def test_rigid_limit_two_stiffnesses():
     assert abs(g2.period - gh.period) < 2e-3 and abs(g2.step_length - gh.step_length) < 3e-3
     assert g2.double_support < 0.1 * g1.double_support and g2.double_support < 5e-3
     assert abs(g2.multipliers[0]) == pytest.approx(abs(gh.multipliers[0]), abs=0.02)
+
+
+@pytest.mark.slow
+def test_limit_cycle_studies(repo_root):
+    """benchmarks/limit_cycles.py (fixed points, basin.png) and benchmarks/rigid_limit.py
+    (fig8.png, rigid_limit.png): a few minutes; `make study`."""
+    import sys
+    sys.path.insert(0, str(repo_root / "benchmarks"))
+    import limit_cycles
+    import rigid_limit
+    limit_cycles.main()
+    rigid_limit.main()
+    for name in ("basin", "fig8", "rigid_limit"):
+        assert (repo_root / "docs" / "figures" / (name + ".png")).exists()
