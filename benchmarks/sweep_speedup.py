@@ -57,7 +57,7 @@ def main(argv=None):
             times[backend, w] = best
     load = os.getloadavg()
     lines = ["Sweep speed-up (benchmarks/sweep_speedup.py): %d points, 20 s of walking each "
-             "(rodas4 rtol 1e-7), best of %d; %d cores; load average before/after %.2f"
+             "(rodas4 rtol 1e-7), best of %d; %d cores; load average (1 min) at the end %.2f"
              % (n, args.repeat, os.cpu_count(), load[0]), "",
              "| backend | workers | wall [s] | per point [ms] | speed-up over 1 worker |",
              "|---|---|---|---|---|"]
