@@ -47,6 +47,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_model.py
 	$(PY) benchmarks/bench_simulate.py
 	$(PY) benchmarks/bench_integrators.py
+	$(PY) benchmarks/bench_scenes.py
 
 ## study: slow studies (marked slow in tests/)
 study: $(STAMP)

@@ -62,6 +62,31 @@ STATUS = (
     "singular",     # the step's linear system was singular
     "periodic",     # stopped because successive steps agree (gait converged)
 )
+# Which stop condition of a scene ended a run before t_end (pdw_sim.stop_reason).
+STOP = (
+    "none",         # none did: the run reached t_end, or failed
+    "steps",        # the requested number of complete gait steps was reached
+    "periodic",     # the last k steps agreed within the tolerance
+)
+
+# Per-step gait descriptors (MODEL.md section 8), computed online in the compiled loop as the
+# events happen, with the definitions of pdw/gait.py; one row of doubles per complete step.
+STEP = (
+    "leg",              # swing leg of the step (0 or 1, as in EVENT)
+    "t_lift_off",       # its lift-off [s]
+    "t_touch_down",     # its touch-down [s] (the step ends here)
+    "L",                # step length: footprint spacing along X [m]
+    "travel",           # the swing foot's own travel, lift-off to touch-down [m]
+    "P",                # step period: lift-off to touch-down [s]
+    "v",                # step velocity L / P [m/s]
+    "cycle",            # time since the previous touch-down [s]
+    "double_support",   # touch-down to the other leg's lift-off [s] (NaN: not (yet) known)
+    "ds_fraction",      # double_support / cycle
+)
+# The online analysis keeps the last STEP_RING steps (a ring buffer: O(1) memory per run).
+STEP_RING = 32
+# The descriptors the periodic stop compares over the last k steps.
+PERIODIC_FIELDS = ("L", "travel", "P", "cycle")
 
 
 def work_layout():

@@ -95,9 +95,19 @@ def dynamics_jacobian(spec: KernelSpec):
     """A = df/dx + sum_i (df/dF_i)(dF_i/dx) - (dM/dx) qdd, a 4x8 matrix, row-major (32).
 
     dF/dx of each foot is assembled by the chain rule from the contact stage's
-    partials (symbols) and the symbolic gradients of delta, delta_dot, xi, v_x.
+    partials (symbols) and the symbolic gradients of delta, delta_dot, xi, v_x. A partial
+    that is identically zero in this kernel (its force element absent) is left out of the
+    chain, so its gradient is never computed.
     """
     sym = contact_partial_symbols()
+    zero = set()
+    if "normal_damping" not in spec.features:
+        zero.add("dFn_ddeltad")
+    if "tangential" not in spec.features:
+        zero.add("dFt_dxi")
+    if "friction" not in spec.features:
+        zero.add("mu")
+    sym = {key: (sp.S.Zero if key[1] in zero else s) for key, s in sym.items()}
     f = forcing(spec)
     M = mdl.mechanics().M
     x = mdl.X

@@ -8,6 +8,7 @@ mass_matrix             M(q) of Eq. 2
 contact_forces          contact kinematics and forces of both feet (Eqs. 3-11)
 energies                kinetic and potential energies
 simulate, Result        one compiled simulation (support flags, events, status)
+Scene, run              everything a simulation needs, as one object or TOML file (docs/scenes.md)
 steps                   per-step gait descriptors (MODEL.md section 8)
 hybrid                  the rigid-ground impact-momentum model (MODEL.md section 9): find_gait, ...
 find_gait               period-one gait of the continuous model: Newton shooting on the touch-down
@@ -27,6 +28,8 @@ from .params import Params
 from . import hybrid
 from .gait_types import Gait
 from .simulation import METHODS, X0_DISTURBED, X0_PAPER, Event, Result, simulate
+from . import scene
+from .scene import Scene, run
 from . import limit_cycle, cell_mapping, sweep
 from .limit_cycle import find_gait
 
@@ -36,6 +39,6 @@ __all__ = [
     "Params", "rhs", "jacobian", "mass_matrix", "contact_forces", "ContactState", "energies",
     "STATE", "VARIANTS", "INPUT_HASH", "simulate", "Result", "Event", "METHODS", "X0_PAPER",
     "X0_DISTURBED", "steps", "Steps", "PdwError", "SimulationError", "DivergedError",
-    "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait",
+    "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait", "Scene", "run",
     "limit_cycle", "cell_mapping", "find_gait", "sweep",
 ]

@@ -16,6 +16,7 @@ cdef extern from "pdw_model.h":
         PDW_NKERNELS, PDW_NEVENT, PDW_NREC
         PDW_WORK_TRIG, PDW_WORK_KIN, PDW_WORK_CONTACT, PDW_WORK_M, PDW_WORK_F, PDW_WORK_QDD
         PDW_STATUS_RUNNING, PDW_STATUS_EVENTS_FULL
+        PDW_NSTEP, PDW_STEP_RING
     ctypedef struct pdw_kernel:
         const char *name
         int variant
@@ -53,6 +54,10 @@ cdef extern from "pdw_sim.h":
         double x[8]
         int leg
         int reason
+    ctypedef struct pdw_gait:
+        long n_steps
+        long n_touch_down, n_lift_off
+        double ring[1][1]
     ctypedef struct pdw_sim:
         const pdw_kernel *kernel
         double p[32]
@@ -66,6 +71,10 @@ cdef extern from "pdw_sim.h":
         double rtol, atol
         double h_max
         double event_tol
+        int record_events
+        long stop_steps
+        int periodic_k
+        double periodic_tol
         double *rec_t
         double *rec_x
         int *rec_flags
@@ -82,7 +91,9 @@ cdef extern from "pdw_sim.h":
         pdw_discrete disc
         double work[1]
         long n_rhs, n_jac, n_rejected
+        pdw_gait gait
         int status
+        int stop_reason
         pdw_failure failure
     ctypedef int (*pdw_advance_fn)(pdw_sim *s) noexcept nogil
     ctypedef struct pdw_method:
@@ -94,6 +105,7 @@ cdef extern from "pdw_sim.h":
     const int pdw_nmethods
     void pdw_discrete_init(const pdw_kernel *k, const double *p, const double *x,
                            const int *flags0, pdw_discrete *d, double *work) noexcept nogil
+    void pdw_gait_init(pdw_gait *g) noexcept nogil
     enum:
         PDW_STATUS_RECORDS_FULL
 
@@ -259,8 +271,15 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         double dt, long n_steps, long record_every, bint record_contact,
         double fall_hip_height, double fall_depth, double max_speed,
         double rtol=1e-6, double atol=1e-8, double h_max=0.0, long max_records=0,
-        long event_capacity=256, double event_tol=1e-9):
+        long event_capacity=256, double event_tol=1e-9, bint record_events=True,
+        long stop_steps=0, int periodic_k=0, double periodic_tol=0.0):
     """Run one simulation in compiled code (GIL released). Returns a dict of arrays and status.
+
+    The online gait analysis runs for every method: the result's "gait" holds the last
+    min(n_gait_steps, PDW_STEP_RING) complete steps (rows of layout STEP, oldest first), with
+    the step and event counts. record_events=False stores no event (only counts). stop_steps > 0
+    stops at that many complete steps, periodic_k > 0 when the last periodic_k steps agree within
+    periodic_tol (relative); "stop_reason" says which (layout STOP).
 
     Fixed-step methods take n_steps steps of dt; adaptive ones integrate to n_steps*dt with
     first step dt, locating flag switches to within event_tol [s]. The record buffer first holds
@@ -298,7 +317,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     rec_x = np.zeros((n_rec_cap, PDW_NX))
     rec_flags = np.zeros((n_rec_cap, 2), dtype=np.intc)
     rec_contact = np.zeros((n_rec_cap if record_contact else 0, PDW_NREC))
-    events = np.zeros((max(event_capacity, 4), PDW_NEVENT))
+    events = np.zeros((max(event_capacity, 4) if record_events else 1, PDW_NEVENT))
     cdef double[::1] v_t = rec_t
     cdef double[:, ::1] v_x = rec_x
     cdef int[:, ::1] v_f = rec_flags
@@ -311,8 +330,15 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         if record_contact:
             s.rec_contact = &v_c[0, 0]
     s.rec_capacity = n_rec_cap
-    s.events = &v_e[0, 0]
-    s.ev_capacity = events.shape[0]
+    s.record_events = record_events
+    s.events = &v_e[0, 0] if record_events else NULL
+    s.ev_capacity = events.shape[0] if record_events else 0
+    s.stop_steps = stop_steps
+    if periodic_k < 0 or periodic_k == 1 or periodic_k > PDW_STEP_RING:
+        raise ValueError("periodic_k must be 0 (off) or in [2, %d], got %d" % (PDW_STEP_RING, periodic_k))
+    s.periodic_k = periodic_k
+    s.periodic_tol = periodic_tol
+    pdw_gait_init(&s.gait)
     memcpy(s.x, &x0[0], PDW_NX * sizeof(double))
     flags0[0] = f1; flags0[1] = f2
     pdw_discrete_init(s.kernel, s.p, s.x, flags0, &s.disc, s.work)
@@ -350,11 +376,26 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         else:
             break
     n_rec = s.n_rec
+    cdef long n_gait = s.gait.n_steps
+    cdef long n_keep = min(n_gait, <long>PDW_STEP_RING)
+    cdef double *ring = &s.gait.ring[0][0]
+    # fixed size (a view of the first n_keep rows is returned): the same memory however long
+    # the run
+    gait = np.full((PDW_STEP_RING, PDW_NSTEP), np.nan)
+    cdef long r, c, slot
+    for r in range(n_keep):
+        slot = (n_gait - n_keep + r) % PDW_STEP_RING
+        for c in range(PDW_NSTEP):
+            gait[r, c] = ring[slot * PDW_NSTEP + c]
     return {
+        "gait": gait[:n_keep],
+        "n_gait_steps": n_gait,
+        "event_counts": {"touch_down": s.gait.n_touch_down, "lift_off": s.gait.n_lift_off},
+        "stop_reason": s.stop_reason,
         "status": status,
         "t": rec_t[:n_rec], "x": rec_x[:n_rec], "flags": rec_flags[:n_rec],
         "contact": rec_contact[:n_rec] if record_contact else None,
-        "events": events[:s.n_events].copy(),
+        "events": events[:s.n_events].copy() if record_events else np.zeros((0, PDW_NEVENT)),
         "n_steps": s.n,
         "t_final": s.t,
         "stats": {"steps": s.n, "rhs": s.n_rhs, "jacobians": s.n_jac, "rejected": s.n_rejected},

@@ -1,10 +1,14 @@
-"""Command line: ``pdw walk`` (also ``python -m pdw walk``), the main job.
+"""Command line: ``pdw walk`` (also ``python -m pdw walk``), the main job, and ``pdw run``.
 
 ``pdw walk`` runs the paper's typical gait (Sec. 3.2: `Params.paper()`, x0 of
 `pdw.simulation.X0_PAPER`, 3.5 s, dt = 1e-4, the central difference method), prints the step
 table next to the paper's numbers, and writes the report and the figures (Figs. 4-7 and an
 animated GIF) to an output folder. Every option can also come from a TOML scene file
 (``--scene FILE``); options given on the command line win.
+
+``pdw run SCENE.toml`` runs a `pdw.Scene` file (docs/scenes.md): it prints the run's summary,
+its gait descriptors and their steady values, and with ``--out DIR`` writes steps.csv,
+run.json and the scene as run (scene.toml).
 """
 from __future__ import annotations
 
@@ -20,6 +24,7 @@ from .errors import PdwError
 from .gait import steps
 from .params import Params
 from .report import walk_report
+from .scene import Scene
 from .simulation import METHODS, X0_PAPER, simulate
 
 WALK_KEYS = {
@@ -68,9 +73,7 @@ def _walk(args):
     out = pathlib.Path(cfg["out"])
     out.mkdir(parents=True, exist_ok=True)
     (out / "report.txt").write_text(text + "\n")
-    st = steps(res)
-    (out / "steps.csv").write_text(",".join(st.table) + "\n" + "\n".join(
-        ",".join(str(st.table[k][i].item()) for k in st.table) for i in range(len(st))) + "\n")
+    _write_steps_csv(steps(res), out / "steps.csv")
     meta = {k: (v if not isinstance(v, np.ndarray) else v.tolist()) for k, v in cfg.items()}
     meta.update(status=res.status, params=params.as_dict(), wall_time_s=res.wall_time,
                 failure=None if res.failure is None else
@@ -87,6 +90,56 @@ def _walk(args):
     return 0 if res.status == "walked" else 3
 
 
+def _write_steps_csv(st, path):
+    path.write_text(",".join(st.table) + "\n" + "\n".join(
+        ",".join(str(st.table[k][i].item()) for k in st.table) for i in range(len(st))) + "\n")
+
+
+def _jsonable(v):
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    if isinstance(v, (np.floating, np.integer)):
+        return v.item()
+    if isinstance(v, dict):
+        return {k: _jsonable(x) for k, x in v.items()}
+    if isinstance(v, float) and not np.isfinite(v):
+        return None
+    return v
+
+
+def _run(args):
+    scene = Scene.load(args.scene)
+    res = scene.run()
+    st = steps(res)
+    lines = ["scene: %s (%s)" % (scene.name or "-", args.scene), res.summary()]
+    if res.failure:
+        lines.append("failure: %s at t = %.4f s" % (res.failure["reason"], res.failure["t"]))
+    kept = "" if res.events_recorded or res.n_gait_steps <= len(st) else \
+        " (the last %d of %d, computed online)" % (len(st), res.n_gait_steps)
+    lines += ["", "gait steps%s:" % kept, st.to_text() if len(st) else "(no complete step)"]
+    if len(st):
+        sd = st.steady()
+        lines += ["", "steady (mean of the last %d steps): L = %.4f m, travel = %.4f m, P = %.4f s, "
+                  "v = %.4f m/s, cycle = %.4f s, double support = %.1f ms (%.2f %%)"
+                  % (sd["last"], sd["L"], sd["travel"], sd["P"], sd["v"], sd["cycle"],
+                     1e3 * sd["double_support"], 100 * sd["ds_fraction"])]
+    text = "\n".join(lines)
+    print(text)
+    if args.out:
+        out = pathlib.Path(args.out)
+        out.mkdir(parents=True, exist_ok=True)
+        _write_steps_csv(st, out / "steps.csv")
+        scene.save(out / "scene.toml")
+        meta = dict(scene=scene.to_dict(), status=res.status, stop_reason=res.stop_reason,
+                    t_final=res.t_final, n_steps=res.n_steps, n_gait_steps=res.n_gait_steps,
+                    event_counts=res.event_counts, wall_time_s=res.wall_time, stats=res.stats,
+                    params=res.params.as_dict(), features=list(res.features),
+                    steady=st.steady() if len(st) else None, failure=res.failure)
+        (out / "run.json").write_text(json.dumps(_jsonable(meta), indent=2) + "\n")
+        print("\nwrote: %s" % ", ".join(str(out / n) for n in ("steps.csv", "run.json", "scene.toml")))
+    return 0 if res.walked else 3
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="pdw", description="pdw: passive dynamic walking on compliant ground")
     sub = ap.add_subparsers(dest="command", required=True)
@@ -100,11 +153,16 @@ def main(argv=None):
     w.add_argument("--record-every", dest="record_every", type=int, help="record every k-th step")
     w.add_argument("--out", help="output folder (default out/typical_gait)")
     w.add_argument("--no-figures", action="store_true", help="skip the figures and the GIF")
+    r = sub.add_parser("run", help="run a scene file (docs/scenes.md): summary, gait descriptors")
+    r.add_argument("scene", help="TOML scene file (pdw.Scene)")
+    r.add_argument("--out", help="also write steps.csv, run.json and scene.toml to this folder")
     from .sweep import add_cli as _add_sweep    # ``pdw sweep STUDY.toml`` (pdw/sweep.py)
     _add_sweep(sub)
     args = ap.parse_args(argv)
     try:
-        return args.func(args) if hasattr(args, "func") else _walk(args)
+        if hasattr(args, "func"):
+            return args.func(args)
+        return _run(args) if args.command == "run" else _walk(args)
     except PdwError as e:
         print("pdw: error: %s" % e, file=sys.stderr)
         return 2

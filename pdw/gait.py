@@ -12,6 +12,11 @@ A *step* ends at a touch-down of the swing leg j (time t_td, contact point x_td)
 - double support: from t_td to the other leg's next lift-off (both flags 1), and its
   fraction of the step's cycle; NaN when the run ends before that lift-off, or when
   the other leg does not lift off before the next touch-down.
+
+The compiled loops compute the same descriptors online, as the events happen (pdw/csrc/
+pdw_discrete.c, layout `pdw._layout.STEP`), keeping the last `pdw._layout.STEP_RING` steps:
+`Result.gait`. `steps` recomputes every step from a run's events; for a run that did not keep
+its events (``record_events=False``) it returns `Result.gait`.
 """
 from __future__ import annotations
 
@@ -19,8 +24,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-FIELDS = ("leg", "t_lift_off", "t_touch_down", "L", "travel", "P", "v", "cycle",
-          "double_support", "ds_fraction")
+from . import _layout
+
+FIELDS = _layout.STEP
 UNITS = {"leg": "", "t_lift_off": "s", "t_touch_down": "s", "L": "m", "travel": "m", "P": "s",
          "v": "m/s", "cycle": "s", "double_support": "s", "ds_fraction": ""}
 
@@ -63,6 +69,22 @@ class Steps:
         return "\n".join(rows)
 
 
+def steps_from_rows(rows, capacity: int = _layout.STEP_RING) -> Steps:
+    """Steps from rows of the compiled online analysis (layout `pdw._layout.STEP`, legs 0/1).
+
+    The columns are views of arrays of ``capacity`` (at least len(rows)) entries, so that the
+    memory of a result does not depend on how many steps its ring holds."""
+    rows = np.asarray(rows, dtype=float).reshape(-1, len(FIELDS))
+    n = len(rows)
+    cols = np.full((len(FIELDS), max(capacity, n)), np.nan)
+    cols[:, :n] = rows.T
+    legs = np.zeros(cols.shape[1], dtype=int)
+    legs[:n] = cols[FIELDS.index("leg"), :n]
+    legs[:n] += 1
+    table = {f: (legs[:n] if f == "leg" else cols[i, :n]) for i, f in enumerate(FIELDS)}
+    return Steps(table)
+
+
 def steps(result_or_events) -> Steps:
     """Gait descriptors of every complete step of a run.
 
@@ -70,7 +92,9 @@ def steps(result_or_events) -> Steps:
     ----------
     result_or_events : Result or sequence of Event
         A `pdw.simulate` result, or its ``events`` (time-ordered touch-downs and lift-offs,
-        legs numbered 1 and 2).
+        legs numbered 1 and 2). For a result that did not keep its events
+        (``record_events=False``): its online descriptors, `Result.gait` (the last
+        `pdw._layout.STEP_RING` steps).
 
     Returns
     -------
@@ -78,6 +102,8 @@ def steps(result_or_events) -> Steps:
         Steps whose swing leg has a known lift-off and whose other foot has a known
         touch-down (the first, partial step of a run is skipped).
     """
+    if getattr(result_or_events, "events_recorded", True) is False:
+        return result_or_events.gait
     events = getattr(result_or_events, "events", result_or_events)
     events = sorted(events, key=lambda e: e.t)
     last_td = {1: None, 2: None}     # (t, x_D) of each leg's latest touch-down

@@ -15,6 +15,7 @@ import numpy as np
 
 from . import _core, _layout
 from .errors import DivergedError, InvalidInputError, SingularSystemError
+from .gait import Steps, steps_from_rows
 from .model import STATE, check_variant, kernel_index, parameter_vector
 from .params import Params
 
@@ -62,11 +63,29 @@ class Result:
     Fn, Ft : ndarray (N, 2)
         Normal and tangential contact forces of feet 1, 2 [N] (empty if not recorded).
     events : list of Event
-        Every touch-down and lift-off (always kept, whatever the recording).
+        Every touch-down and lift-off (empty when ``record_events=False``; `event_counts`
+        counts them either way).
     status : str
-        ``"walked"`` (reached t_end), ``"fell"`` (see `failure`) or ``"diverged"``.
+        ``"walked"`` (reached t_end, or the requested number of gait steps), ``"periodic"``
+        (stopped because the last steps agreed), ``"fell"`` (see `failure`) or ``"diverged"``.
     failure : dict or None
         For a fall or divergence: ``t`` and ``x`` of the last good state, ``reason`` and ``leg``.
+    params : Params
+        The parameters simulated: with the parameters of absent force elements zeroed
+        (`Params.without`) when ``features`` was given.
+    gait : Steps
+        The gait descriptors computed online in the compiled loop (MODEL.md section 8, the
+        definitions of `pdw.steps`): the last ``min(n_gait_steps, pdw._layout.STEP_RING)``
+        complete steps. A run stopped by a stop condition ends at a touch-down, so its last
+        step's double support is NaN (not known yet).
+    n_gait_steps : int
+        Complete gait steps of the whole run.
+    event_counts : dict
+        ``{"touch_down": n, "lift_off": n}`` over the whole run.
+    stop_reason : str
+        ``"t_end"``, ``"steps"`` (stop_steps reached), ``"periodic"``, or the failure status.
+    energies : dict or None
+        With ``record_energies``: T, V_gravity, V_hip and E [J] at the recorded samples.
     """
 
     t: np.ndarray
@@ -87,18 +106,30 @@ class Result:
     n_steps: int
     wall_time: float
     stats: dict = field(default_factory=dict)
+    gait: Steps | None = None
+    n_gait_steps: int = 0
+    event_counts: dict = field(default_factory=dict)
+    events_recorded: bool = True
+    stop_reason: str = "t_end"
+    energies: dict | None = None
+    features: tuple = _layout.FEATURES
+    scene: object = None
 
     @property
     def walked(self) -> bool:
-        return self.status == "walked"
+        """Did the walker keep walking to the end of the run (t_end or a stop condition)?"""
+        return self.status in ("walked", "periodic")
 
     def state(self, name: str) -> np.ndarray:
         """Recorded time series of one state component by name, e.g. ``"thetad1"``."""
         return self.x[:, STATE.index(name)]
 
     def summary(self) -> str:
-        s = "%s: %s, %d steps of %.3g s to t = %.4f s, %d events" % (
-            self.method, self.status, self.n_steps, self.dt, self.t_final, len(self.events))
+        n_ev = sum(self.event_counts.values()) if self.event_counts else len(self.events)
+        s = "%s: %s, %d steps of %.3g s to t = %.4f s, %d events, %d gait steps" % (
+            self.method, self.status, self.n_steps, self.dt, self.t_final, n_ev, self.n_gait_steps)
+        if self.stop_reason in ("steps", "periodic"):
+            s += " (stopped: %s)" % self.stop_reason
         if self.failure:
             s += "; %s at t = %.4f s" % (self.failure["reason"], self.failure["t"])
         return s
@@ -125,15 +156,25 @@ def check_state(x0, name="x0"):
     return x
 
 
+_DEFAULTS = dict(t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm", flags0=(0, 1),
+                 record_every=1, record_forces=True, on_failure="raise", fall_hip_height=None,
+                 fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8, h_max=None, event_tol=1e-9,
+                 features=None, record_events=True, record_energies=False, stop_steps=0,
+                 periodic_steps=0, periodic_tol=1e-3)
+
+
 def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
              flags0=(0, 1), record_every=1, record_forces=True, on_failure="raise",
              fall_hip_height=None, fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8,
-             h_max=None, event_tol=1e-9):
-    """Simulate the walker from ``x0`` for ``t_end`` seconds.
+             h_max=None, event_tol=1e-9, *, features=None, record_events=True,
+             record_energies=False, stop_steps=0, periodic_steps=0, periodic_tol=1e-3):
+    """Simulate the walker from ``x0`` for ``t_end`` seconds (or run a `pdw.Scene`).
+
+    ``simulate(scene)`` runs the scene (as `pdw.run`); no other argument may be given then.
 
     Parameters
     ----------
-    x0 : array_like (8,)
+    x0 : array_like (8,) or Scene
         Initial state [x_o, y_o, theta1, theta2, xd_o, yd_o, thetad1, thetad2] (m, rad, m/s,
         rad/s). Default: the paper's typical gait (`X0_PAPER`).
     t_end : float
@@ -172,11 +213,35 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
         Adaptive methods locate each flag switch (touch-down, lift-off, arming) to within this
         time [s] and end a step there (docs/integrators.md); fixed-step methods switch at step
         boundaries.
+    features : iterable of str, optional
+        Force elements present (`pdw._layout.FEATURES`; default all). The absent ones are
+        switched off: a specialized generated kernel if there is one, else the general kernel
+        with their parameters zeroed (`Params.without`).
+    record_events : bool
+        Keep the list of events (False: only their counts and the online gait analysis, O(1)
+        memory however long the run).
+    record_energies : bool
+        Also return the energies at the recorded samples (needs ``record_every > 0``).
+    stop_steps : int
+        Stop after this many complete gait steps (0: no limit); status ``"walked"``,
+        ``stop_reason`` ``"steps"``.
+    periodic_steps, periodic_tol : int, float
+        With ``periodic_steps = k >= 2``: stop (status ``"periodic"``) as soon as the last k
+        steps agree, each of L, travel, P and cycle within ``periodic_tol`` relative
+        (max - min <= tol |latest|). 0: off.
 
     Returns
     -------
     Result
     """
+    from .scene import Scene
+    if isinstance(x0, Scene):
+        given = sorted(k for k, v in locals().items()
+                       if k in _DEFAULTS and not _same(v, _DEFAULTS[k]))
+        if given:
+            raise InvalidInputError("simulate(scene) takes no other arguments (got %s): set them "
+                                    "in the scene" % ", ".join(given))
+        return x0.run()
     params = Params.paper() if params is None else params
     if not isinstance(params, Params):
         raise InvalidInputError("params must be a pdw.Params, got %s" % type(params).__name__)
@@ -208,18 +273,73 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     atol = _check_positive("atol", atol)
     h_max = 0.0 if h_max is None else _check_positive("h_max", h_max)
     event_tol = _check_positive("event_tol", event_tol)
+    feats = _check_features(features)
+    if record_energies and not record_every:
+        raise InvalidInputError("record_energies needs recorded states (record_every > 0)")
+    stop_steps = _check_count("stop_steps", stop_steps)
+    periodic_steps = _check_count("periodic_steps", periodic_steps)
+    if periodic_steps == 1 or periodic_steps > _layout.STEP_RING:
+        raise InvalidInputError("periodic_steps must be 0 (off) or in [2, %d], got %d"
+                                % (_layout.STEP_RING, periodic_steps))
+    periodic_tol = _check_positive("periodic_tol", periodic_tol)
 
-    k = kernel_index(variant)
+    k = kernel_index(variant, feats)
+    if feats != _layout.FEATURES:
+        params = params.without(feats)
     p = parameter_vector(params)
     start = time.perf_counter()
     raw = _core.run(k, METHODS.index(method), x, p, f0[0], f0[1], dt, n_steps, int(record_every),
                     bool(record_forces), hip, depth, max_speed, rtol, atol, h_max,
-                    event_tol=event_tol)
+                    event_tol=event_tol, record_events=bool(record_events), stop_steps=stop_steps,
+                    periodic_k=periodic_steps, periodic_tol=periodic_tol)
     wall = time.perf_counter() - start
-    return _result(raw, params, variant, method, dt, t_end, wall, on_failure)
+    energies = None
+    if record_energies:
+        e = np.empty((len(raw["x"]), len(_layout.ENERGY)))
+        if len(e):
+            _core.energies_batch(k, np.ascontiguousarray(raw["x"]), p, e)
+        energies = {name: e[:, i] for i, name in enumerate(_layout.ENERGY)}
+        energies["E"] = e.sum(axis=1)
+    return _result(raw, params, variant, method, dt, t_end, wall, on_failure, feats,
+                   bool(record_events), energies)
 
 
-def _result(raw, params, variant, method, dt, t_end, wall, on_failure):
+def _same(a, b):
+    """Is an argument its default? (for simulate(scene))"""
+    if a is None or b is None:
+        return a is b
+    try:
+        return bool(np.array_equal(np.asarray(a, dtype=object), np.asarray(b, dtype=object)))
+    except (TypeError, ValueError):
+        return False
+
+
+def _check_count(name, value):
+    try:
+        ok = not isinstance(value, bool) and int(value) == value and value >= 0
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise InvalidInputError("%s must be an integer >= 0, got %r" % (name, value))
+    return int(value)
+
+
+def _check_features(features):
+    if features is None:
+        return _layout.FEATURES
+    if isinstance(features, str):
+        raise InvalidInputError("features must be a collection of names, got the string %r"
+                                % features)
+    feats = set(features)
+    unknown = feats - set(_layout.FEATURES)
+    if unknown:
+        raise InvalidInputError("unknown feature(s) %s; allowed: %s"
+                                % (", ".join(sorted(map(str, unknown))), ", ".join(_layout.FEATURES)))
+    return tuple(f for f in _layout.FEATURES if f in feats)
+
+
+def _result(raw, params, variant, method, dt, t_end, wall, on_failure,
+            features=_layout.FEATURES, events_recorded=True, energies=None):
     status = _STATUS[raw["status"]]
     rc = raw["contact"]
     ic = {n: i for i, n in enumerate(_layout.RECORD_CONTACT)}
@@ -236,11 +356,17 @@ def _result(raw, params, variant, method, dt, t_end, wall, on_failure):
         f = raw["failure"]
         failure = {"t": f["t"], "x": f["x"], "reason": _REASONS[f["reason"]],
                    "leg": None if f["leg"] < 0 else f["leg"] + 1}
+    public = {"done": "walked", "singular": "diverged"}.get(status, status)
+    stop = _layout.STOP[raw["stop_reason"]]
     res = Result(t=raw["t"], x=raw["x"], flags=raw["flags"], Fn=Fn, Ft=Ft, events=events,
-                 status={"done": "walked", "singular": "diverged"}.get(status, status),
+                 status=public,
                  failure=failure, x_final=raw["x_final"], t_final=raw["t_final"], stats=raw["stats"],
                  params=params, variant=variant, method=method, dt=dt, t_end=t_end,
-                 n_steps=raw["n_steps"], wall_time=wall)
+                 n_steps=raw["n_steps"], wall_time=wall, gait=steps_from_rows(raw["gait"]),
+                 n_gait_steps=int(raw["n_gait_steps"]), event_counts=dict(raw["event_counts"]),
+                 events_recorded=events_recorded,
+                 stop_reason=stop if stop != "none" else ("t_end" if public == "walked" else public),
+                 energies=energies, features=tuple(features))
     if res.status == "diverged" and on_failure == "raise":
         cls = SingularSystemError if status == "singular" else DivergedError
         raise cls("simulation diverged at t = %.6g s (step %d, dt = %g, method %s): %s; "

@@ -21,7 +21,9 @@ int pdw_cdm_advance(pdw_sim *s)
     s->status = PDW_STATUS_RUNNING;
     if (!s->started) {
         double xdot[PDW_NX];
-        if (pdw_update_flags(s, 0.0)) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
+        const int r = pdw_update_flags(s, 0.0);
+        if (r < 0) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
+        if (r > 0) { s->started = 1; pdw_record_final(s, 0.0); return s->status; }
         k->rhs(s->x, s->p, s->disc.flags, s->disc.anchors, xdot, s->work);
         for (int i = 0; i < PDW_NQ; ++i)
             s->u_prev[i] = s->x[i] - dt*s->x[PDW_NQ + i] + 0.5*dt*dt*xdot[PDW_NQ + i];
@@ -35,7 +37,11 @@ int pdw_cdm_advance(pdw_sim *s)
         const double t = s->n * dt;
         /* flags from (U_n, U'_n); this also leaves trig and kin of x_n in work (at n = 0 the
          * start-up's update and right-hand side did) */
-        if (s->n > 0 && pdw_update_flags(s, t)) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
+        if (s->n > 0) {
+            const int r = pdw_update_flags(s, t);
+            if (r < 0) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
+            if (r > 0) { pdw_record_final(s, t); return s->status; }   /* a stop condition */
+        }
         if (pdw_check_feet(s, t)) return s->status;
         k->contact(kin, s->disc.flags, s->p, contact);
         k->cdm_terms(s->x, trig, s->p, contact, M, C, QmG);
@@ -68,11 +74,9 @@ int pdw_cdm_advance(pdw_sim *s)
         s->n_rhs++;
     }
     /* final sample: flags and forces at t_end */
-    if (pdw_update_flags(s, s->n * dt)) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
-    if (s->record_every > 0 && s->n % s->record_every == 0) {
-        k->contact(kin, s->disc.flags, s->p, contact);
-        pdw_record(s, s->n * dt);
-    }
-    s->status = PDW_STATUS_DONE;
+    const int r = pdw_update_flags(s, s->n * dt);
+    if (r < 0) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
+    pdw_record_final(s, s->n * dt);
+    if (r == 0) s->status = PDW_STATUS_DONE;      /* else: the stop condition's status */
     return s->status;
 }

@@ -66,18 +66,22 @@ int pdw_fixed_advance(pdw_sim *s, pdw_fixed_step_fn step)
     double xnew[PDW_NX];
     s->status = PDW_STATUS_RUNNING;
     if (!s->started) {
-        if (pdw_update_flags(s, 0.0)) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
+        const int r = pdw_update_flags(s, 0.0);
+        if (r < 0) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
         s->started = 1;
         s->n = 0;
         s->t = 0.0;
         s->cache_valid = 0;
         if (s->record_every > 0) sample(s);
+        if (r > 0) return s->status;                        /* a stop condition */
     }
     while (s->n < s->n_steps) {
         if (s->n > 0) {
             /* flags from (U_n, U'_n) before step n, as the paper's loop (Fig. 3) */
             const pdw_discrete before = s->disc;
-            if (pdw_update_flags(s, s->t)) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
+            const int r = pdw_update_flags(s, s->t);
+            if (r < 0) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
+            if (r > 0) { pdw_record_final(s, s->t); return s->status; }   /* a stop condition */
             if (forces_changed(&before, &s->disc)) s->cache_valid = 0;
             if (pdw_check_feet(s, s->t)) return s->status;
             if (s->record_every > 0 && s->n % s->record_every == 0) sample(s);
@@ -88,21 +92,24 @@ int pdw_fixed_advance(pdw_sim *s, pdw_fixed_step_fn step)
         s->n++;
         s->t = s->n * dt;
     }
-    if (pdw_update_flags(s, s->t)) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
+    const int r = pdw_update_flags(s, s->t);
+    if (r < 0) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
     if (s->record_every > 0 && s->n % s->record_every == 0) sample(s);
-    s->status = PDW_STATUS_DONE;
+    if (r == 0) s->status = PDW_STATUS_DONE;           /* else: the stop condition's status */
     return s->status;
 }
 
 /* ---------------------------------------------------------------- adaptive --------------- */
 
 /* Apply pdw_update_flags until nothing changes (a lift-off can arm the same leg at once), so
- * that no switch is pending at the start of the next step. Needs room for 6 events. */
+ * that no switch is pending at the start of the next step. Needs room for 6 events. Returns
+ * pdw_update_flags's code: -1 (events full), 1 (a stop condition: s->status set), or 0. */
 static int settle_flags(pdw_sim *s, double t)
 {
     for (int it = 0; it < 3; ++it) {
         const pdw_discrete before = s->disc;
-        if (pdw_update_flags(s, t)) return -1;
+        const int r = pdw_update_flags(s, t);
+        if (r) return r;
         if (memcmp(&before, &s->disc, sizeof before) == 0) break;
     }
     return 0;
@@ -158,14 +165,16 @@ int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx)
         s->err_prev = 1e-4;
         s->h_prev = 0.0;
         s->cache_valid = 0;
-        if (settle_flags(s, 0.0)) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
+        const int r = settle_flags(s, 0.0);
+        if (r < 0) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
         s->started = 1;
         if (s->record_every > 0) sample(s);
+        if (r > 0) return s->status;                        /* a stop condition */
     }
     while (s->t < t_end) {
         /* room for what an accepted step may append; return here only (before a step), so
          * that a resumed call continues exactly */
-        if (s->n_events + 6 > s->ev_capacity) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
+        if (!pdw_events_room(s, 6)) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
         if (s->record_every > 0 && s->n_rec + 1 > s->rec_capacity) {
             s->status = PDW_STATUS_RECORDS_FULL;
             return s->status;
@@ -236,7 +245,10 @@ int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx)
         last_rejected = 0;
 
         const pdw_discrete before = s->disc;
-        settle_flags(s, s->t);                              /* room checked above */
+        if (settle_flags(s, s->t) > 0) {                    /* room checked above */
+            if (s->record_every > 0) sample(s);             /* a stop condition: like t_end, */
+            return s->status;                               /* the final state is recorded */
+        }
         if (forces_changed(&before, &s->disc)) s->cache_valid = 0;
         if (pdw_check_feet(s, s->t)) return s->status;
         if (s->record_every > 0 && (s->n % s->record_every == 0 || s->t >= t_end)) sample(s);

@@ -34,6 +34,22 @@ enum {
     PDW_REASON_STEP_SIZE = 6      /* adaptive step size underflow (error test never passed) */
 };
 
+/* Online gait analysis (MODEL.md section 8): the per-step descriptors of pdw/gait.py, computed
+ * as the events happen, in O(1) memory: the latest touch-down and lift-off of each leg, counts,
+ * and the last PDW_STEP_RING complete steps (layout PDW_STEP_*) in a ring buffer. */
+typedef struct pdw_gait {
+    double td_t[2], td_x[2];    /* each leg's latest touch-down: time [s], contact point x_D [m] */
+    double lo_t[2], lo_x[2];    /* each leg's latest lift-off */
+    int has_td[2], has_lo[2];
+    double prev_td_t;           /* the latest touch-down of either leg */
+    int has_prev_td;
+    int ds_leg;                 /* the latest step's double support ends at this leg's lift-off;
+                                 * -1: none awaited */
+    long n_steps;               /* complete steps so far (the rows pdw.steps would give) */
+    long n_touch_down, n_lift_off;
+    double ring[PDW_STEP_RING][PDW_NSTEP];   /* step k (from 0) is ring[k % PDW_STEP_RING] */
+} pdw_gait;
+
 /* A loop status beyond the generated PDW_STATUS_*: the record buffer is full. Like
  * PDW_STATUS_EVENTS_FULL it never reaches Python's result: _core.run grows the record arrays
  * and calls advance again, which resumes where it stopped. Only adaptive methods (whose
@@ -54,6 +70,14 @@ typedef struct pdw_sim {
     double rtol, atol;          /* tolerances of adaptive methods */
     double h_max;               /* largest step of adaptive methods [s] */
     double event_tol;           /* adaptive methods: a flag switch is located to within this [s] */
+    int record_events;          /* 1: store every event in `events`; 0: only count them (the
+                                 * online gait analysis sees them either way) */
+    long stop_steps;            /* stop (PDW_STATUS_DONE, PDW_STOP_STEPS) at this many complete
+                                 * gait steps; 0: no limit */
+    int periodic_k;             /* stop (PDW_STATUS_PERIODIC) when the last periodic_k steps agree:
+                                 * each PDW_PERIODIC_FIELDS descriptor within periodic_tol (relative,
+                                 * max - min <= tol |latest|); 0: off. 2 <= k <= PDW_STEP_RING */
+    double periodic_tol;
     /* --- outputs (caller-allocated) --- */
     double *rec_t;              /* (rec_capacity,) */
     double *rec_x;              /* (rec_capacity, PDW_NX) */
@@ -77,8 +101,11 @@ typedef struct pdw_sim {
     double h_prev;              /* adaptive methods: previous accepted step (0: none yet) */
     /* --- work counters (every method) --- */
     long n_rhs, n_jac, n_rejected;
+    /* --- online gait analysis (every method; see pdw_update_flags) --- */
+    pdw_gait gait;
     /* --- termination --- */
     int status;                 /* PDW_STATUS_* */
+    int stop_reason;            /* PDW_STOP_*: which stop condition ended the run (NONE: t_end or a failure) */
     pdw_failure failure;
 } pdw_sim;
 
@@ -86,10 +113,23 @@ typedef struct pdw_sim {
 void pdw_discrete_init(const pdw_kernel *k, const double *p, const double *x,
                        const int flags0[2], pdw_discrete *d, double *work);
 
-/* Update flags and arming once from s->x (MODEL.md section 5); appends events to sim.
- * Leaves the trig and kinematics of s->x (with the new anchors) in s->work. Returns 0, or
- * -1 when the event buffer is full (nothing changed then). */
+/* Update flags and arming once from s->x (MODEL.md section 5); each flag change is an event:
+ * stored in s->events (if record_events), counted, and fed to the online gait analysis
+ * (s->gait), which checks the stop conditions (stop_steps, periodic_k) at each complete step.
+ * Leaves the trig and kinematics of s->x (with the new anchors) in s->work. Returns 0; -1 when
+ * the event buffer is full (nothing changed then; the caller returns PDW_STATUS_EVENTS_FULL);
+ * 1 when a stop condition was met (s->status and s->stop_reason are set: the caller stores the
+ * final sample with pdw_record_final and returns s->status). */
 int pdw_update_flags(pdw_sim *s, double t);
+
+/* Room for `n` more events (always, when events are not stored)? */
+static inline int pdw_events_room(const pdw_sim *s, long n)
+{
+    return !s->record_events || s->n_events + n <= s->ev_capacity;
+}
+
+/* Reset the online gait analysis (before the first step). */
+void pdw_gait_init(pdw_gait *g);
 
 /* After pdw_update_flags: fell if a foot is deeper than fall_depth (sets status, returns 1). */
 int pdw_check_feet(pdw_sim *s, double t);
@@ -97,6 +137,10 @@ int pdw_check_feet(pdw_sim *s, double t);
 /* Check a new state (finite, speeds, hip height); on failure sets s->status and s->failure
  * and returns nonzero. */
 int pdw_check_state(pdw_sim *s, const double *xnew, double t);
+
+/* A stop condition ended the run at s->x (time t) right after pdw_update_flags: store the
+ * sample if step n is a recording step (contact forces computed here). */
+void pdw_record_final(pdw_sim *s, double t);
 
 /* Store sample n (time t) if it is a recording step. */
 void pdw_record(pdw_sim *s, double t);
@@ -114,9 +158,12 @@ int pdw_switch_pending(const pdw_sim *s, const double *x, double *work);
  * advance(s): take steps from s->x (time s->t, step count s->n) until s->t reaches t_end (or
  * n_steps for fixed-step methods), updating the discrete state once per step through
  * pdw_update_flags, recording through pdw_record, checking each new state with
- * pdw_check_state, counting work in n_rhs / n_jac / n_rejected. Returns s->status:
- * PDW_STATUS_DONE, a failure, or PDW_STATUS_EVENTS_FULL (the caller grows s->events and
- * calls again; the method resumes where it stopped). */
+ * pdw_check_state, counting work in n_rhs / n_jac / n_rejected. When pdw_update_flags reports
+ * a stop condition (returns 1) the method stores the final sample (fixed step: pdw_record_final;
+ * adaptive: always, as at t_end) and returns s->status at once.
+ * Returns s->status: PDW_STATUS_DONE, PDW_STATUS_PERIODIC, a failure, or
+ * PDW_STATUS_EVENTS_FULL (the caller grows s->events and calls again; the method resumes where
+ * it stopped). */
 typedef int (*pdw_advance_fn)(pdw_sim *s);
 
 typedef struct pdw_method {
