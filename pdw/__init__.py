@@ -11,6 +11,10 @@ simulate, Result        one compiled simulation (support flags, events, status)
 Scene, run              everything a simulation needs, as one object or TOML file (docs/scenes.md)
 steps                   per-step gait descriptors (MODEL.md section 8)
 hybrid                  the rigid-ground impact-momentum model (MODEL.md section 9): find_gait, ...
+find_gait               period-one gait of the continuous model: Newton shooting on the touch-down
+                        Poincare map, Floquet multipliers (pdw.limit_cycle; cell mapping:
+                        pdw.cell_mapping)
+sweep                   parameter studies from TOML files: run_study, load_study (``pdw sweep``)
 PdwError, SimulationError, DivergedError, InvalidInputError   the error hierarchy
 STATE, VARIANTS         the state layout and the contact variants (MODEL.md section 6)
 """
@@ -26,6 +30,8 @@ from .gait_types import Gait
 from .simulation import METHODS, X0_DISTURBED, X0_PAPER, Event, Result, simulate
 from . import scene
 from .scene import Scene, run
+from . import limit_cycle, cell_mapping, sweep
+from .limit_cycle import find_gait
 
 __version__ = "0.1.0"
 
@@ -34,4 +40,5 @@ __all__ = [
     "STATE", "VARIANTS", "INPUT_HASH", "simulate", "Result", "Event", "METHODS", "X0_PAPER",
     "X0_DISTURBED", "steps", "Steps", "PdwError", "SimulationError", "DivergedError",
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait", "Scene", "run",
+    "limit_cycle", "cell_mapping", "find_gait", "sweep",
 ]

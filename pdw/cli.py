@@ -156,8 +156,12 @@ def main(argv=None):
     r = sub.add_parser("run", help="run a scene file (docs/scenes.md): summary, gait descriptors")
     r.add_argument("scene", help="TOML scene file (pdw.Scene)")
     r.add_argument("--out", help="also write steps.csv, run.json and scene.toml to this folder")
+    from .sweep import add_cli as _add_sweep    # ``pdw sweep STUDY.toml`` (pdw/sweep.py)
+    _add_sweep(sub)
     args = ap.parse_args(argv)
     try:
+        if hasattr(args, "func"):
+            return args.func(args)
         return _run(args) if args.command == "run" else _walk(args)
     except PdwError as e:
         print("pdw: error: %s" % e, file=sys.stderr)

@@ -1,0 +1,240 @@
+"""Parameter studies (pdw.sweep, `pdw sweep`): study files, CSV + provenance, executors
+(threads, processes, Dask), resumption after a kill."""
+import concurrent.futures as cf
+import csv
+import json
+import pathlib
+import sys
+
+import numpy as np
+import pytest
+
+import pdw
+import pdw.cli
+from pdw import sweep as S
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+STUDY_FILES = sorted((ROOT / "docs" / "studies").glob("*.toml"))
+
+TINY = """
+name = "tiny"
+title = "tiny k_n study"
+preset = "paper_steady"
+variant = "paper"
+method = "rodas4"
+[[axes]]
+name = "k_n"
+values = [0.8e5, 1.0e5, 1.2e5]
+[[axes]]
+name = "k_hip"
+values = [0.95, 1.0]
+[run]
+t_end = 6.0
+steady = 3
+period_tol = 1e-3
+fallback = false
+[paper]
+at = { k_hip = 0.95 }
+L = [0.3967, 0.3976]
+P = [0.622, 0.620]
+v = [0.6375, 0.641]
+"""
+
+
+@pytest.fixture
+def tiny():
+    return S.parse_study(TINY)
+
+
+def _csv(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def test_study_files_parse():
+    assert len(STUDY_FILES) >= 9
+    names = {f.stem for f in STUDY_FILES}
+    assert {"fig11_k_n", "fig12_d_n", "fig13_k_t", "fig14_d_t", "table5_m_h", "table5_m_l",
+            "table5_J_l", "table5_w", "table5_r"} <= names
+    for f in STUDY_FILES:
+        st = S.load_study(f)
+        assert st.name == f.stem and st.preset == "paper_steady"
+        assert 1 <= len(st.axes) <= 2 and len(st.points()) >= 9
+        if st.name.startswith("fig1"):
+            assert st.axis_names[1] == "k_hip"
+            assert st.axes[1][1].tolist() == [0.9, 0.95, 1.0]
+            assert set(st.paper) >= {"L", "P", "v", "at"}
+
+
+@pytest.mark.parametrize("text, match", [
+    ("bogus = 1\n[[axes]]\nname='k_n'\nvalues=[1e5]", "unknown key 'bogus'"),
+    ("[[axes]]\nname='k_x'\nvalues=[1e5]", "Params field"),
+    ("[[axes]]\nname='k_n'\nstart=1\nstop=2", "missing num"),
+    ("[[axes]]\nname='k_n'\nvalues=[-1.0]", "k_n"),
+    ("variant='other'\n[[axes]]\nname='k_n'\nvalues=[1e5]", "variant"),
+    ("[run]\nmode='guess'\n[[axes]]\nname='k_n'\nvalues=[1e5]", "mode"),
+    ("[run]\nt_end='long'\n[[axes]]\nname='k_n'\nvalues=[1e5]", "t_end"),
+    ("[params]\nk_n=2e5\n[[axes]]\nname='k_n'\nvalues=[1e5]", "swept and also fixed"),
+    ("title='no axes'", "one or two"),
+])
+def test_bad_study_files_name_the_key(text, match):
+    with pytest.raises(pdw.InvalidInputError, match=match):
+        S.parse_study(text)
+
+
+def test_points_order_and_tasks(tiny):
+    pts = tiny.points()
+    assert [k for k, _ in pts] == list(range(6))
+    assert [v["k_n"] for _, v in pts[:3]] == [0.8e5, 1.0e5, 1.2e5]      # first axis fastest
+    assert [v["k_hip"] for _, v in pts] == [0.95] * 3 + [1.0] * 3
+    t = tiny.task(*pts[4])
+    assert t["params"]["k_n"] == 1.0e5 and t["params"]["k_hip"] == 1.0
+    assert t["params"]["d_hip"] == 0.010                                 # the preset
+
+
+@pytest.fixture(scope="module")
+def tiny_serial(tmp_path_factory):
+    out = tmp_path_factory.mktemp("serial")
+    return S.run_study(S.parse_study(TINY), out, backend="serial", progress=False)
+
+
+def test_run_writes_csv_provenance_and_figure(tiny_serial):
+    res = tiny_serial
+    rows = _csv(res.paths["csv"])
+    assert [int(r["index"]) for r in rows] == list(range(6))
+    assert all(r["status"] == "walked" and r["gait"] == "period-1" for r in rows)
+    L = np.array([float(r["L"]) for r in rows])
+    assert np.all((L > 0.3) & (L < 0.45))
+    # k_hip 0.95 -> 1.0 shortens the step at every k_n (the paper's trend)
+    assert np.all(L[3:] < L[:3])
+    meta = json.loads(res.paths["json"].read_text())
+    assert meta["code"]["input_hash"] == pdw.INPUT_HASH
+    assert meta["code"]["pdw_version"] == pdw.__version__
+    assert "git_describe" in meta["code"]
+    assert meta["study"]["sha256"] == res.study.digest() and meta["n_points"] == 6
+    assert meta["base_params"]["d_hip"] == 0.010 and meta["status_counts"] == {"walked": 6}
+    assert res.paths["png"].exists() and res.paths["png"].stat().st_size > 10000
+
+
+def _values(rows):
+    return [(r["index"], r["L"], r["P"], r["cycle"]) for r in rows]
+
+
+def test_threads_and_processes_give_the_serial_numbers(tiny_serial, tmp_path):
+    for backend in ("thread", "process"):
+        res = S.run_study(S.parse_study(TINY), tmp_path / backend, backend=backend, workers=2,
+                          progress=False, figures=False)
+        assert _values(res.rows) == _values(tiny_serial.rows), backend
+
+
+class KillAfter(cf.Executor):
+    """An executor that computes the first n tasks (in this thread) and then 'dies': every
+    later task fails, as if the machine went away."""
+
+    def __init__(self, n):
+        self.n, self.count = n, 0
+
+    def submit(self, fn, *args, **kwargs):
+        fut = cf.Future()
+        if self.count < self.n:
+            fut.set_result(fn(*args, **kwargs))
+        else:
+            fut.set_exception(KeyboardInterrupt("killed"))
+        self.count += 1
+        return fut
+
+
+def test_killed_sweep_resumes_without_recomputing(tiny_serial, tmp_path, monkeypatch):
+    study = S.parse_study(TINY)
+    with pytest.raises(KeyboardInterrupt):
+        S.run_study(study, tmp_path, executor=KillAfter(4), progress=False, figures=False)
+    rows = _csv(tmp_path / "tiny.csv")
+    assert sorted(int(r["index"]) for r in rows) == [0, 1, 2, 3]
+    # a write cut by the kill: a torn last line is dropped on resumption
+    with open(tmp_path / "tiny.csv", "a") as f:
+        f.write("4,100000.0,1.0,wal")
+    calls = []
+    real = S.run_point
+
+    def counting(task):
+        calls.append(task["index"])
+        return real(task)
+
+    monkeypatch.setattr(S, "run_point", counting)
+    res = S.run_study(study, tmp_path, backend="thread", workers=2, progress=False,
+                      figures=False)
+    assert sorted(calls) == [4, 5] and res.computed == [4, 5] and res.resumed == [0, 1, 2, 3]
+    rows = _csv(tmp_path / "tiny.csv")
+    assert [int(r["index"]) for r in rows] == list(range(6))           # each point once
+    assert _values(res.rows) == _values(tiny_serial.rows)
+    meta = json.loads((tmp_path / "tiny.json").read_text())
+    assert meta["n_resumed"] == 4 and meta["n_computed"] == 2
+    # all done: a rerun computes nothing
+    calls.clear()
+    res = S.run_study(study, tmp_path, progress=False, figures=False)
+    assert calls == [] and res.computed == []
+
+
+def test_resume_refuses_a_csv_of_another_study(tmp_path):
+    study = S.parse_study(TINY)
+    other = S.parse_study(TINY.replace("values = [0.8e5, 1.0e5, 1.2e5]",
+                                       "values = [0.7e5, 1.0e5, 1.2e5]"))
+    with pytest.raises(KeyboardInterrupt):
+        S.run_study(study, tmp_path, executor=KillAfter(1), progress=False, figures=False)
+    with pytest.raises(pdw.PdwError, match="does not match"):
+        S.run_study(other, tmp_path, progress=False, figures=False)
+    res = S.run_study(other, tmp_path, resume=False, backend="serial", progress=False,
+                      figures=False)
+    assert len(res.computed) == 6
+
+
+def test_dask_local_cluster(tiny_serial, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        res = S.run_study(S.parse_study(TINY), tmp_path, executor=client.get_executor(),
+                          progress=False, figures=False)
+    assert _values(res.rows) == _values(tiny_serial.rows)
+    meta = json.loads((tmp_path / "tiny.json").read_text())
+    assert "ClientExecutor" in meta["executor"]
+
+
+def test_progress_bar_lines(capsys):
+    import io
+    buf = io.StringIO()
+    bar = S.Progress(20, 0, label="x", stream=buf)
+    for _ in range(20):
+        bar.update()
+    lines = buf.getvalue().splitlines()
+    assert 10 <= len(lines) <= 12 and lines[-1].startswith("x: [") and "20/20 (100%)" in lines[-1]
+
+
+def test_cli_sweep(tmp_path, capsys):
+    f = tmp_path / "tiny.toml"
+    f.write_text(TINY.replace("values = [0.95, 1.0]", "values = [0.95]"))
+    out = tmp_path / "out"
+    rc = pdw.cli.main(["sweep", str(f), "--out", str(out), "--no-progress", "--no-figures",
+                       "--workers", "2"])
+    assert rc == 0
+    assert "3 points (3 computed, 0 resumed)" in capsys.readouterr().out
+    assert (out / "tiny.csv").exists() and (out / "tiny.json").exists()
+    assert pdw.cli.main(["sweep", str(tmp_path / "missing.toml")]) == 2
+
+
+def test_run_point_reports_bad_points_as_rows(tiny):
+    t = tiny.task(0, {"k_n": 1e5, "k_hip": 0.95})
+    t["params"]["r"] = 0.6                     # r >= l: invalid
+    row = S.run_point(t)
+    assert row["status"] == "error" and "r" in row["error"]
+
+
+@pytest.mark.slow
+def test_all_studies():
+    """The paper's Table 5 and Figs. 11-14 (docs/studies/*.toml): figures in docs/figures/,
+    trends in benchmarks/results/studies.txt (a few tens of seconds)."""
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    import studies
+    studies.main([])
+    text = (ROOT / "benchmarks" / "results" / "studies.txt").read_text()
+    assert "fig11_k_n" in text and "table5_r" in text
