@@ -17,7 +17,7 @@ from ._layout import INPUT_HASH
 from .model import (STATE, VARIANTS, ContactState, contact_forces, energies, jacobian,
                     mass_matrix, rhs)
 from .errors import (DivergedError, FellError, InvalidInputError, PdwError, SimulationError,
-                     SingularSystemError)
+                     SingularSystemError, StepSizeError, StepSizeWarning)
 from .gait import Steps, steps
 from .params import Params
 from . import hybrid
@@ -31,4 +31,5 @@ __all__ = [
     "STATE", "VARIANTS", "INPUT_HASH", "simulate", "Result", "Event", "METHODS", "X0_PAPER",
     "X0_DISTURBED", "steps", "Steps", "PdwError", "SimulationError", "DivergedError",
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait",
+    "StepSizeWarning", "StepSizeError",
 ]

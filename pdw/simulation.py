@@ -13,7 +13,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from . import _core, _layout
+from . import _core, _layout, stability as _stability
 from .errors import DivergedError, InvalidInputError, SingularSystemError
 from .model import STATE, check_variant, kernel_index, parameter_vector
 from .params import Params
@@ -128,7 +128,7 @@ def check_state(x0, name="x0"):
 def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
              flags0=(0, 1), record_every=1, record_forces=True, on_failure="raise",
              fall_hip_height=None, fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8,
-             h_max=None, event_tol=1e-9):
+             h_max=None, event_tol=1e-9, check_step="warn"):
     """Simulate the walker from ``x0`` for ``t_end`` seconds.
 
     Parameters
@@ -172,6 +172,10 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
         Adaptive methods locate each flag switch (touch-down, lift-off, arming) to within this
         time [s] and end a step there (docs/integrators.md); fixed-step methods switch at step
         boundaries.
+    check_step : {"warn", "error", "off"}
+        Fixed-step methods: compare dt with `pdw.stability.step_limit` (the method's estimated
+        stability limit for these parameters) and warn (`pdw.StepSizeWarning`) or refuse
+        (`pdw.StepSizeError`) above it, naming the limit and the force that sets it.
 
     Returns
     -------
@@ -208,6 +212,7 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     atol = _check_positive("atol", atol)
     h_max = 0.0 if h_max is None else _check_positive("h_max", h_max)
     event_tol = _check_positive("event_tol", event_tol)
+    _stability.check_step(dt, params, method, variant, check_step)
 
     k = kernel_index(variant)
     p = parameter_vector(params)
