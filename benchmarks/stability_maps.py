@@ -39,6 +39,7 @@ SWEEPS = {
 }
 QUICK = {k: ([v[0][0], v[0][len(v[0]) // 2], v[0][-1]], v[1]) for k, v in SWEEPS.items()}
 BASE = "paper_steady"
+VARIANTS = ("paper", "consistent")
 ADAPTIVE_RTOL = 1e-6
 DOPRI5_T_END = 0.4      # first stance and touch-down: dopri5 is stability-bound, ~1e6 steps/s
 MARGIN_T_END = 5.0      # a cell whose reference falls before this is marked marginal
@@ -66,10 +67,11 @@ def linear_along(ref, method, idx=None):
     """Min over the reference trajectory of the linear limit without friction: (h, t, flags)."""
     P = ref.params
     idx = _trajectory_states(ref) if idx is None else idx
+    anchors = S._anchors(ref)
     best = (math.inf, None, None)
     for i in idx:
-        J = pdw.jacobian(ref.x[i], P, flags=tuple(ref.flags[i]), variant=ref.variant,
-                         features=S._NO_FRICTION)
+        J = pdw.jacobian(ref.x[i], P, flags=tuple(ref.flags[i]), anchors=tuple(anchors[i]),
+                         variant=ref.variant, features=S._NO_FRICTION)
         h = S.linear_limit(method, J)
         if h < best[0]:
             best = (h, float(ref.t[i]), tuple(int(f) for f in ref.flags[i]))
@@ -77,10 +79,11 @@ def linear_along(ref, method, idx=None):
 
 
 def adaptive_stats(P, method, ref):
-    x0 = S.typical_start(P)
+    x0 = S.typical_start(P, ref.variant)
     t_end = DOPRI5_T_END if method == "dopri5" else ref.t_end
     t0 = time.perf_counter()
     r = S._sim(x0=x0, t_end=t_end, dt=1e-5, params=P, method=method, rtol=ADAPTIVE_RTOL,
+               variant=ref.variant,
                atol=ADAPTIVE_RTOL * 1e-2, record_every=1, record_forces=False)
     wall = time.perf_counter() - t0
     h = np.diff(r.t)
@@ -98,53 +101,58 @@ def adaptive_stats(P, method, ref):
 
 def cell(args):
     """Everything measured at one parameter point."""
-    name, value, preset = args
+    name, value, preset, variant = args
     t0 = time.perf_counter()
     P = params_for(name, value, preset)
-    ref = S.reference(P)
-    out = {"param": name, "value": value, "preset": preset, "ref_status": ref.status,
-           "ref_touch_downs": len(S.touch_downs(ref)), "ref_gain": S.energy_gain(ref),
-           "ref_t_final": ref.t_final, "methods": {}, "adaptive": {}}
+    ref = S.reference(P, variant)
+    out = {"param": name, "value": value, "preset": preset, "variant": variant,
+           "ref_status": ref.status, "ref_touch_downs": len(S.touch_downs(ref)),
+           "ref_gain": S.energy_gain(ref), "ref_t_final": ref.t_final, "methods": {},
+           "adaptive": {}}
     walks = ref.status == "walked"
     # a marginal gait (the reference falls soon after t_end) decides "walks" by chance
-    longer = S._sim(x0=S.typical_start(P), t_end=MARGIN_T_END, params=P, method="rodas4",
-                    rtol=1e-9, atol=1e-11, record_every=0)
+    longer = S._sim(x0=S.typical_start(P, variant), t_end=MARGIN_T_END, params=P, method="rodas4",
+                    variant=variant, rtol=1e-9, atol=1e-11, record_every=0)
     out["marginal"] = None if longer.status == "walked" else "reference %s at %.2f s" % (
         longer.status, longer.t_final)
+    legs = [leg for _, leg in S.touch_downs(ref)]
+    if any(a == b for a, b in zip(legs[:-1], legs[1:])):
+        out["marginal"] = "reference bounces (a foot touches down twice in a row)"
     idx = _trajectory_states(ref)
     for m in FIXED:
         d = {}
         if walks:
-            ls = S.largest_step(P, m, ref, lo=1e-6)
+            ls = S.largest_step(P, m, ref, variant=variant, lo=1e-6)
             d["walk"] = ls["walk"]
             d["correct"] = ls["correct"]
             d["runs"] = [(dt, v.walks, v.correct, v.reason) for dt, v in ls["runs"]]
-        d["h_states"] = S._limits(P, m, "paper")
-        d["step_limit"] = S.step_limit(P, m).dt_max
+        d["h_states"] = S._limits(P, m, variant)
+        d["step_limit"] = S.step_limit(P, m, variant).dt_max
         d["h_traj"], d["t_traj"], d["flags_traj"] = linear_along(ref, m, idx)
-        d["sensitivity"] = S.sensitivity(P, m)
+        d["sensitivity"] = S.sensitivity(P, m, variant)
+        d["force"] = S.step_limit(P, m, variant).force
         out["methods"][m] = d
     if walks:
         for m in ("dopri5", "rodas4"):
             out["adaptive"][m] = adaptive_stats(P, m, ref)
-        out["adaptive"]["dopri5"]["h_linear_friction"] = S.step_limit(P, "dopri5").dt_chatter
+        out["adaptive"]["dopri5"]["h_linear_friction"] = S.step_limit(P, "dopri5", variant).dt_chatter
     out["wall"] = time.perf_counter() - t0
     return out
 
 
 def chatter_cell(args):
     """Chatter and spurious-slip onsets of each fixed-step method at one parameter point."""
-    name, value, preset = args
+    name, value, preset, variant = args
     P = params_for(name, value, preset)
-    ref = S.reference(P, t_end=S.CHATTER_WINDOW[1])
-    v = S.slip(ref)
+    ref = S.reference(P, variant, t_end=S.CHATTER_WINDOW[1])
+    v = S.slip(ref, 2, S.CHATTER_WINDOW)
     out = {"param": name, "value": value, "ref_stuck": float(np.mean(np.abs(v) < P.v_s)),
            "ref_v_max": float(np.max(np.abs(v))), "methods": {}}
     for m in FIXED:
         out["methods"][m] = {
-            "slides": S.chatter_onset(P, m, key="slides", hi=1e-3),
-            "chatters": S.chatter_onset(P, m, key="chatters", hi=1e-3),
-            "linear": S.step_limit(P, m).dt_chatter,
+            "slides": S.chatter_onset(P, m, variant, key="slides", hi=1e-3),
+            "chatters": S.chatter_onset(P, m, variant, key="chatters", hi=1e-3),
+            "linear": S.step_limit(P, m, variant).dt_chatter,
         }
     return out
 
@@ -224,25 +232,44 @@ def _fmt(x):
 
 def report(cells, chat, cl, energy):
     lines = ["Stability maps (benchmarks/stability_maps.py); base parameters Params.%s, start "
-             "stability.typical_start, 3.5 s, variant paper." % BASE, ""]
-    lines.append("Largest step [s]: walks / walks correctly (touch-downs within max(2 ms, 1% "
-                 "cycle)); lin = linear limit min along the reference; S = step_limit")
-    for name in SWEEPS:
+             "stability.typical_start, 3.5 s." % BASE, ""]
+    lines.append("Largest step [s]: walks / walks correctly (touch-downs within max(2 ms, 1%% "
+                 "cycle)); lin = linear limit min along the reference; S = step_limit; "
+                 "marg. = marginal gait (reference falls before %g s)" % MARGIN_T_END)
+    for variant in VARIANTS:
+        vc = [c for c in cells if c.get("variant", "paper") == variant]
+        if not vc:
+            continue
         lines.append("")
-        lines.append("%-8s %-5s | %s" % (name, "ref", " | ".join(
-            "%-6s walk    correct  lin      S" % m for m in FIXED)))
-        for c in [c for c in cells if c["param"] == name]:
-            row = "%-8.3g %-5s |" % (c["value"], "marg." if c.get("marginal") else c["ref_status"][:5])
+        lines.append("== variant %s ==" % variant)
+        for name in SWEEPS:
+            lines.append("")
+            lines.append("%-8s %-5s | %s" % (name, "ref", " | ".join(
+                "%-6s walk    correct  lin      S        force" % m for m in FIXED)))
+            for c in [c for c in vc if c["param"] == name]:
+                row = "%-8.3g %-5s |" % (c["value"], "marg." if c.get("marginal") else c["ref_status"][:5])
+                for m in FIXED:
+                    d = c["methods"][m]
+                    row += " %-6s %-8s %-8s %-8s %-8s %-5s |" % (
+                        "", _fmt(d.get("walk")), _fmt(d.get("correct")), _fmt(d["h_traj"]),
+                        _fmt(d["step_limit"]), d.get("force", ""))
+                lines.append(row)
+        lines.append("")
+        lines.append("Failure at the first failing step (walks):")
+        for c in vc:
+            row = []
             for m in FIXED:
-                d = c["methods"][m]
-                row += " %-6s %-8s %-8s %-8s %-8s |" % ("", _fmt(d.get("walk")), _fmt(d.get("correct")),
-                                                        _fmt(d["h_traj"]), _fmt(d["step_limit"]))
-            lines.append(row)
+                x = c["methods"][m]
+                if not x.get("walk") or x["walk"][1] is None:
+                    continue
+                r = [r for r in x["runs"] if abs(r[0] - x["walk"][1]) < 1e-15]
+                row.append("%s %.2g: %s" % (m, x["walk"][1], r[0][3] if r else "?"))
+            lines.append("  %s=%-8g %s" % (c["param"], c["value"], " | ".join(row)))
     lines.append("")
     lines.append("Adaptive (rtol %g): rodas4 over 3.5 s, dopri5 over %.1f s" % (ADAPTIVE_RTOL, DOPRI5_T_END))
     lines.append("%-8s %-8s | rodas4: steps  h_max    h_med(ss) correct | dopri5: steps/s  h_max    "
                  "h_med(ss) lin(fric)" % ("param", "value"))
-    for c in cells:
+    for c in [c for c in cells if c.get("variant", "paper") == "paper"]:
         a = c["adaptive"]
         if not a:
             continue
@@ -286,6 +313,14 @@ def report(cells, chat, cl, energy):
 # ---------------------------------------------------------------------------------- figures ---
 
 def figures(cells, chat):
+    for variant in VARIANTS:
+        vc = [c for c in cells if c.get("variant", "paper") == variant]
+        if vc:
+            map_figure(vc, variant)
+    adaptive_figure([c for c in cells if c.get("variant", "paper") == "paper"], chat)
+
+
+def map_figure(cells, variant):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -326,7 +361,7 @@ def figures(cells, chat):
     ax.axis("off")
     h, l = axes.flat[0].get_legend_handles_labels()
     ax.legend(h, l, fontsize=8, ncol=2, loc="lower left", frameon=False)
-    ax.text(0.0, 1.0, "Typical gait, Params.%s, 3.5 s, variant 'paper'.\n"
+    ax.text(0.0, 1.0, "Typical gait, Params.%s, 3.5 s, variant '%s'.\n"
             "walks: reaches 3.5 s with the reference's touch-downs\n"
             "  and no energy gain beyond the reference's + 0.1 J\n"
             "walks correctly: + touch-downs within max(2 ms, 1 %% cycle)\n"
@@ -334,12 +369,21 @@ def figures(cells, chat):
             "  stable step of the method on df/dx without friction\n"
             "step_limit: pdw.stability.step_limit (calibrated)\n"
             "grey bars: marginal gait (the rodas4 reference falls\n"
-            "  before 5 s): 'walks' is decided by chance there" % BASE,
+            "  before 5 s, or bounces): 'walks' is decided by chance\n"
+            "  there; not used for the calibration" % (BASE, variant),
             va="top", family="monospace", fontsize=9)
-    fig.savefig(FIGURES / "stability_maps.png", dpi=90)
+    fig.savefig(FIGURES / ("stability_maps.png" if variant == "paper"
+                           else "stability_maps_%s.png" % variant), dpi=90)
     plt.close(fig)
 
-    # adaptive
+
+def adaptive_figure(cells, chat):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    colors = {"cdm": "C0", "verlet": "C1", "rk4": "C2"}
+    labels = {"k_n": r"$k_n$ [N/m$^{1.5}$]", "d_n": r"$d_n$ [N s/m$^{2.5}$]",
+              "v_s": r"$v_s$ [m/s] ($v_d = 10 v_s$)", "k_t": r"$k_t$", "d_t": r"$d_t$"}
     fig, axes = plt.subplots(1, 5, figsize=(18, 4), constrained_layout=True)
     for ax, name in zip(axes, SWEEPS):
         cs = sorted([c for c in cells if c["param"] == name and c["adaptive"]], key=lambda c: c["value"])
@@ -400,9 +444,10 @@ def main(argv=None):
     a = ap.parse_args(argv)
     sweeps = QUICK if a.quick else SWEEPS
     t0 = time.perf_counter()
-    tasks = [(name, v, BASE) for name, (vals, _) in sweeps.items() for v in vals]
-    chat_tasks = [("v_s", v, BASE) for v in sweeps["v_s"][0]] + \
-                 [("k_n", v, BASE) for v in sweeps["k_n"][0]]
+    tasks = [(name, v, BASE, "paper") for name, (vals, _) in sweeps.items() for v in vals] + \
+            [(name, v, BASE, "consistent") for name, (vals, _) in QUICK.items() for v in vals]
+    chat_tasks = [("v_s", v, BASE, "paper") for v in sweeps["v_s"][0]] + \
+                 [("k_n", v, BASE, "paper") for v in sweeps["k_n"][0]]
     path = RESULTS / "stability_maps.json"
     data = json.loads(path.read_text()) if path.exists() else {}
     with mp.Pool(a.jobs) as pool:
@@ -420,9 +465,11 @@ def main(argv=None):
     lines = report(data.get("cells", []), data.get("chatter", []), data.get("claims", {}),
                    data.get("energy", []))
     lines.append("")
-    lines.append("Calibration (smallest walking edge / linear limit at the stance states, per method): "
-                 + ", ".join("%s %.3g (median %.3g, cell %s)" % (m, c["min"], c["median"], c["at"])
-                             for m, c in data["calibration"].items()))
+    for variant, cal in data["calibration"].items():
+        lines.append("Calibration, variant %s (smallest walking edge / linear limit at the stance "
+                     "states): " % variant + ", ".join(
+                         "%s %.3g (median %.3g, max %.3g, at %s)" % (m, c["min"], c["median"], c["max"], c["at"])
+                         for m, c in cal.items()))
     lines.append("wall %.0f s" % (time.perf_counter() - t0))
     publish("stability_maps.txt", lines)
     if not a.no_figures:
@@ -431,18 +478,22 @@ def main(argv=None):
 
 def calibration(cells):
     """Ratio of the measured walking edge to the uncalibrated linear limit at the stance states
-    (min over the states), per method: its minimum over the cells is `CALIBRATION`."""
+    (min over the states), per variant and method: its minimum over the non-marginal cells is
+    `pdw.stability.CALIBRATION`."""
     out = {}
-    for m in FIXED:
-        ratios = []
-        for c in cells:
-            d = c["methods"][m]
-            if d.get("walk") and d["walk"][0] and not c.get("marginal"):
-                ratios.append((d["walk"][0] / min(d["h_states"]), "%s=%g" % (c["param"], c["value"])))
-        if ratios:
-            r = min(ratios)
-            out[m] = {"min": r[0], "at": r[1], "median": float(np.median([x for x, _ in ratios])),
-                      "max": max(ratios)[0]}
+    for variant in VARIANTS:
+        out[variant] = {}
+        for m in FIXED:
+            ratios = []
+            for c in cells:
+                d = c["methods"][m]
+                if c.get("variant", "paper") == variant and d.get("walk") and d["walk"][0] \
+                        and not c.get("marginal"):
+                    ratios.append((d["walk"][0] / min(d["h_states"]), "%s=%g" % (c["param"], c["value"])))
+            if ratios:
+                r = min(ratios)
+                out[variant][m] = {"min": r[0], "at": r[1], "max": max(ratios)[0],
+                                   "median": float(np.median([x for x, _ in ratios]))}
     return out
 
 

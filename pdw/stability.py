@@ -52,10 +52,19 @@ FORCES = {
 }
 _NO_FRICTION = tuple(f for f in _layout.FEATURES if f != "friction")
 
-#: Calibration of `step_limit`: the largest step at which the typical gait walks (measured,
-#: docs/stability.md) divided by the linear limit at the representative stance state, the
-#: smallest ratio over the maps' cells, per method. Written by benchmarks/stability_maps.py.
-CALIBRATION = {"cdm": 0.1, "verlet": 0.17, "rk4": 0.22}
+#: Calibration of `step_limit`, per variant and method: the largest step at which the typical
+#: gait walks (measured, docs/stability.md) divided by the linear limit at the representative
+#: states, at its smallest over the stability maps' cells (benchmarks/stability_maps.py prints
+#: it), rounded down.
+CALIBRATION = {"paper": {"cdm": 0.1, "verlet": 0.17, "rk4": 0.22},
+               "consistent": {"cdm": 0.11, "verlet": 0.12, "rk4": 0.12}}
+#: When a stuck stance foot needs at least FRICTION_LOAD of its static friction mu_s F_n to
+#: hold the tangential spring-damper (paper variant, k_t >~ 600 at the paper's values), an
+#: explicit method's friction chatter changes the gait: the walking edge falls to a few times
+#: the chatter limit (k_t = 850 in docs/stability.md: 6-10 x). `step_limit` is then at most
+#: CHATTER_CALIBRATION x `StepLimit.dt_chatter`.
+FRICTION_LOAD = 0.8
+CHATTER_CALIBRATION = 5.0
 
 
 # --------------------------------------------------------------------------------------------
@@ -253,7 +262,9 @@ def stance_states(params: Params | None = None, variant: str = "paper") -> tuple
     """The representative states of `step_limit`: ``(X, flags)``, X of shape (4, 8): the three
     `STANCE_STATES` (flags (0, 1)) and the landing, `DOUBLE_SUPPORT_STATE` with flags
     `LANDING_FLAGS`; each with the support foot stuck (x_o' set so that its slip velocity is 0
-    -- at `pdw.X0_PAPER` it still slides at 5 mm/s) and y_o set so that it carries the weight
+    -- at `pdw.X0_PAPER` it still slides at 5 mm/s), in single stance not sinking either (y_o'
+    set so that the consistent normal rate y_o' + (l - r) sin(theta2) theta2' is 0; the paper
+    variant's printed rate keeps its r theta2'), and y_o set so that it carries the weight
     (the landing: `DOUBLE_SUPPORT_LOAD` times it) under ``params`` and ``variant``. Late in
     stance the paper variant's tangential spring-damper acts (xi_2 < 0), early on it does not;
     the landing holds the impact (d_n delta^p delta' at its largest)."""
@@ -263,6 +274,8 @@ def stance_states(params: Params | None = None, variant: str = "paper") -> tuple
             [(DOUBLE_SUPPORT_STATE, LANDING_FLAGS, 0, DOUBLE_SUPPORT_LOAD)]:
         x = np.array(x0, dtype=float)
         x[4] -= float(contact_forces(x, params, flags=fl, variant=variant).v_x[foot])
+        if foot == 1:       # single stance: the stance foot neither sinks nor rises
+            x[5] = -(params.l - params.r) * math.sin(x[3]) * x[7]
         out.append(_set_hip_height(x, params, variant, fl, load * params.weight))
         flags.append(fl)
     return np.array(out), flags
@@ -294,6 +307,10 @@ class StepLimit:
         The stiffest eigenvalue of df/dx (friction excluded) at that state [1/s].
     sensitivity : dict
         Exponent a of dt_linear ~ parameter^a for k_n, d_n, k_t, d_t, d_hip (`sensitivity`).
+    friction_load : float
+        The largest share of the static friction mu_s F_n that a stuck stance foot needs to hold
+        the tangential spring-damper at the stance states; from `FRICTION_LOAD` on, dt_max is
+        capped by the chatter limit and ``force`` is "v_s".
     """
 
     method: str
@@ -305,12 +322,22 @@ class StepLimit:
     dt_chatter: float
     eigenvalue: complex
     sensitivity: dict = field(default_factory=dict, compare=False)
+    friction_load: float = 0.0
 
     @property
     def why(self) -> str:
         return FORCES.get(self.force, self.force)
 
     def message(self, dt: float) -> str:
+        if self.force == "v_s" and self.method in FIXED_STEP:
+            return ("dt = %.3g s exceeds the estimated limit %.2g s of method %r for these "
+                    "parameters (variant %r): the stuck stance foot needs %.0f %% of its static "
+                    "friction to hold the tangential spring, so the friction chatter of an "
+                    "explicit method (above ~%.2g s, %s) changes the gait; limit = %.0f x that "
+                    "(docs/stability.md). Use dt <= %.2g, or method='rodas4' (L-stable, no step "
+                    "limit); check_step='off' disables this check."
+                    % (dt, self.dt_max, self.method, self.variant, 100 * self.friction_load,
+                       self.dt_chatter, FORCES["v_s"], CHATTER_CALIBRATION, self.dt_max))
         return ("dt = %.3g s exceeds the estimated stability limit %.2g s of method %r for these "
                 "parameters (variant %r): the limit is set by %s (limit ~ %s^%.2g; stiffest "
                 "non-friction eigenvalue %.3g /s in stance; linear limit %.2g s x calibration "
@@ -327,10 +354,18 @@ def _stiffest(J):
     return complex(ev[np.argmax(np.abs(ev))])
 
 
+def state_jacobian(x, params: Params, flags, variant: str = "paper", features=_NO_FRICTION):
+    """df/dx at a representative state, its support feet anchored where they are (the
+    consistent variant's xi = 0: a foot that has not slipped since touch-down)."""
+    s = contact_forces(x, params, flags=flags, variant=variant).s
+    anchors = tuple(float(s[i]) if flags[i] else 0.0 for i in range(2))
+    return jacobian(x, params, flags=flags, anchors=anchors, variant=variant, features=features)
+
+
 def _limits(params: Params, method: str, variant: str, features=_NO_FRICTION):
     """Linear limits of ``method`` at each of `stance_states`."""
     X, flags = stance_states(params, variant)
-    return [linear_limit(method, jacobian(x, params, flags=fl, variant=variant, features=features))
+    return [linear_limit(method, state_jacobian(x, params, fl, variant, features))
             for x, fl in zip(X, flags)]
 
 
@@ -342,8 +377,32 @@ def _linear(params: Params, method: str, variant: str):
     return hs[k], k
 
 
+@functools.lru_cache(maxsize=1024)
+def _friction_load(params: Params, variant: str) -> float:
+    """Largest |F_t without friction| / (mu_s F_n) of the stuck foot at the single-stance states."""
+    X, flags = stance_states(params, variant)
+    P0 = params.replace(mu_s=0.0, mu_d=0.0)
+    load = 0.0
+    for x, fl in zip(X[:len(STANCE_STATES)], flags[:len(STANCE_STATES)]):
+        s = contact_forces(x, params, flags=fl, variant=variant).s
+        anchors = tuple(float(s[i]) if fl[i] else 0.0 for i in range(2))
+        cs = contact_forces(x, P0, flags=fl, anchors=anchors, variant=variant)
+        i = fl.index(1)
+        need, cap = abs(float(cs.F_t[i])), params.mu_s * float(cs.F_n[i])
+        load = max(load, need / cap if cap > 0 else (math.inf if need > 0 else 0.0))
+    return load
+
+
+@functools.lru_cache(maxsize=1024)
+def _chatter_limit(params: Params, method: str, variant: str) -> float:
+    return min(_limits(params, method, variant, features=None)[:len(STANCE_STATES)])
+
+
 def _dt_max(params, method, variant):
-    return CALIBRATION[method] * _linear(params, method, variant)[0]
+    dt = CALIBRATION[variant][method] * _linear(params, method, variant)[0]
+    if _friction_load(params, variant) >= FRICTION_LOAD:
+        dt = min(dt, CHATTER_CALIBRATION * _chatter_limit(params, method, variant))
+    return dt
 
 
 @functools.lru_cache(maxsize=256)
@@ -351,18 +410,20 @@ def _step_limit(params: Params, method: str, variant: str) -> StepLimit:
     if method == "rodas4":
         return StepLimit(method, variant, math.inf, "none", math.inf, 1.0, math.inf, 0j)
     X, flags = stance_states(params, variant)
-    dt_chatter = min(_limits(params, method, variant, features=None)[:len(STANCE_STATES)])
-    Jf = [jacobian(x, params, flags=fl, variant=variant) for x, fl in zip(X, flags)]
+    dt_chatter = _chatter_limit(params, method, variant)
+    Jf = [state_jacobian(x, params, fl, variant, None) for x, fl in zip(X, flags)]
     if method == "dopri5":
         # adaptive: the controller keeps the step below its explicit bound by itself
         return StepLimit(method, variant, dt_chatter, "v_s", dt_chatter, 1.0, dt_chatter,
-                         max((_stiffest(J) for J in Jf), key=abs))
+                         max((_stiffest(J) for J in Jf[:len(STANCE_STATES)]), key=abs))
     h, k = _linear(params, method, variant)
     sens = sensitivity(params, method, variant)
-    J = jacobian(X[k], params, flags=flags[k], variant=variant, features=_NO_FRICTION)
-    c = CALIBRATION[method]
-    return StepLimit(method, variant, c * h, limiting_force(sens), h, c, dt_chatter, _stiffest(J),
-                     sens)
+    J = state_jacobian(X[k], params, flags[k], variant)
+    c = CALIBRATION[variant][method]
+    load = _friction_load(params, variant)
+    dt_max = _dt_max(params, method, variant)
+    force = "v_s" if dt_max < c * h else limiting_force(sens)
+    return StepLimit(method, variant, dt_max, force, h, c, dt_chatter, _stiffest(J), sens, load)
 
 
 def step_limit(params: Params | None = None, method: str = "cdm", variant: str = "paper") -> StepLimit:

@@ -193,15 +193,30 @@ def test_step_limit_names_the_limiting_force():
     assert lim.dt_chatter < 5e-6                      # the stuck foot's friction mode
 
 
-@pytest.mark.parametrize("kw", [{}, dict(d_n=1e7), dict(d_t=1e4), dict(k_n=1e4)])
+@pytest.mark.parametrize("kw, variant", [
+    ({}, "paper"), (dict(d_n=1e7), "paper"), (dict(d_t=1e4), "paper"), (dict(k_n=1e4), "paper"),
+    (dict(k_t=850), "paper"), ({}, "consistent"), (dict(d_n=2.5e7), "consistent")])
 @pytest.mark.parametrize("method", S.FIXED_STEP)
-def test_the_gait_walks_at_the_step_limit(method, kw):
-    """At dt = step_limit the typical gait walks (calibration is conservative)."""
+def test_the_gait_walks_at_the_step_limit(method, kw, variant):
+    """At dt = step_limit the typical gait walks (the calibration is conservative), also where
+    the friction chatter sets the limit (k_t = 850: the stuck foot at its friction limit)."""
     P = pdw.Params.paper_steady(**kw)
-    lim = S.step_limit(P, method)
-    ref = S.reference(P)
-    v = S.judge(S.run_fixed(P, method, lim.dt_max), ref)
+    lim = S.step_limit(P, method, variant)
+    ref = S.reference(P, variant)
+    v = S.judge(S.run_fixed(P, method, lim.dt_max, variant), ref)
     assert v.walks, v.reason
+
+
+def test_friction_bound_limit():
+    """k_t = 850: the stuck foot needs 115 % of mu_s F_n; the limit is the chatter's, and the
+    message says so. Explicit runs above it fail (cdm at the paper's dt loses a step)."""
+    P = pdw.Params.paper_steady(k_t=850)
+    lim = S.step_limit(P, "cdm")
+    assert lim.force == "v_s" and lim.friction_load > 1.0
+    assert lim.dt_max == pytest.approx(S.CHATTER_CALIBRATION * lim.dt_chatter)
+    assert "static friction" in lim.message(1e-4)
+    assert not S.judge(S.run_fixed(P, "cdm", 1e-4), S.reference(P)).walks
+    assert S.step_limit(pdw.Params.paper_steady(), "cdm").friction_load < 0.2
 
 
 # -------------------------------------------------------------- linear stability regions ----
