@@ -6,10 +6,11 @@ the stiffest forces of the model (docs/stability.md has the measured maps). This
 * the **linear stability of one step** of each method applied to the linearized model
   x' = J x (`step_matrix`, `linear_limit`): the largest h for which the one-step map does not
   grow faster than the exact solution;
-* the **step-size check** of `pdw.simulate` (`step_limit`, `check_step`): the linear limit at a
-  representative stance state of the given parameters, *without* the friction law's slope
+* the **step-size check** of `pdw.simulate` (`step_limit`, `check_step`): the smallest linear
+  limit at four representative states of the typical gait (`stance_states`: three in single
+  stance, one at the landing) for the given parameters, *without* the friction law's slope
   (friction saturates, so its instability is a bounded chatter, not a divergence; see below),
-  times a per-method factor calibrated on the stability maps;
+  times a per-variant, per-method factor calibrated on the stability maps (`CALIBRATION`);
 * the **criteria of the stability maps** (`typical_start`, `reference`, `judge`,
   `largest_step`, `chatter`), and the **energy balance** of a run (`energy_balance`).
 
@@ -19,7 +20,9 @@ method is unstable above a step of ~2 us there. The instability does not diverge
 at +-mu_s -- but the stuck foot then slides back and forth (cdm: the slip velocity reverses
 every other step) at up to 100 v_s. `check_step` does not warn about it (it happens at every
 step size anyone would use with an explicit method, including the paper's dt = 1e-4); the
-limit is reported as `StepLimit.dt_chatter` and documented.
+limit is reported as `StepLimit.dt_chatter` and documented. The exception: where the stuck
+foot needs most of its static friction to hold the tangential spring (`FRICTION_LOAD`),
+chatter changes the gait, and the limit is capped at a few times the chatter limit.
 """
 from __future__ import annotations
 
@@ -297,7 +300,7 @@ class StepLimit:
         The parameter of the force element that sets it (a key of `FORCES`): the one with the
         most negative exponent in ``sensitivity``.
     dt_linear : float
-        The linear limit at the representative stance state (before calibration).
+        The smallest linear limit at the representative states (before calibration).
     calibration : float
         dt_max / dt_linear (measured on the maps, `CALIBRATION`).
     dt_chatter : float
@@ -429,11 +432,15 @@ def _step_limit(params: Params, method: str, variant: str) -> StepLimit:
 def step_limit(params: Params | None = None, method: str = "cdm", variant: str = "paper") -> StepLimit:
     """Estimate the largest fixed step ``method`` can take on the walker with ``params``.
 
-    The linear stability limit (`linear_limit`) of the method on df/dx without the friction
-    slope, at the typical gait's stance state (`typical_start`, leg 2 carrying the weight),
-    times the method's calibration factor `CALIBRATION` (the smallest ratio of the measured
-    walking limit to this linear limit over the stability maps, docs/stability.md). Cached per
-    (params, method, variant); about 5 ms the first time.
+    The smallest linear stability limit (`linear_limit`) of the method on df/dx without the
+    friction slope at the representative states (`stance_states`), times the calibration
+    factor `CALIBRATION[variant][method]` (the smallest ratio of the measured walking limit to
+    this linear limit over the stability maps, docs/stability.md); capped at
+    `CHATTER_CALIBRATION` x the chatter limit where the stuck foot needs `FRICTION_LOAD` of its
+    static friction. For dopri5: its explicit bound with friction (the step its controller
+    keeps below by itself); for rodas4: inf. Cached per
+    (params, method, variant); about 40 ms the first time (the force's exponents take five
+    more linear limits).
     """
     from .model import check_variant
     from .simulation import METHODS
@@ -454,7 +461,7 @@ def check_step(dt: float, params: Params, method: str, variant: str, mode: str =
 
     ``mode``: "warn" (a `pdw.StepSizeWarning` when dt > `step_limit`), "error" (raise
     `pdw.StepSizeError` instead), "off". Adaptive methods are not checked (their dt is only
-    the first trial step). Returns the `StepLimit` when dt exceeds it, else None. Costs ~3 ms
+    the first trial step). Returns the `StepLimit` when dt exceeds it, else None. Costs ~7 ms
     per new (params, method, variant), nothing after (cached).
     """
     if mode not in CHECK_MODES:
