@@ -53,6 +53,7 @@ bench: $(STAMP)
 ## study: slow studies (marked slow in tests/)
 study: $(STAMP)
 	$(PY) -m pytest -q -m slow
+	$(PY) benchmarks/stability_maps.py
 
 clean:
 	rm -rf build pdw/_core.c pdw/*.so out

@@ -22,7 +22,7 @@ from ._layout import INPUT_HASH
 from .model import (STATE, VARIANTS, ContactState, contact_forces, energies, jacobian,
                     mass_matrix, rhs)
 from .errors import (DivergedError, FellError, InvalidInputError, PdwError, SimulationError,
-                     SingularSystemError)
+                     SingularSystemError, StepSizeError, StepSizeWarning)
 from .gait import Steps, steps
 from .params import Params
 from . import hybrid
@@ -41,4 +41,5 @@ __all__ = [
     "X0_DISTURBED", "steps", "Steps", "PdwError", "SimulationError", "DivergedError",
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait", "Scene", "run",
     "limit_cycle", "cell_mapping", "find_gait", "sweep",
+    "StepSizeWarning", "StepSizeError",
 ]

@@ -272,7 +272,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         double fall_hip_height, double fall_depth, double max_speed,
         double rtol=1e-6, double atol=1e-8, double h_max=0.0, long max_records=0,
         long event_capacity=256, double event_tol=1e-9, bint record_events=True,
-        long stop_steps=0, int periodic_k=0, double periodic_tol=0.0):
+        long stop_steps=0, int periodic_k=0, double periodic_tol=0.0, double t_end=0.0):
     """Run one simulation in compiled code (GIL released). Returns a dict of arrays and status.
 
     The online gait analysis runs for every method: the result's "gait" holds the last
@@ -281,7 +281,8 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     stops at that many complete steps, periodic_k > 0 when the last periodic_k steps agree within
     periodic_tol (relative); "stop_reason" says which (layout STOP).
 
-    Fixed-step methods take n_steps steps of dt; adaptive ones integrate to n_steps*dt with
+    Fixed-step methods take n_steps steps of dt; adaptive ones integrate to t_end (default
+    n_steps*dt) with
     first step dt, locating flag switches to within event_tol [s]. The record buffer first holds
     max_records samples (default: n_steps/record_every+2, exact for fixed-step methods; for
     adaptive ones at most 4096 to start with). When a loop fills the event or the record buffer
@@ -300,7 +301,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         n_rec_cap = 4096        # adaptive: the number of steps is unknown; grown on demand
     memset(&s, 0, sizeof(pdw_sim))
     s.kernel = _kernel(k)
-    s.t_end = n_steps * dt
+    s.t_end = t_end if t_end > 0 else n_steps * dt   # adaptive methods end exactly at t_end
     s.rtol = rtol
     s.atol = atol
     s.h_max = h_max if h_max > 0 else s.t_end

@@ -46,3 +46,28 @@ class SingularSystemError(SimulationError):
 
 class FellError(SimulationError):
     """The walker fell (raised only when a caller asked for a fall to be an error)."""
+
+
+class StepSizeError(InvalidInputError):
+    """A fixed step size above the method's estimated stability limit for the parameters
+    (`pdw.simulate(..., check_step="error")`, `pdw.stability.step_limit`).
+
+    Attributes: ``dt`` (the step asked for), ``limit`` (the estimated limit [s]) and ``force``
+    (the force element that sets it)."""
+
+    def __init__(self, message, dt=float("nan"), limit=float("nan"), force=""):
+        super().__init__(message)
+        self.dt = float(dt)
+        self.limit = float(limit)
+        self.force = force
+
+
+class StepSizeWarning(UserWarning):
+    """A fixed step size above the method's estimated stability limit (`pdw.simulate` with the
+    default ``check_step="warn"``); same attributes as `StepSizeError`."""
+
+    def __init__(self, message, dt=float("nan"), limit=float("nan"), force=""):
+        super().__init__(message)
+        self.dt = float(dt)
+        self.limit = float(limit)
+        self.force = force

@@ -148,21 +148,19 @@ def step_map(state, params=None, **options) -> np.ndarray:
     Raises `FellError`, `SingularSystemError` or `SimulationError` when the step fails.
     """
     res = step(state, params, **options)
-    _raise_for(res)
+    _raise_for(res, params)
     return res["y_plus"]
 
 
-def _raise_for(res):
+def _raise_for(res, params=None):
+    """Raise the error of a failed step, carrying the step's start as a full-model state (8,)."""
     st = res["status"]
     if st == "ok":
         return
     msg = "hybrid step failed: %s after %.4g s (state at start %r)" % (st, res["t_strike"],
                                                                          res["y0"])
-    if st == "fell":
-        raise FellError(msg, t=res["t_strike"], reason=st)
-    if st == "singular":
-        raise SingularSystemError(msg, t=res["t_strike"], reason=st)
-    raise SimulationError(msg, t=res["t_strike"], reason=st)
+    cls = {"fell": FellError, "singular": SingularSystemError}.get(st, SimulationError)
+    raise cls(msg, t=res["t_strike"], x=full_state(res["y0"], params), reason=st)
 
 
 def _y_of(z):

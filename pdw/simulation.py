@@ -13,7 +13,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from . import _core, _layout
+from . import _core, _layout, stability as _stability
 from .errors import DivergedError, InvalidInputError, SingularSystemError
 from .gait import Steps, steps_from_rows
 from .model import STATE, check_variant, kernel_index, parameter_vector
@@ -160,14 +160,15 @@ _DEFAULTS = dict(t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
                  record_every=1, record_forces=True, on_failure="raise", fall_hip_height=None,
                  fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8, h_max=None, event_tol=1e-9,
                  features=None, record_events=True, record_energies=False, stop_steps=0,
-                 periodic_steps=0, periodic_tol=1e-3)
+                 periodic_steps=0, periodic_tol=1e-3, check_step="warn")
 
 
 def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
              flags0=(0, 1), record_every=1, record_forces=True, on_failure="raise",
              fall_hip_height=None, fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8,
              h_max=None, event_tol=1e-9, *, features=None, record_events=True,
-             record_energies=False, stop_steps=0, periodic_steps=0, periodic_tol=1e-3):
+             record_energies=False, stop_steps=0, periodic_steps=0, periodic_tol=1e-3,
+             check_step="warn"):
     """Simulate the walker from ``x0`` for ``t_end`` seconds (or run a `pdw.Scene`).
 
     ``simulate(scene)`` runs the scene (as `pdw.run`); no other argument may be given then.
@@ -229,6 +230,10 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
         With ``periodic_steps = k >= 2``: stop (status ``"periodic"``) as soon as the last k
         steps agree, each of L, travel, P and cycle within ``periodic_tol`` relative
         (max - min <= tol |latest|). 0: off.
+    check_step : {"warn", "error", "off"}
+        Fixed-step methods: compare dt with `pdw.stability.step_limit` (the method's estimated
+        stability limit for these parameters) and warn (`pdw.StepSizeWarning`) or refuse
+        (`pdw.StepSizeError`) above it, naming the limit and the force that sets it.
 
     Returns
     -------
@@ -286,12 +291,13 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     k = kernel_index(variant, feats)
     if feats != _layout.FEATURES:
         params = params.without(feats)
+    _stability.check_step(dt, params, method, variant, check_step)
     p = parameter_vector(params)
     start = time.perf_counter()
     raw = _core.run(k, METHODS.index(method), x, p, f0[0], f0[1], dt, n_steps, int(record_every),
                     bool(record_forces), hip, depth, max_speed, rtol, atol, h_max,
                     event_tol=event_tol, record_events=bool(record_events), stop_steps=stop_steps,
-                    periodic_k=periodic_steps, periodic_tol=periodic_tol)
+                    periodic_k=periodic_steps, periodic_tol=periodic_tol, t_end=t_end)
     wall = time.perf_counter() - start
     energies = None
     if record_energies:
