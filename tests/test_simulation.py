@@ -114,15 +114,16 @@ def test_event_buffer_grows_and_the_loop_resumes_exactly():
 
 
 def test_divergence_stops_with_time_state_and_reason():
-    """Explicit normal damping d_n = 1e7 at dt = 1e-3 is unstable (the state runs away)."""
+    """Explicit normal damping d_n = 1e7 at dt = 1e-3 is unstable (the state runs away); the
+    step-size check warns before the run, naming the normal damping."""
     p = pdw.Params(d_n=1e7)
-    with pytest.raises(pdw.DivergedError) as ei:
+    with pytest.raises(pdw.DivergedError) as ei, pytest.warns(pdw.StepSizeWarning, match="d_n"):
         pdw.simulate(dt=1e-3, t_end=3.5, params=p)
     err = ei.value
     assert 0 <= err.t < 3.5 and err.x.shape == (8,) and np.isfinite(err.x).all()
     assert "diverged at t =" in str(err) and err.reason
     assert err.result is not None and err.result.status == "diverged"
-    r = pdw.simulate(dt=1e-3, t_end=3.5, params=p, on_failure="return")
+    r = pdw.simulate(dt=1e-3, t_end=3.5, params=p, on_failure="return", check_step="off")
     assert r.status == "diverged" and r.failure["t"] == err.t
     assert np.isfinite(r.x).all()
 
