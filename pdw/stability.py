@@ -638,13 +638,7 @@ def largest_step(params: Params, method: str, ref, variant: str = "paper", start
             if i == 0:
                 return None, grid[0]
             a, b = grid[i - 1], grid[i]
-        for _ in range(refine):
-            m = math.sqrt(a * b)
-            if ok(m):
-                a = m
-            else:
-                b = m
-        return a, b
+        return _bisect_log(ok, a, b, refine)
 
     walk = edge("walks")
     correct = edge("correct")
@@ -751,6 +745,11 @@ def chatter_onset(params: Params, method: str, variant: str = "paper", key: str 
             if ok(a):
                 break
             b = a
+    return _bisect_log(ok, a, b, refine)
+
+
+def _bisect_log(ok, a, b, refine):
+    """Narrow a bracket ok(a), not ok(b) by ``refine`` bisections in log(dt)."""
     for _ in range(refine):
         m = math.sqrt(a * b)
         if ok(m):
