@@ -4,6 +4,7 @@ Public API
 ----------
 Params                  model parameters and presets (MODEL.md section 1)
 rhs, jacobian           f(x) of Eq. A.4 and its Jacobian, compiled from the symbolic derivation
+ode_function            f(t, x) and jac(t, x) for external solvers (solve_ivp), validated once
 mass_matrix             M(q) of Eq. 2
 contact_forces          contact kinematics and forces of both feet (Eqs. 3-11)
 energies                kinetic and potential energies
@@ -27,6 +28,7 @@ from .gait import Steps, steps
 from .params import Params
 from . import hybrid
 from .gait_types import Gait
+from .ode import OdeFunction, ode_function
 from .simulation import METHODS, X0_DISTURBED, X0_PAPER, Event, Result, simulate
 from . import scene
 from .scene import Scene, run
@@ -41,5 +43,5 @@ __all__ = [
     "X0_DISTURBED", "steps", "Steps", "PdwError", "SimulationError", "DivergedError",
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait", "Scene", "run",
     "limit_cycle", "cell_mapping", "find_gait", "sweep",
-    "StepSizeWarning", "StepSizeError",
+    "StepSizeWarning", "StepSizeError", "ode_function", "OdeFunction",
 ]

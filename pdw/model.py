@@ -6,6 +6,7 @@ metres, radians, and their rates), and returns arrays of matching leading shape.
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -113,8 +114,28 @@ def rhs(x, params=None, flags=(0, 1), anchors=(0.0, 0.0), variant="paper", featu
     -------
     ndarray, shape (8,) or (N, 8)
     """
+    if (features is None and type(x) is np.ndarray and x.shape == (_core.NX,)
+            and x.dtype == np.float64):
+        try:
+            fn = _rhs_function(params, variant, flags, anchors)
+        except TypeError:       # unhashable arguments (a list of flags): the general path
+            fn = None
+        if fn is not None and np.isfinite(x).all():
+            return fn(0.0, np.ascontiguousarray(x))
     X, single, *_, xdot, _ = _evaluate(x, params, flags, anchors, variant, features)
     return xdot[0] if single else xdot
+
+
+@functools.lru_cache(maxsize=64)
+def _rhs_function(params, variant, flags, anchors):
+    """`rhs`'s fast path for one state: a validated `_core.OdeFunction` per (hashable)
+    argument set, built once (the checks of the general path run the first time)."""
+    if params is not None and not isinstance(params, Params):
+        return None
+    check_variant(variant)
+    f, a = _discrete(flags, anchors, 1)
+    return _core.OdeFunction(kernel_index(variant), parameter_vector(params),
+                             int(f[0, 0]), int(f[0, 1]), float(a[0, 0]), float(a[0, 1]))
 
 
 def jacobian(x, params=None, flags=(0, 1), anchors=(0.0, 0.0), variant="paper", features=None):

@@ -1,0 +1,106 @@
+"""The model as an ODE object for external solvers (`scipy.integrate.solve_ivp`, optimizers,
+control loops): what PyDy's ``generate_ode_function`` gives its users.
+
+`ode_function` validates its inputs once and returns an `OdeFunction` (compiled,
+`pdw._core`): ``f(t, x)`` is f(x) of Eq. A.4 (MODEL.md section 3) with the support flags and
+the tangential anchors held fixed, ``f.jac(t, x)`` its symbolic Jacobian, ``f.batch(X)`` the
+rows of an (N, 8) array in one compiled loop. The discrete state of MODEL.md sections 5-6
+(flags, arming, anchors) is *not* updated: integrate a stretch without flag changes, or use
+`pdw.simulate`, which does.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import _core, _layout
+from .errors import InvalidInputError
+from .model import check_variant, kernel_index, parameter_vector
+from .params import Params
+
+OdeFunction = _core.OdeFunction
+
+
+def _check_discrete(flags, anchors):
+    try:
+        f = tuple(flags)
+        a = tuple(float(v) for v in anchors)
+    except (TypeError, ValueError):
+        raise InvalidInputError("flags must be two values in {0, 1} and anchors two finite "
+                                "numbers [m], got %r, %r" % (flags, anchors)) from None
+    if len(f) != 2 or any(isinstance(v, bool) or v not in (0, 1) for v in f):
+        raise InvalidInputError("flags must be two values in {0, 1} (1 support, 0 swing), "
+                                "got %r" % (flags,))
+    if len(a) != 2 or not all(math.isfinite(v) for v in a):
+        raise InvalidInputError("anchors must be two finite numbers [m], got %r" % (anchors,))
+    return (int(f[0]), int(f[1])), a
+
+
+def _check_features(features):
+    if features is None:
+        return _layout.FEATURES
+    if isinstance(features, str):
+        raise InvalidInputError("features must be a collection of names, got the string %r"
+                                % features)
+    unknown = set(features) - set(_layout.FEATURES)
+    if unknown:
+        raise InvalidInputError("unknown feature(s) %s; allowed: %s"
+                                % (", ".join(sorted(map(str, unknown))),
+                                   ", ".join(_layout.FEATURES)))
+    return tuple(f for f in _layout.FEATURES if f in set(features))
+
+
+def ode_function(params: Params | None = None, variant: str = "paper",
+                 flags=(0, 1), anchors=(0.0, 0.0), features=None) -> OdeFunction:
+    """The right-hand side f(t, x) of Eq. A.4 as a fast callable for external solvers.
+
+    Parameters
+    ----------
+    params : Params, optional
+        Default `Params.paper()`.
+    variant : {"paper", "consistent"}
+        Contact reading of MODEL.md section 6.
+    flags : (int, int)
+        Support flags of legs 1 and 2 (1 support, 0 swing; MODEL.md section 5), held fixed.
+    anchors : (float, float)
+        Rolling coordinate s_i at the last touch-down of each foot [m] (only the
+        ``consistent`` variant uses them), held fixed.
+    features : iterable of str, optional
+        Force elements present (`pdw._layout.FEATURES`; default all), as in `pdw.simulate`.
+
+    Returns
+    -------
+    OdeFunction
+        ``f(t, x)`` -> ndarray (8,) for a float64 state x of shape (8,) [m, rad, m/s, rad/s]
+        (t is ignored: the model is autonomous); ``f.jac(t, x)`` -> (8, 8);
+        ``f.batch(X, out=None)`` -> (N, 8) for X of shape (N, 8); ``f.set_discrete(f1, f2,
+        a1, a2)`` changes the flags and anchors (unchecked: use `ode_function` to validate).
+
+    Notes
+    -----
+    Inputs are validated here, once; a call does no checking beyond the shape of x (a
+    non-finite state gives a non-finite derivative). ``solve_ivp(f, (0, T), x0,
+    method="Radau", jac=f.jac)`` integrates one stretch of constant support flags; see
+    docs/benchmarks.md for the cost per call (benchmarks/bench_io.py).
+
+    Examples
+    --------
+    >>> import numpy as np, pdw
+    >>> f = pdw.ode_function()
+    >>> f(0.0, np.array(pdw.X0_PAPER)).shape
+    (8,)
+    """
+    params = Params.paper() if params is None else params
+    if not isinstance(params, Params):
+        raise InvalidInputError("params must be a pdw.Params, got %s" % type(params).__name__)
+    try:
+        check_variant(variant)
+    except ValueError as e:
+        raise InvalidInputError(str(e)) from None
+    feats = _check_features(features)
+    (f1, f2), (a1, a2) = _check_discrete(flags, anchors)
+    k = kernel_index(variant, feats)
+    p = parameter_vector(params if feats == _layout.FEATURES else params.without(feats))
+    return OdeFunction(k, p, f1, f2, a1, a2)
+
