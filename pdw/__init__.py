@@ -2,21 +2,21 @@
 
 Public API
 ----------
-Params                  model parameters and presets (MODEL.md section 1)
+Params                  model parameters and presets (docs/model.md section 1)
 rhs, jacobian           f(x) of Eq. A.4 and its Jacobian, compiled from the symbolic derivation
 mass_matrix             M(q) of Eq. 2
 contact_forces          contact kinematics and forces of both feet (Eqs. 3-11)
 energies                kinetic and potential energies
 simulate, Result        one compiled simulation (support flags, events, status)
 Scene, run              everything a simulation needs, as one object or TOML file (docs/scenes.md)
-steps                   per-step gait descriptors (MODEL.md section 8)
-hybrid                  the rigid-ground impact-momentum model (MODEL.md section 9): find_gait, ...
+steps                   per-step gait descriptors (docs/model.md section 8)
+hybrid                  the rigid-ground impact-momentum model (docs/model.md section 9): find_gait, ...
 find_gait               period-one gait of the continuous model: Newton shooting on the touch-down
                         Poincare map, Floquet multipliers (pdw.limit_cycle; cell mapping:
                         pdw.cell_mapping)
 sweep                   parameter studies from TOML files: run_study, load_study (``pdw sweep``)
 PdwError, SimulationError, DivergedError, InvalidInputError   the error hierarchy
-STATE, VARIANTS         the state layout and the contact variants (MODEL.md section 6)
+STATE, VARIANTS         the state layout and the contact variants (docs/model.md section 6)
 """
 from ._layout import INPUT_HASH
 from .model import (STATE, VARIANTS, ContactState, contact_forces, energies, jacobian,

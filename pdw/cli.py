@@ -147,7 +147,7 @@ def main(argv=None):
     w.add_argument("--scene", help="TOML file with any of: %s" % ", ".join(WALK_KEYS))
     w.add_argument("--t-end", dest="t_end", type=float, help="duration [s] (default 3.5)")
     w.add_argument("--dt", type=float, help="time step [s] (default 1e-4)")
-    w.add_argument("--variant", choices=("paper", "consistent"), help="contact variant (MODEL.md section 6)")
+    w.add_argument("--variant", choices=("paper", "consistent"), help="contact variant (docs/model.md section 6)")
     w.add_argument("--preset", choices=("paper", "paper_steady"), help="parameter preset")
     w.add_argument("--method", choices=METHODS, help="integrator (default cdm, the paper's)")
     w.add_argument("--record-every", dest="record_every", type=int, help="record every k-th step")

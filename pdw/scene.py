@@ -14,7 +14,7 @@ TOML layout (every key optional; defaults are `Scene()`'s)::
 
     name = "typical gait"
     preset = "paper_steady"          # Params preset: "paper" or "paper_steady"
-    variant = "paper"                # MODEL.md section 6: "paper" or "consistent"
+    variant = "paper"                # docs/model.md section 6: "paper" or "consistent"
     x0 = [0.0, 0.4969, -0.0582, 0.0582, 0.5092, 0.0186, 3.3338, -1.0093]
     flags0 = [0, 1]
 
@@ -264,7 +264,7 @@ class Integrator(_Section):
 
 @dataclass(frozen=True)
 class Forces(_Section):
-    """Which force elements are present (MODEL.md sections 3-4). Absent ones are switched off
+    """Which force elements are present (docs/model.md sections 3-4). Absent ones are switched off
     in a specialized kernel, or by zeroing their parameters (`Params.without`)."""
 
     SECTION = "forces"
@@ -359,7 +359,7 @@ class Scene(_Section):
     name: str = _f("", "str", "a label")
     preset: str = _f("paper", "str", "parameter preset (pdw.Params.preset)", _one_of(PRESETS))
     params: dict = _f({}, "params", "overrides of the preset's parameters")
-    variant: str = _f("paper", "str", "contact variant (MODEL.md section 6)",
+    variant: str = _f("paper", "str", "contact variant (docs/model.md section 6)",
                       _one_of(_layout.VARIANTS))
     x0: tuple = _f(X0_PAPER, "state", "initial state [x_o, y_o, theta1, theta2, rates]")
     flags0: tuple = _f((0, 1), "flags", "initial support flags of legs 1, 2")

@@ -117,7 +117,7 @@ def test_stop_when_periodic_stops_as_soon_as_the_last_k_steps_agree(k, tol, full
 
 
 def test_a_gait_that_does_not_converge_is_not_stopped():
-    """The paper's d_hip = 0.018 gait decays and falls (MODEL.md section 8): no periodic stop."""
+    """The paper's d_hip = 0.018 gait decays and falls (docs/model.md section 8): no periodic stop."""
     r = pdw.simulate(t_end=8.0, record_every=0, periodic_steps=4, periodic_tol=1e-4)
     assert r.status == "fell" and r.stop_reason == "fell"
 
