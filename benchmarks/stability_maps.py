@@ -25,9 +25,8 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 import pdw  # noqa: E402
 from pdw import stability as S  # noqa: E402
 
-from _results import RESULTS, publish  # noqa: E402
+from _results import FIGURES, RESULTS, publish  # noqa: E402
 
-FIGURES = ROOT / "docs" / "figures"
 FIXED = S.FIXED_STEP
 #: swept parameters: values (the paper's range is marked) -- a decade beyond each end
 SWEEPS = {
@@ -460,7 +459,7 @@ def main(argv=None):
     if "energy" in a.only:
         data["energy"] = energy_table()
     data["calibration"] = calibration(data.get("cells", []))
-    RESULTS.mkdir(exist_ok=True)
+    RESULTS.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(data, indent=1, default=float))
     lines = report(data.get("cells", []), data.get("chatter", []), data.get("claims", {}),
                    data.get("energy", []))

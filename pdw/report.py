@@ -70,7 +70,9 @@ def walk_report(result, last=4) -> str:
     if len(st):
         sd = st.steady(last)
         lines.append("Last %d steps (mean, largest change between successive steps) vs the paper:"
-                     % sd["last"])
+                     % sd["last"] if result.walked else
+                     "Last %d steps before the run %s (mean, largest change; not a steady gait):"
+                     % (sd["last"], result.status))
         lines.append("%-22s %10s %10s %10s" % ("", "pdw", "change", "paper"))
         for name, label, scale in (("L", "step length L [m]", 1), ("travel", "swing travel [m]", 1),
                                    ("P", "step period P [s]", 1), ("v", "velocity v [m/s]", 1),

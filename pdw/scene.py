@@ -58,10 +58,9 @@ from __future__ import annotations
 import dataclasses
 import math
 import pathlib
-import tomllib
 from dataclasses import dataclass, field
 
-from . import _layout
+from . import _layout, _toml
 from .errors import InvalidInputError
 from .params import Params
 
@@ -423,8 +422,8 @@ class Scene(_Section):
         """Read a scene from TOML text. Unknown keys, wrong types and invalid values are
         `pdw.InvalidInputError` naming the key."""
         try:
-            data = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as e:
+            data = _toml.loads(text)
+        except _toml.TOMLDecodeError as e:
             raise InvalidInputError("%s: not valid TOML: %s" % (source, e)) from None
         try:
             return cls.from_dict(data)
@@ -443,50 +442,13 @@ class Scene(_Section):
 
     def to_toml(self) -> str:
         """TOML text of the scene; `Scene.from_toml` reads it back to an equal scene."""
-        d = self.to_dict()
-        lines = ["# pdw scene (docs/scenes.md); run it with `pdw run FILE`"]
-        for key in ("name", "preset", "variant", "x0", "flags0"):
-            lines.append("%s = %s" % (key, _toml_value(d[key])))
-        for section in ("params",) + tuple(SECTION_TYPES):
-            table = d[section]
-            if section == "params" and not table:
-                continue
-            lines += ["", "[%s]" % section]
-            lines += ["%s = %s" % (k, _toml_value(v)) for k, v in table.items()]
-        return "\n".join(lines) + "\n"
+        return _toml.dumps(self.to_dict(), "pdw scene (docs/scenes.md); run it with `pdw run FILE`")
 
     def save(self, path) -> pathlib.Path:
         """Write the scene as a TOML file."""
         path = pathlib.Path(path)
         path.write_text(self.to_toml())
         return path
-
-
-def _toml_value(v) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        return repr(v)          # 0.0001, 1e-08, inf, nan: all TOML floats
-    if isinstance(v, str):
-        return _toml_string(v)
-    if isinstance(v, (list, tuple)):
-        return "[%s]" % ", ".join(_toml_value(x) for x in v)
-    raise TypeError("no TOML form for %r" % (v,))
-
-
-def _toml_string(s: str) -> str:
-    out = ['"']
-    for ch in s:
-        if ch in '"\\':
-            out.append("\\" + ch)
-        elif ord(ch) < 0x20 or ord(ch) == 0x7F:
-            out.append("\\u%04X" % ord(ch))
-        else:
-            out.append(ch)
-    out.append('"')
-    return "".join(out)
 
 
 def run(scene):

@@ -1,11 +1,12 @@
 """Parameter studies at scale: ``pdw sweep study.toml`` (docs/studies.md).
 
-A *study* (a TOML file, `load_study`) sweeps one or two `Params` fields over ranges, the others
-fixed (a preset plus overrides), with one contact variant and one integrator. Every point gets
-a steady gait, either
+A *study* (a TOML file, `load_study`) sweeps one or two `Params` fields over ranges; everything
+else is one `pdw.Scene`, the study's ``[scene]`` table (the same schema as ``pdw run`` and
+``pdw walk --scene``: preset, parameter overrides, variant, x0, flags0, integrator, stop), on
+top of the study defaults `SCENE_DEFAULTS`. Every point gets a steady gait, either
 
-* ``mode = "simulate"`` (default): one simulation of ``t_end`` seconds from ``x0`` (default the
-  paper's initial condition), the steady descriptors being the mean of the last ``steady`` steps
+* ``mode = "simulate"`` (default): one run of the scene (``stop.t_end`` seconds from ``x0``,
+  default the paper's initial condition), the steady descriptors being the mean of the last ``steady`` steps
   (`pdw.steps(...).steady`), classified period-1 / period-2 / none from the step-to-step
   spread; or
 * ``mode = "newton"``: `pdw.find_gait` (Newton shooting on the touch-down map) with its
@@ -29,6 +30,7 @@ from its CSV: rerunning skips the points already there and computes only the oth
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
 import csv
 import dataclasses
 import datetime
@@ -43,25 +45,31 @@ import platform
 import subprocess
 import sys
 import time
-import tomllib
 
 import numpy as np
 
-from . import _layout
+from . import _layout, _toml
 from .errors import InvalidInputError, PdwError
 from .params import Params
-from .simulation import METHODS, X0_PAPER
+from .scene import Scene
 
-STUDY_KEYS = {"name": str, "title": str, "preset": str, "variant": str, "method": str,
-              "params": dict, "axes": list, "run": dict, "paper": dict, "description": str}
+STUDY_KEYS = {"name": str, "title": str, "description": str, "scene": dict, "axes": list,
+              "run": dict, "paper": dict}
 AXIS_KEYS = {"name": str, "values": list, "start": (int, float), "stop": (int, float),
              "num": int, "log": bool}
-RUN_KEYS = {"mode": str, "t_end": (int, float), "dt": (int, float), "steady": int,
-            "rtol": (int, float), "atol": (int, float), "x0": list, "flags0": list,
-            "period_tol": (int, float), "fallback": bool}
-RUN_DEFAULTS = {"mode": "simulate", "t_end": 16.0, "dt": 1e-4, "steady": 4, "rtol": 1e-7,
-                "atol": 1e-9, "x0": list(X0_PAPER), "flags0": [0, 1], "period_tol": 1e-4,
-                "fallback": True}
+RUN_KEYS = {"mode": str, "steady": int, "period_tol": (int, float), "fallback": bool}
+RUN_DEFAULTS = {"mode": "simulate", "steady": 4, "period_tol": 1e-4, "fallback": True}
+#: The scene of a study before its ``[scene]`` table: the steady preset, rodas4 at tight
+#: tolerances, 16 s, events and descriptors only, a diverged point returned as a row.
+SCENE_DEFAULTS = {"preset": "paper_steady",
+                  "integrator": {"method": "rodas4", "rtol": 1e-7, "atol": 1e-9},
+                  "record": {"every": 0, "forces": False, "energies": False, "events": True},
+                  "stop": {"t_end": 16.0, "on_failure": "return"}}
+#: Keys of the earlier study format and where they live now.
+MOVED = {"preset": "scene.preset", "variant": "scene.variant", "method": "scene.integrator.method",
+         "params": "scene.params", "run.t_end": "scene.stop.t_end", "run.dt": "scene.integrator.dt",
+         "run.rtol": "scene.integrator.rtol", "run.atol": "scene.integrator.atol",
+         "run.x0": "scene.x0", "run.flags0": "scene.flags0"}
 #: Result columns of a point (after the index and the axis values).
 COLUMNS = ("status", "gait", "source", "L", "P", "v", "cycle", "double_support", "ds_fraction", "travel",
            "spread_L", "spread_cycle", "n_steps", "max_multiplier", "t_final", "wall_s", "error")
@@ -75,22 +83,36 @@ class Study:
 
     name: str
     title: str
-    preset: str
-    variant: str
-    method: str
-    params: dict
+    scene: Scene               # everything but the swept parameters
     axes: list                 # [(name, values ndarray), ...] (1 or 2)
-    run: dict
+    run: dict                  # mode, steady, period_tol, fallback
     paper: dict
     source: str = ""           # the TOML text
     path: str = ""
+
+    @property
+    def preset(self) -> str:
+        return self.scene.preset
+
+    @property
+    def variant(self) -> str:
+        return self.scene.variant
+
+    @property
+    def method(self) -> str:
+        return self.scene.integrator.method
+
+    @property
+    def params(self) -> dict:
+        """The scene's overrides of its preset (fixed for every point)."""
+        return dict(self.scene.params)
 
     @property
     def axis_names(self):
         return [a for a, _ in self.axes]
 
     def base_params(self) -> Params:
-        return Params.preset(self.preset, **self.params)
+        return self.scene.parameters()
 
     def points(self):
         """List of (index, {axis: value}) in a fixed order (first axis fastest)."""
@@ -102,11 +124,12 @@ class Study:
         return out
 
     def task(self, index, values) -> dict:
-        """The worker's input for one point (plain data: picklable, small)."""
+        """The worker's input for one point (plain data: picklable, small): the scene as a
+        dict and the point's full parameter set."""
         p = self.base_params().as_dict()
         p.update(values)
-        return {"index": index, "values": dict(values), "params": p, "variant": self.variant,
-                "method": self.method, "run": dict(self.run)}
+        return {"index": index, "values": dict(values), "params": p,
+                "scene": self.scene.to_dict(), "run": dict(self.run)}
 
     def digest(self) -> str:
         return hashlib.sha256(self.source.encode()).hexdigest()
@@ -120,34 +143,40 @@ def _typecheck(where, key, value, typ):
         raise InvalidInputError("%s: key %r must be of type %s, got %r" % (where, key, names, value))
 
 
+def _moved(where, key):
+    raise InvalidInputError("%s: key %r is now %r: a study's walker, start, integrator and "
+                            "duration are its [scene] table, a pdw.Scene (docs/studies.md)"
+                            % (where, key, MOVED[key]))
+
+
+def study_scene(table: dict | None = None) -> Scene:
+    """The scene of a study: `SCENE_DEFAULTS` updated by the study's ``[scene]`` table (a
+    `pdw.Scene` in TOML form; a table given there updates that table of the defaults)."""
+    base = Scene.from_dict({k: dict(v) if isinstance(v, dict) else v
+                            for k, v in SCENE_DEFAULTS.items()})
+    return base.replace(**(table or {}))
+
+
 def parse_study(text, name="study", path="") -> Study:
     """Parse and validate a study from TOML text. Errors name the offending key."""
     where = path or name
     try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
+        data = _toml.loads(text)
+    except _toml.TOMLDecodeError as e:
         raise InvalidInputError("%s: not valid TOML: %s" % (where, e)) from None
     for k, v in data.items():
+        if k in MOVED:
+            _moved(where, k)
         if k not in STUDY_KEYS:
             raise InvalidInputError("%s: unknown key %r; allowed: %s"
                                     % (where, k, ", ".join(STUDY_KEYS)))
         _typecheck(where, k, v, STUDY_KEYS[k])
-    preset = data.get("preset", "paper_steady")
-    variant = data.get("variant", "paper")
-    method = data.get("method", "rodas4")
-    if variant not in _layout.VARIANTS:
-        raise InvalidInputError("%s: variant must be one of %s, got %r"
-                                % (where, ", ".join(_layout.VARIANTS), variant))
-    if method not in METHODS:
-        raise InvalidInputError("%s: method must be one of %s, got %r"
-                                % (where, ", ".join(METHODS), method))
+    try:
+        scene = study_scene(data.get("scene"))
+    except InvalidInputError as e:
+        raise InvalidInputError("%s: [scene]: %s" % (where, e)) from None
     fields = set(_layout.PARAMS)
-    params = dict(data.get("params", {}))
-    for k, v in params.items():
-        if k not in fields:
-            raise InvalidInputError("%s: [params] has unknown field %r; allowed: %s"
-                                    % (where, k, ", ".join(_layout.PARAMS)))
-        _typecheck(where + " [params]", k, v, (int, float))
+    params = scene.params
     axes_in = data.get("axes", [])
     if not 1 <= len(axes_in) <= 2:
         raise InvalidInputError("%s: need one or two [[axes]], got %d" % (where, len(axes_in)))
@@ -190,6 +219,8 @@ def parse_study(text, name="study", path="") -> Study:
         axes.append((an, vals))
     run = dict(RUN_DEFAULTS)
     for k, v in data.get("run", {}).items():
+        if "run." + k in MOVED:
+            _moved(where + " [run]", "run." + k)
         if k not in RUN_KEYS:
             raise InvalidInputError("%s [run]: unknown key %r; allowed: %s"
                                     % (where, k, ", ".join(RUN_KEYS)))
@@ -198,13 +229,11 @@ def parse_study(text, name="study", path="") -> Study:
     if run["mode"] not in ("simulate", "newton"):
         raise InvalidInputError("%s [run]: mode must be 'simulate' or 'newton', got %r"
                                 % (where, run["mode"]))
-    if len(run["x0"]) != 8 or len(run["flags0"]) != 2:
-        raise InvalidInputError("%s [run]: x0 needs 8 numbers and flags0 two" % where)
-    if run["steady"] < 1 or run["t_end"] <= 0 or run["dt"] <= 0:
-        raise InvalidInputError("%s [run]: steady >= 1, t_end > 0, dt > 0 required" % where)
+    if run["steady"] < 1:
+        raise InvalidInputError("%s [run]: steady must be >= 1, got %r" % (where, run["steady"]))
     study = Study(name=data.get("name", name), title=data.get("title", data.get("name", name)),
-                  preset=preset, variant=variant, method=method, params=params, axes=axes,
-                  run=run, paper=dict(data.get("paper", {})), source=text, path=str(path))
+                  scene=scene, axes=axes, run=run, paper=dict(data.get("paper", {})),
+                  source=text, path=str(path))
     try:                                   # every point's parameters must be valid
         base = study.base_params()
         for _, values in study.points():
@@ -252,11 +281,9 @@ def run_point(task) -> dict:
     run = task["run"]
     try:
         params = Params(**task["params"])
+        scene = Scene.from_dict(task["scene"])
         if run["mode"] == "simulate":
-            res = simulate(run["x0"], t_end=run["t_end"], dt=run["dt"], params=params,
-                           variant=task["variant"], method=task["method"],
-                           flags0=tuple(run["flags0"]), record_every=0, record_forces=False,
-                           on_failure="return", rtol=run["rtol"], atol=run["atol"])
+            res = simulate(**{**scene.simulate_kwargs(), "params": params})
             st = steps(res)
             s = st.steady(run["steady"])
             row.update(status=res.status, n_steps=len(st), t_final=res.t_final, source="simulate",
@@ -267,19 +294,19 @@ def run_point(task) -> dict:
                                               "ds_fraction", "travel")},
                            spread_L=s["spread_L"], spread_cycle=s["spread_cycle"])
         if run["mode"] == "newton" or (run["fallback"] and row["gait"] != "period-1"):
-            _newton_point(row, params, task)
+            _newton_point(row, params, scene)
     except (PdwError, ValueError) as e:
         row.update(status="error", error=str(e)[:300])
     row["wall_s"] = time.perf_counter() - t0
     return row
 
 
-def _newton_point(row, params, task):
+def _newton_point(row, params, scene):
     """Fill ``row`` from `pdw.find_gait` (default guesses); keeps ``row`` if none is found."""
     from .gait_types import GaitNotFoundError
     from .limit_cycle import find_gait
     try:
-        g = find_gait(params, variant=task["variant"], method=task["method"], workers=1,
+        g = find_gait(params, variant=scene.variant, method=scene.integrator.method, workers=1,
                       max_iter=12)
     except GaitNotFoundError as e:
         if row["status"] == "":
@@ -420,6 +447,7 @@ def provenance(study, **extra) -> dict:
     return {
         "study": {"name": study.name, "title": study.title, "path": study.path,
                   "sha256": study.digest(), "toml": study.source},
+        "scene": study.scene.to_dict(),
         "preset": study.preset, "variant": study.variant, "method": study.method,
         "base_params": study.base_params().as_dict(),
         "axes": {a: v.tolist() for a, v in study.axes},
@@ -649,13 +677,20 @@ def add_cli(subparsers):
     """Register ``pdw sweep`` on an argparse subparsers object."""
     s = subparsers.add_parser("sweep", help="run a parameter study described in a TOML file "
                                             "(CSV + JSON provenance + figure)")
-    s.add_argument("study", help="the study file (TOML; see docs/studies.md)")
+    s.add_argument("study", nargs="?", help="the study file (TOML; see docs/studies.md)")
+    s.add_argument("--example", help="run an example study shipped with pdw "
+                                     "(pdw run --list-examples lists them)")
     s.add_argument("--out", help="output folder (default out/studies/<name>)")
-    s.add_argument("--workers", type=int, help="pool size (default: all cores)")
-    s.add_argument("--backend", choices=("thread", "process", "serial"), default="thread",
-                   help="local pool kind (default thread)")
-    s.add_argument("--scheduler", help="address of a Dask scheduler (tcp://host:port): run the "
-                                       "points on that cluster (needs pdw[dask])")
+    s.add_argument("--workers", type=int, help="local pool size, or the number of workers of "
+                                               "--dask-local (default: all cores)")
+    s.add_argument("--backend", choices=("thread", "process", "serial"),
+                   help="local pool kind (default thread); not with a Dask option")
+    where = s.add_mutually_exclusive_group()
+    where.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:port): "
+                                           "run the points on that cluster (needs pdw[dask])")
+    where.add_argument("--dask-local", action="store_true",
+                       help="start a local Dask cluster (--workers processes, one thread each) "
+                            "for this sweep (needs pdw[dask])")
     s.add_argument("--fresh", action="store_true", help="ignore an existing CSV (start afresh)")
     s.add_argument("--no-figures", action="store_true", help="skip the figure")
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -663,23 +698,40 @@ def add_cli(subparsers):
     return s
 
 
-def cli_main(args):
-    study = load_study(args.study)
-    executor, client = None, None
-    if args.scheduler:
-        try:
-            from distributed import Client
-        except ImportError:
-            raise PdwError("--scheduler needs Dask: pip install 'pdw[dask]'") from None
-        client = Client(args.scheduler)
-        executor = client.get_executor()
+def _dask():
     try:
+        import distributed
+    except ImportError as e:
+        raise PdwError("Dask is not installed: pip install 'pdw[dask]'") from e
+    return distributed
+
+
+def cli_main(args):
+    if (args.study is None) == (args.example is None):
+        raise PdwError("give a study file or --example NAME (one of them)")
+    if args.backend is not None and (args.scheduler or args.dask_local):
+        raise PdwError("--backend chooses a local pool; it cannot be combined with "
+                       "--scheduler or --dask-local")
+    if args.workers is not None and args.scheduler:
+        raise PdwError("--workers sizes a local pool or --dask-local; a --scheduler cluster "
+                       "has its own workers")
+    from . import examples
+    study = load_study(examples.study_path(args.example) if args.example else args.study)
+    executor = None
+    with contextlib.ExitStack() as stack:
+        if args.scheduler or args.dask_local:
+            distributed = _dask()
+            if args.dask_local:
+                cluster = stack.enter_context(distributed.LocalCluster(
+                    n_workers=args.workers or os.cpu_count() or 1, threads_per_worker=1,
+                    dashboard_address=None))
+                client = stack.enter_context(distributed.Client(cluster))
+            else:
+                client = stack.enter_context(distributed.Client(args.scheduler))
+            executor = client.get_executor()
         res = run_study(study, args.out, executor=executor, workers=args.workers,
-                        backend=args.backend, resume=not args.fresh,
+                        backend=args.backend or "thread", resume=not args.fresh,
                         progress=not args.no_progress, figures=not args.no_figures)
-    finally:
-        if client is not None:
-            client.close()
     counts = {}
     for r in res.rows:
         counts[r["status"]] = counts.get(r["status"], 0) + 1
@@ -688,4 +740,7 @@ def cli_main(args):
              ", ".join("%s %d" % kv for kv in sorted(counts.items()))))
     for k, p in res.paths.items():
         print("wrote %s" % p)
+    if not args.no_figures and "png" not in res.paths:
+        print("pdw: no figure: matplotlib is not installed: pip install 'pdw[plot]'",
+              file=sys.stderr)
     return 0

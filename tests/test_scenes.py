@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import pdw
+import pdw.examples
 from pdw import _layout, cli
 from pdw.gait import FIELDS
 from pdw.scene import Forces, Integrator, Record, Scene, Stop
@@ -323,7 +324,7 @@ def test_invalid_toml_is_reported(tmp_path):
 # ------------------------------------------------------------------ the shipped example, CLI
 
 def test_shipped_example_runs_with_pdw_run(tmp_path, capsys):
-    example = ROOT / "docs" / "examples" / "typical_gait.toml"
+    example = pdw.examples.scene_path("typical_gait")
     sc = Scene.load(example)
     assert sc == Scene.from_toml(sc.to_toml())
     rc = cli.main(["run", str(example), "--out", str(tmp_path)])
@@ -339,7 +340,8 @@ def test_shipped_example_runs_with_pdw_run(tmp_path, capsys):
 def test_pdw_run_reports_a_fall_with_code_3(tmp_path, capsys):
     path = Scene(stop={"t_end": 8.0}, record=Record.events_only()).save(tmp_path / "f.toml")
     assert cli.main(["run", str(path)]) == 3
-    assert "fell" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "fell" in out and "no steady values: the run fell" in out and "steady (mean" not in out
 
 
 def test_pdw_walk_still_works(tmp_path, capsys):
