@@ -15,6 +15,7 @@ find_gait               period-one gait of the continuous model: Newton shooting
                         Poincare map, Floquet multipliers (pdw.limit_cycle; cell mapping:
                         pdw.cell_mapping)
 sweep                   parameter studies from TOML files: run_study, load_study (``pdw sweep``)
+examples                the example scenes and studies shipped with pdw (``pdw run --list-examples``)
 PdwError, SimulationError, DivergedError, InvalidInputError   the error hierarchy
 STATE, VARIANTS         the state layout and the contact variants (docs/model.md section 6)
 """
@@ -31,6 +32,7 @@ from .simulation import METHODS, X0_DISTURBED, X0_PAPER, Event, Result, simulate
 from . import scene
 from .scene import Scene, run
 from . import limit_cycle, cell_mapping, sweep
+from . import examples
 from .limit_cycle import find_gait
 
 __version__ = "0.1.0"
@@ -41,5 +43,5 @@ __all__ = [
     "X0_DISTURBED", "steps", "Steps", "PdwError", "SimulationError", "DivergedError",
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait", "Scene", "run",
     "limit_cycle", "cell_mapping", "find_gait", "sweep",
-    "StepSizeWarning", "StepSizeError",
+    "StepSizeWarning", "StepSizeError", "examples",
 ]
