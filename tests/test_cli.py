@@ -161,7 +161,7 @@ def test_closed_pipe_ends_quietly(tmp_path):
     env = dict(os.environ, PYTHONUNBUFFERED="0")
     p = subprocess.Popen([sys.executable, "-m", "pdw", "walk", "--t-end", "0.5", "--no-figures",
                           "--out", str(tmp_path)], stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, env=env)
+                         stderr=subprocess.PIPE, env=env, cwd=tmp_path)
     p.stdout.close()                     # the reader is gone before anything was written
     err = p.stderr.read().decode()
     rc = p.wait()

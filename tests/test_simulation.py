@@ -3,7 +3,6 @@ import math
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
 
 import pdw
 from pdw import _core
@@ -14,6 +13,7 @@ FLIGHT_X0 = np.array([0.0, 10.0, -0.2, 0.3, 0.5, 0.0, 2.0, -1.0])  # feet ~9.5 m
 
 
 def _reference_flight(params, t_end):
+    solve_ivp = pytest.importorskip("scipy.integrate").solve_ivp     # the test extra
     sol = solve_ivp(lambda t, x: pdw.rhs(x, params, flags=(0, 0)), (0, t_end), FLIGHT_X0,
                     method="DOP853", rtol=1e-13, atol=1e-13)
     return sol.y[:, -1]
