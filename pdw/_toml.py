@@ -20,8 +20,8 @@ loads = tomllib.loads
 
 
 def dumps(data: dict, header: str = "") -> str:
-    """TOML text of ``data`` (tables nested as dicts; None values and empty tables left out, TOML has no null),
-    after the comment lines of ``header``."""
+    """TOML text of ``data`` (tables nested as dicts; None values and empty tables left out:
+    TOML has no null), after the comment lines of ``header``."""
     def clean(d):
         return {k: clean(v) if isinstance(v, dict) else (list(v) if isinstance(v, tuple) else v)
                 for k, v in d.items() if v is not None and v != {}}

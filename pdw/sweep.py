@@ -6,7 +6,8 @@ else is one `pdw.Scene`, the study's ``[scene]`` table (the same schema as ``pdw
 top of the study defaults `SCENE_DEFAULTS`. Every point gets a steady gait, either
 
 * ``mode = "simulate"`` (default): one run of the scene (``stop.t_end`` seconds from ``x0``,
-  default the paper's initial condition), the steady descriptors being the mean of the last ``steady`` steps
+  default the paper's initial condition), the steady descriptors being the mean of the last
+  ``steady`` steps
   (`pdw.steps(...).steady`), classified period-1 / period-2 / none from the step-to-step
   spread; or
 * ``mode = "newton"``: `pdw.find_gait` (Newton shooting on the touch-down map) with its

@@ -161,8 +161,8 @@ def test_page_code_blocks_run(page, tmp_path, monkeypatch):
         if kind is None:
             continue
         if b["skip"] is not None:
-            assert b["skip"], "%s: a skipped block must say why: <!-- docs-test: skip (reason) -->" \
-                % where
+            assert b["skip"], \
+                "%s: a skipped block must say why: <!-- docs-test: skip (reason) -->" % where
             continue
         if kind == "python":
             run_python(b["code"], ns, where)
