@@ -6,11 +6,11 @@ PIP    := $(PY) -m pip
 OUT    ?= out/typical_gait
 BUILT  := $(VENV)/.pdw-built
 STAMP  := $(VENV)/.pdw-installed
-SOURCES := $(wildcard generated/*.c generated/*.h pdw/*.pyx pdw/csrc/*.c pdw/csrc/*.h pdw/*/*.pyx pdw/*/csrc/*.c pdw/*/csrc/*.h) setup.py pyproject.toml
+SOURCES := $(wildcard generated/*.c generated/*.h pdw/core/*.pyx pdw/core/csrc/*.c pdw/core/csrc/*.h) setup.py pyproject.toml
 # an extra's requirements, read from pyproject.toml (installed without rebuilding pdw)
 EXTRA_REQS = $(PY) -c "import sys, tomllib; print('\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies'][sys.argv[1]]))"
 
-.PHONY: all run test test-all derive check-generated bench study clean distclean
+.PHONY: all run test lint test-all derive check-generated bench study clean distclean
 
 all: $(STAMP)
 
@@ -21,7 +21,7 @@ $(VENV)/bin/python:
 # plot extra (the figures of `make run`).
 $(BUILT): $(VENV)/bin/python $(SOURCES)
 	$(PIP) install --quiet --disable-pip-version-check "setuptools>=77" wheel "Cython>=3.0"
-	$(PIP) install --quiet --disable-pip-version-check --no-build-isolation -e ".[plot]"
+	PYTHONWARNINGS=ignore $(PIP) install --quiet --disable-pip-version-check --no-build-isolation -e ".[plot]"
 	@touch $(BUILT)
 
 # What testing needs on top: the test extra.
@@ -34,16 +34,22 @@ $(STAMP): $(BUILT)
 run: $(BUILT)
 	$(PY) -m pdw walk --out $(OUT)
 
-## test: build everything, check generated/ against derive/, run the test suite
+## test: build everything, check generated/ against derive/, lint, the layer contract, the tests
 test: $(STAMP)
 	$(PY) -m derive --check
+	$(MAKE) --no-print-directory lint
 	$(PY) -m pytest -q
+
+## lint: ruff (rules in pyproject.toml) and the import contract (layers, no cycles: docs/architecture.md)
+lint: $(STAMP)
+	$(VENV)/bin/ruff check pdw tests benchmarks derive
+	$(VENV)/bin/lint-imports --no-cache
 
 ## test-all: also the slow studies
 test-all: $(STAMP)
 	$(PY) -m pytest -q -m ""
 
-## derive: regenerate generated/ and pdw/_layout.py from the symbolic derivation
+## derive: regenerate generated/ and pdw/core/_layout.py from the symbolic derivation
 derive: $(VENV)/bin/python
 	$(EXTRA_REQS) derive > $(VENV)/requirements-derive.txt
 	$(PIP) install --quiet --disable-pip-version-check -r $(VENV)/requirements-derive.txt

@@ -32,10 +32,10 @@ import sys
 import time
 
 import numpy as np
-
-import pdw
 from _results import FIGURES, RESULTS
 from scipy_driver import simulate_scipy
+
+import pdw
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 FIGURE = FIGURES / "work_precision.png"

@@ -7,8 +7,8 @@ import sys
 import pytest
 
 import pdw
-from pdw import cli
-from pdw.scene import Scene
+from pdw.present import cli
+from pdw.sim.scene import Scene
 
 
 def test_walk_writes_report_steps_and_run_info(tmp_path, capsys):

@@ -138,8 +138,8 @@ def run_sh(code: str, cwd: pathlib.Path, where: str):
 
 def run_toml(code: str, where: str):
     import pdw
-    from pdw import _toml
-    from pdw.sweep import parse_study
+    from pdw.core import _toml
+    from pdw.studies.study import parse_study
     data = _toml.loads(code)
     if "axes" in data:
         parse_study(code, name=where)

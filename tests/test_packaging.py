@@ -18,7 +18,7 @@ import zipfile
 
 import pytest
 
-from pdw import _toml
+from pdw.core import _toml
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 pytestmark = pytest.mark.slow

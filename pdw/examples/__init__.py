@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import pathlib
 
-from ..errors import InvalidInputError
+from ..core.errors import InvalidInputError
 
 HERE = pathlib.Path(__file__).resolve().parent
 
