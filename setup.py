@@ -7,7 +7,8 @@ from setuptools import Extension, setup
 
 # Portable, reproducible optimisation; no -march=native or -ffast-math unless asked for.
 extra = ["-O3", "-std=c99", "-fno-math-errno"] + os.environ.get("PDW_CFLAGS", "").split()
-hybrid = ["pdw/_hybrid.pyx", "generated/pdw_hybrid.c", "pdw/csrc/pdw_hybrid_sim.c"]
+hybrid = ["pdw/_hybrid.pyx", "generated/pdw_hybrid.c", "pdw/csrc/pdw_hybrid_sim.c",
+          "pdw/csrc/pdw_hybrid_var.c"]
 sources = ["pdw/_core.pyx", "generated/pdw_model.c"] + sorted(set(glob.glob("pdw/csrc/*.c")) - set(hybrid))
 
 setup(
