@@ -293,3 +293,20 @@ def step_jac_batch(const double[::1] p, const double[:, ::1] y0, dict opts,
             status[i] = pdw_hybrid_step_jac(&p[0], &y0[i, 0], &o, &r, &DP[i, 0, 0])
             for j in range(PDW_NHY):
                 y_plus[i, j] = r.y_plus[j]
+
+
+def step_jac(const double[::1] p, const double[::1] y0, dict opts):
+    """One step and its exact Jacobian: (result dict, DP (4, 4)); DP is NaN unless ok."""
+    cdef pdw_hybrid_opts o
+    cdef pdw_hybrid_result r
+    cdef int st
+    _fill_opts(&o, opts)
+    DP = np.full((PDW_NHY, PDW_NHY), np.nan)
+    cdef double[:, ::1] v = DP
+    with nogil:
+        st = pdw_hybrid_step_jac(&p[0], &y0[0], &o, &r, &v[0, 0])
+    d = _result_dict(&r)
+    if st != 0:
+        d["status"] = STATUS[st] if 0 <= st < len(STATUS) else str(st)
+        DP[:] = np.nan
+    return d, DP
