@@ -120,7 +120,7 @@ class _Engine:
             e = np.zeros(self.n + 1)
             e[-1] = 1.0
             d = pt.tangent / pt.tangent[-1] if abs(pt.tangent[-1]) > 1e-12 else e
-            x_pred = pt.x + ds * d * np.sign(pt.tangent[-1] or 1.0)
+            x_pred = pt.x + ds * d
             c = e
         else:
             x_pred = pt.x + ds * pt.tangent
@@ -128,10 +128,7 @@ class _Engine:
         x, ev, its = self.correct(x_pred, c)
         if x is None:
             return None, ev, its
-        ref = pt.tangent
-        if self.natural:
-            ref = np.zeros(self.n + 1)
-            ref[-1] = np.sign(pt.tangent[-1] or 1.0)
+        ref = c if self.natural else pt.tangent
         return _Point(x, ev, self.tangent(ev, ref), its, ds), None, its
 
 
@@ -346,14 +343,13 @@ def continue_gait(params, parameter, stop, *, model="continuous", variant="paper
     if not np.isfinite(mu_stop) or mu_stop == mu0:
         raise InvalidInputError("stop must differ from the start value %r, got %r"
                                 % (value, stop))
-    scale = abs(mu_stop - mu0)
-    direction = np.sign(mu_stop - mu0)
+    scale = mu_stop - mu0          # signed: u runs from 0 to 1
     tol = tol if tol is not None else (1e-10 if model == "hybrid" else 1e-8)
     eng = _Engine(prob, mu0, scale, tol, max_newton, method == "natural")
-    ds = (abs(step) / scale) if step else 0.02
+    ds = abs(step / scale) if step else 0.02
     step_min = 1e-6 if step_min is None else step_min
     step_max = 0.1 if step_max is None else step_max
-    locate_tol = 1e-6 * scale if locate_tol is None else locate_tol
+    locate_tol = 1e-6 * abs(scale) if locate_tol is None else locate_tol
     if int(max_points) < 2:
         raise InvalidInputError("max_points must be >= 2, got %r" % (max_points,))
 
@@ -367,7 +363,7 @@ def continue_gait(params, parameter, stop, *, model="continuous", variant="paper
         raise GaitNotFoundError("the start is not a period-%d gait of the %s model at %s = %r: "
                                 "%s" % (period, model, parameter, value, why))
     ev = why
-    ref = e * direction
+    ref = e.copy()
     if isinstance(start, Gait) and start.details and "direction" in start.details:
         dz, dmu = start.details["direction"]
         ref = np.append(np.asarray(dz, dtype=float), dmu / scale)
@@ -396,7 +392,6 @@ def continue_gait(params, parameter, stop, *, model="continuous", variant="paper
         u = b.x[-1]
         if ends:
             stop_reason = "end of the family: " + ends[0].reason
-            pts.append(b)
             break
         if u >= 1.0:
             # land on stop exactly
