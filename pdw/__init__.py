@@ -14,6 +14,9 @@ hybrid                  the rigid-ground impact-momentum model (MODEL.md section
 find_gait               period-one gait of the continuous model: Newton shooting on the touch-down
                         Poincare map, Floquet multipliers (pdw.limit_cycle; cell mapping:
                         pdw.cell_mapping)
+continue_gait, Branch   continuation of gaits in one parameter: branches, Floquet multipliers,
+                        folds, period doublings, Neimark-Sacker, ends (pdw.continuation;
+                        ``pdw continue``)
 sweep                   parameter studies from TOML files: run_study, load_study (``pdw sweep``)
 PdwError, SimulationError, DivergedError, InvalidInputError   the error hierarchy
 STATE, VARIANTS         the state layout and the contact variants (MODEL.md section 6)
@@ -32,6 +35,8 @@ from . import scene
 from .scene import Scene, run
 from . import limit_cycle, cell_mapping, sweep
 from .limit_cycle import find_gait
+from .branch import Bifurcation, Branch
+from .continuation import continue_gait
 
 __version__ = "0.1.0"
 
@@ -41,5 +46,5 @@ __all__ = [
     "X0_DISTURBED", "steps", "Steps", "PdwError", "SimulationError", "DivergedError",
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait", "Scene", "run",
     "limit_cycle", "cell_mapping", "find_gait", "sweep",
-    "StepSizeWarning", "StepSizeError",
+    "StepSizeWarning", "StepSizeError", "continue_gait", "Branch", "Bifurcation",
 ]

@@ -84,6 +84,7 @@ class Branch:
     ``double_support`` [s] (mean; 0 for the hybrid model), ``multipliers`` (N, dim) complex,
     sorted by decreasing modulus, ``stable`` (all |multiplier| < 1), ``state`` (N, 4 hybrid /
     8 continuous: the `Gait.state` of each point), ``z`` (N, dim) section coordinates,
+    ``orbit`` (N, n, dim) the n section points of each period-n gait (``orbit[:, 0] == z``),
     ``tangents`` (N, dim + 1), ``step_size`` (N: the arclength step that reached the point;
     0 for the first), ``newton_iterations`` (N).
     """
@@ -99,6 +100,7 @@ class Branch:
     stable: np.ndarray
     state: np.ndarray
     z: np.ndarray
+    orbit: np.ndarray
     tangents: np.ndarray
     step_size: np.ndarray
     newton_iterations: np.ndarray

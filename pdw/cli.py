@@ -158,6 +158,8 @@ def main(argv=None):
     r.add_argument("--out", help="also write steps.csv, run.json and scene.toml to this folder")
     from .sweep import add_cli as _add_sweep    # ``pdw sweep STUDY.toml`` (pdw/sweep.py)
     _add_sweep(sub)
+    from .continuation_cli import add_cli as _add_continue    # ``pdw continue SPEC.toml``
+    _add_continue(sub)
     args = ap.parse_args(argv)
     try:
         if hasattr(args, "func"):

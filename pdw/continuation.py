@@ -190,7 +190,7 @@ def _bifurcation(engine, kind, pt, index, width, reason, eigvec=None):
     return Bifurcation(kind=kind, value=engine.value(pt.x), gait=gait, index=index,
                        tolerance=width, reason=reason, z=pt.x[:-1].copy(),
                        mu=engine.mu(pt.x), tangent=pt.tangent.copy(), eigenvector=eigvec,
-                       multipliers=pt.mult.copy())
+                       multipliers=pt.mult.copy(), details={"orbit": pt.ev.info["orbit"]})
 
 
 def _check_crossings(engine, a, b, index, locate_tol, detect):
@@ -416,7 +416,9 @@ def continue_gait(params, parameter, stop, *, model="continuous", variant="paper
                    dict(method=method, tol=tol, locate_tol=locate_tol, step_min=step_min,
                         step_max=step_max, log=log, start_value=float(value),
                         stop=float(stop), variant=variant, fd_step=fd_step,
-                        options=dict(prob.opts)))
+                        options=dict(prob.opts),
+                        origin=start.details.get("origin") if isinstance(start, Gait)
+                        and start.details else None))
 
 
 def _branch(eng, pts, bifs, stop_reason, prob, wall, settings) -> Branch:
@@ -429,7 +431,8 @@ def _branch(eng, pts, bifs, stop_reason, prob, wall, settings) -> Branch:
         double_support=np.array([p.ev.info["double_support"] for p in pts]),
         multipliers=mult, stable=np.all(np.abs(mult) < 1.0, axis=1),
         state=np.array([p.ev.info["state"] for p in pts]),
-        z=np.array([p.x[:-1] for p in pts]), tangents=np.array([p.tangent for p in pts]),
+        z=np.array([p.x[:-1] for p in pts]), orbit=np.array([p.ev.info["orbit"] for p in pts]),
+        tangents=np.array([p.tangent for p in pts]),
         step_size=np.array([p.ds for p in pts]),
         newton_iterations=np.array([p.iters for p in pts]),
         bifurcations=bifs, stop_reason=stop_reason, n_maps=prob.n_maps, wall_time=wall,
@@ -476,6 +479,8 @@ def switch_branch(branch, bifurcation, amplitude=0.005, max_tries=6) -> Gait:
                 d = x - x_star
                 gait.details.update(value=eng.value(x), direction=(d[:-1], d[-1] * s["scale"]),
                                     switched_from=bifurcation.as_dict(),
+                                    origin=(bifurcation.value, np.asarray(
+                                        bifurcation.details.get("orbit", [bifurcation.z]))),
                                     distance_to_period_n=float(gap))
                 return gait
             why = "landed on the period-%d branch" % p1.period
@@ -492,6 +497,7 @@ def follow_cascade(params, parameter, stop, depth=2, **kw) -> list:
     branches = [continue_gait(params, parameter, stop, **kw)]
     period = kw.pop("period", 1)
     kw.pop("start", None)
+    kw.pop("value", None)
     for _ in range(depth):
         pds = branches[-1].of_kind("period_doubling")
         if not pds:

@@ -155,7 +155,8 @@ class HybridProblem(_Problem):
             P_lam = (vals[0] - vals[1]) / (2 * h)
         info = {"period": float(sum(s["t_strike"] for s in steps)),
                 "step_length": float(np.mean([s["step_length"] for s in steps])),
-                "double_support": 0.0, "state": H._y_of(z)}
+                "double_support": 0.0, "state": H._y_of(z),
+                "orbit": np.array([z] + [s["y_plus"][list(H._SECTION)] for s in steps[:-1]])}
         adm = {"Fn_min": min(s["Fn_min"] for s in steps),
                "v_old_up": min(s["v_old"][1] for s in steps),
                "strike_speed": min(-s["vy_strike"] for s in steps)}
@@ -232,7 +233,8 @@ class ContinuousProblem(_Problem):
                 "step_length": float(np.mean([s["step_length"] for s in steps])),
                 "double_support": float(np.mean([s["double_support"] for s in steps])),
                 "state": LC.embed(z, self.params_at(mu)),
-                "n_events": int(sum(s["n_events"] for s in steps))}
+                "n_events": int(sum(s["n_events"] for s in steps)),
+                "orbit": np.array([z] + [s["z"] for s in steps[:-1]])}
         adm = {"double_support": min(s["double_support"] for s in steps),
                "swing_period": min(s["swing_period"] for s in steps)}
         return Evaluation(True, "ok", Pz, M, P_lam, info, adm)
