@@ -339,12 +339,33 @@ def continue_gait(params, parameter, stop, *, model="continuous", variant="paper
         else:
             raise InvalidInputError("value= (the start's %s) is needed with params_of"
                                     % parameter)
+    if prob.coord(float(stop)) == prob.coord(float(value)):
+        raise InvalidInputError("stop must differ from the start value %r, got %r"
+                                % (value, stop))
+    z0 = _start_z(prob, params, start, variant, period)
+    details = start.details if isinstance(start, Gait) and start.details else {}
+    tol = tol if tol is not None else (1e-10 if model == "hybrid" else 1e-8)
+    return run_continuation(prob, z0, value, stop, method=method, max_points=max_points,
+                            step=step, step_min=step_min, step_max=step_max, tol=tol,
+                            locate_tol=locate_tol, detect=detect, max_newton=max_newton,
+                            direction=details.get("direction"), origin=details.get("origin"),
+                            settings=dict(log=log, variant=variant, fd_step=fd_step), t0=t0)
+
+
+def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_points=200,
+                     step=None, step_min=None, step_max=None, tol=1e-10, locate_tol=None,
+                     detect=("fold", "period_doubling", "neimark_sacker", "end"), max_newton=8,
+                     direction=None, origin=None, settings=None, t0=None) -> Branch:
+    """The continuation proper, on any problem object (`pdw.gait_maps`: ``dim``, ``evaluate``,
+    ``coord``/``value``, ``gait``, ``ADMISSIBLE``, ...), from the fixed point z0 at ``value``
+    towards ``stop``; the arguments as in `continue_gait` (``direction``: (dz, dmu) to orient
+    the first tangent; ``origin``: where a switched branch was born, for plots)."""
+    t0 = time.perf_counter() if t0 is None else t0
     mu0, mu_stop = prob.coord(float(value)), prob.coord(float(stop))
     if not np.isfinite(mu_stop) or mu_stop == mu0:
         raise InvalidInputError("stop must differ from the start value %r, got %r"
                                 % (value, stop))
     scale = mu_stop - mu0          # signed: u runs from 0 to 1
-    tol = tol if tol is not None else (1e-10 if model == "hybrid" else 1e-8)
     eng = _Engine(prob, mu0, scale, tol, max_newton, method == "natural")
     ds = abs(step / scale) if step else 0.02
     step_min = 1e-6 if step_min is None else step_min
@@ -352,20 +373,17 @@ def continue_gait(params, parameter, stop, *, model="continuous", variant="paper
     locate_tol = 1e-6 * abs(scale) if locate_tol is None else locate_tol
     if int(max_points) < 2:
         raise InvalidInputError("max_points must be >= 2, got %r" % (max_points,))
-
-    # the first point
-    z0 = _start_z(prob, params, start, variant, period)
-    x0 = np.append(z0, 0.0)
+    x0 = np.append(np.asarray(z0, dtype=float), 0.0)
     e = np.zeros(prob.dim + 1)
     e[-1] = 1.0
     first, why, _ = eng.correct(x0, e)
     if first is None:
         raise GaitNotFoundError("the start is not a period-%d gait of the %s model at %s = %r: "
-                                "%s" % (period, model, parameter, value, why))
+                                "%s" % (prob.period, prob.model, prob.parameter, value, why))
     ev = why
     ref = e.copy()
-    if isinstance(start, Gait) and start.details and "direction" in start.details:
-        dz, dmu = start.details["direction"]
+    if direction is not None:
+        dz, dmu = direction
         ref = np.append(np.asarray(dz, dtype=float), dmu / scale)
     pts = [_Point(first, ev, eng.tangent(ev, ref), 0, 0.0)]
     pts[0].tests = _tests(eng, pts[0])
@@ -403,6 +421,7 @@ def continue_gait(params, parameter, stop, *, model="continuous", variant="paper
             else:
                 pts.append(b)
             stop_reason = "reached stop = %r" % stop
+            bifs = [f for f in bifs if (f.mu - mu0) / scale <= 1.0 + 1e-12]
             break
         pts.append(b)
         if u < -1e-9 and not eng.natural:
@@ -414,11 +433,9 @@ def continue_gait(params, parameter, stop, *, model="continuous", variant="paper
             ds = max(ds * 0.7, step_min)
     return _branch(eng, pts, bifs, stop_reason, prob, time.perf_counter() - t0,
                    dict(method=method, tol=tol, locate_tol=locate_tol, step_min=step_min,
-                        step_max=step_max, log=log, start_value=float(value),
-                        stop=float(stop), variant=variant, fd_step=fd_step,
-                        options=dict(prob.opts),
-                        origin=start.details.get("origin") if isinstance(start, Gait)
-                        and start.details else None))
+                        step_max=step_max, start_value=float(value), stop=float(stop),
+                        options=dict(getattr(prob, "opts", {})), origin=origin,
+                        **(settings or {})))
 
 
 def _branch(eng, pts, bifs, stop_reason, prob, wall, settings) -> Branch:

@@ -194,3 +194,59 @@ def test_continuous_d_hip_branch_ends_in_a_fold():
     assert np.min(np.abs(folds[0].multipliers - 1.0)) < 1e-2
     with pytest.raises(pdw.gait_types.GaitNotFoundError):
         LC.find_gait(params.replace(d_hip=folds[0].value + 5e-4), guess=folds[0].gait)
+
+
+# --- the engine on maps with known bifurcations -----------------------------------------------
+
+class _Map:
+    """A duck-typed problem (pdw.gait_maps) for a smooth map with known bifurcations."""
+
+    model, parameter, period, ADMISSIBLE = "map", "a", 1, {}
+
+    def __init__(self, f, jac, dim):
+        self.f, self.jac, self.dim, self.n_maps, self.opts = f, jac, dim, 0, {}
+
+    def value(self, mu):
+        return float(mu)
+
+    def coord(self, v):
+        return float(v)
+
+    def evaluate(self, z, mu, jac=True):
+        from pdw.gait_maps import Evaluation
+        self.n_maps += 1
+        h = 1e-7
+        P_lam = (self.f(z, mu + h) - self.f(z, mu - h)) / (2 * h)
+        info = {"period": 1.0, "step_length": 1.0, "double_support": 0.0, "state": z,
+                "orbit": np.array([z])}
+        return Evaluation(True, "ok", self.f(z, mu), self.jac(z, mu), P_lam, info, {})
+
+    def gait(self, z, mu, ev, mult):
+        return pdw.Gait(state=z, period=1.0, step_length=1.0, double_support=0.0,
+                        multipliers=mult, model="map")
+
+
+def test_engine_locates_the_fold_and_period_doubling_of_a_quadratic_map():
+    """z' = z + a - z^2: fixed points z = +-sqrt(a), a fold at a = 0, and on z = +sqrt(a) the
+    multiplier 1 - 2 sqrt(a) passes -1 at a = 1."""
+    from pdw.continuation import run_continuation
+    m = _Map(lambda z, a: z + a - z ** 2, lambda z, a: np.array([[1 - 2 * z[0]]]), 1)
+    b = run_continuation(m, [np.sqrt(2.0)], 2.0, -0.5, tol=1e-12, max_points=200)
+    kinds = [(f.kind, f.value) for f in b.bifurcations]
+    assert [k for k, _ in kinds] == ["period_doubling", "fold"]
+    assert abs(kinds[0][1] - 1.0) < 3e-6 and abs(kinds[1][1]) < 3e-6
+    assert b.z[-1, 0] < 0                                # continued round the fold
+
+
+def test_engine_locates_the_neimark_sacker_of_the_delayed_logistic_map():
+    """x' = y, y' = a y (1 - x): the fixed point's multipliers have |mu|^2 = a - 1, a complex
+    pair crossing the unit circle at a = 2."""
+    from pdw.continuation import run_continuation
+    m = _Map(lambda z, a: np.array([z[1], a * z[1] * (1 - z[0])]),
+             lambda z, a: np.array([[0.0, 1.0], [-a * z[1], a * (1 - z[0])]]), 2)
+    a0 = 1.5
+    b = run_continuation(m, [1 - 1 / a0, 1 - 1 / a0], a0, 2.5, tol=1e-12)
+    ns = [f for f in b.bifurcations if f.kind == "neimark_sacker"]
+    assert len(ns) == 1 and abs(ns[0].value - 2.0) < 1e-5
+    assert not any(f.kind == "period_doubling" for f in b.bifurcations)
+    assert b.stable[b.values < 2.0].all() and not b.stable[b.values > 2.0].any()
