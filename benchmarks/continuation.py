@@ -4,6 +4,7 @@ and docs/figures/continuation_*.png.
     python benchmarks/continuation.py hybrid    # compass cascade + simplest walker (seconds)
     python benchmarks/continuation.py dhip      # continuous model, d_hip from 0.010 to the end
     python benchmarks/continuation.py rigid     # k_n 1e5 -> 1e9, consistent, d_n ~ k_n^(4/3)
+    python benchmarks/continuation.py rigid_paper  # the same in the paper variant: its end
     python benchmarks/continuation.py fig11     # Fig. 11 (k_n): continuation vs the sweep
 """
 from __future__ import annotations
@@ -97,24 +98,41 @@ RIGID_TABLE = {  # docs/studies.md section 3 (benchmarks/rigid_limit.py), consis
     1e8: (0.564415, 0.339977), 3e8: (0.564285, 0.340119), 1e9: (0.564193, 0.340188)}
 
 
+def _rigid_params_of(k, p0=pdw.Params.paper_steady()):
+    return p0.replace(k_n=k, d_n=1e6 * (k / 1e5) ** (4 / 3))
+
+
+def part_rigid_paper():
+    say("== k_n 1e5 -> 1e9 (log), PAPER variant, d_n = 1e6 (k_n/1e5)^(4/3): where does it end? ==")
+    b = continue_gait(pdw.Params.paper_steady(), "k_n", 1e9, variant="paper",
+                      params_of=_rigid_params_of, value=1e5, log=True, max_points=80)
+    _branch_line(b)
+    _bifs(b)
+    for i in range(len(b)):
+        say("  k_n %.4g  period %.6f  L %.6f  DS %.3f ms  |mu| %s %s"
+            % (b.values[i], b.period[i], b.step_length[i], 1e3 * b.double_support[i],
+               " ".join("%.4f" % v for v in np.abs(b.multipliers[i])[:3]),
+               "stable" if b.stable[i] else "UNSTABLE"))
+    ax = plot_branches([b], y="max_multiplier", x_label="k_n [N/m^1.5] (d_n ~ k_n^(4/3))",
+                       title="paper variant towards rigid ground",
+                       path=FIGS / "continuation_k_n_paper.png")
+    import matplotlib.pyplot as plt
+    plt.close(ax.figure)
+
+
 def part_rigid():
     say("== rigid limit: k_n 1e5 -> 1e9 (log), consistent, d_n = 1e6 (k_n/1e5)^(4/3) ==")
     p0 = pdw.Params.paper_steady()
-
-    def params_of(k):
-        return p0.replace(k_n=k, d_n=1e6 * (k / 1e5) ** (4 / 3))
-    b = continue_gait(p0, "k_n", 1e9, variant="consistent", params_of=params_of, value=1e5,
-                      log=True, max_points=80)
+    b = continue_gait(p0, "k_n", 1e9, variant="consistent", params_of=_rigid_params_of,
+                      value=1e5, log=True, max_points=80, at=list(RIGID_TABLE))
     _branch_line(b)
     _bifs(b)
-    lk = np.log(b.values)
-    order = np.argsort(lk)
-    say("k_n | period (branch, interpolated) | table | L (branch) | table")
+    say("k_n | period (branch) | table | L (branch) | table | largest abs(mu)")
     for k, (P, L) in RIGID_TABLE.items():
-        if b.values.min() <= k <= b.values.max():
-            Pi = np.interp(np.log(k), lk[order], b.period[order])
-            Li = np.interp(np.log(k), lk[order], b.step_length[order])
-            say("%.0e | %.6f | %.6f | %.6f | %.6f" % (k, Pi, P, Li, L))
+        i = int(np.argmin(np.abs(np.log(b.values / k))))
+        say("%.0e | %.6f | %.6f | %.6f | %.6f | %.4f (branch point at %.6g)"
+            % (k, b.period[i], P, b.step_length[i], L, np.abs(b.multipliers[i]).max(),
+               b.values[i]))
     ax = plot_branches([b], y="step_length", x_label="k_n [N/m^1.5] (d_n ~ k_n^(4/3))",
                        title="Rigid limit (consistent variant)",
                        path=FIGS / "continuation_rigid_limit.png")
@@ -143,33 +161,43 @@ atol = 1e-9
 """
 
 
-def part_fig11(rounds=1):
+def part_fig11(rounds=2):
+    from pdw import limit_cycle as LC
     from pdw import sweep
     say("== Fig. 11 (k_n, k_hip = 0.95): continuation against the brute-force sweep ==")
+    say("sweep: 9 points, 16 s of walking each (rodas4 rtol 1e-7), 2 threads; continuation: "
+        "tight = rodas4 rtol 1e-10, Newton tol 1e-8, fd 1e-5 (default); loose = rtol 1e-7, "
+        "atol 1e-9, event_tol 1e-10, Newton tol 1e-6, fd 1e-4; both 2 threads, a point at "
+        "each of the sweep's k_n; rounds interleaved")
     say("load average before: %s" % (os.getloadavg(),))
     study = sweep.parse_study(SWEEP)
+    base = pdw.Params.paper_steady(k_hip=0.95, k_n=0.5e5)
+    ks = list(np.linspace(0.5e5, 2.5e5, 9))
+    runs = {"tight": {}, "loose": dict(options=dict(LC.LOOSE), tol=1e-6, fd_step=1e-4)}
     for r in range(rounds):
         with tempfile.TemporaryDirectory() as tmp:
             t0 = time.perf_counter()
             res = sweep.run_study(study, tmp, workers=2, progress=False, figures=False,
                                   resume=False)
             t_sweep = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        b = continue_gait(pdw.Params.paper_steady(k_hip=0.95, k_n=0.5e5), "k_n", 2.5e5,
-                          workers=2)
-        t_cont = time.perf_counter() - t0
-        steps = [row.get("n_steps") for row in res.rows]
-        say("round %d: sweep %d points in %.1f s; continuation %d points, %d map evaluations "
-            "(steps), %.1f s; wall ratio sweep/continuation %.2f"
-            % (r, len(res.rows), t_sweep, len(b), b.n_maps, t_cont, t_sweep / t_cont))
-        say("  sweep rows' step counts: %s" % steps)
-        _bifs(b)
-        for row in res.rows:
-            k = row["k_n"]
-            Li = np.interp(k, b.values, b.step_length)
-            Pi = np.interp(k, b.values, b.period)
-            say("  k_n %.4g: sweep L %s P %s status %s | continuation (interp.) L %.6f P %.6f"
-                % (k, row.get("L"), row.get("P"), row.get("status"), Li, Pi))
+        n_sweep = sum(int(row.get("n_steps") or 0) for row in res.rows)
+        say("round %d: sweep %d points, %d steps walked, %.2f s" % (r, len(res.rows), n_sweep,
+                                                                   t_sweep))
+        for name, kw in runs.items():
+            t0 = time.perf_counter()
+            b = continue_gait(base, "k_n", 2.5e5, workers=2, at=ks, **kw)
+            t = time.perf_counter() - t0
+            say("round %d: continuation (%s) %d points, %d map evaluations (steps), %.2f s; "
+                "wall ratio continuation/sweep %.1f; bifurcations %s"
+                % (r, name, len(b), b.n_maps, t, t / t_sweep, b.bifurcations))
+            if r == rounds - 1:
+                for row in res.rows:
+                    k = row["k_n"]
+                    i = int(np.argmin(np.abs(b.values - k)))
+                    say("  k_n %.4g: sweep L %.6f P %.6f | continuation (%s, at %.6g) L %.6f "
+                        "P %.6f (swing = period - double support) |mu| %.4f"
+                        % (k, row["L"], row["P"], name, b.values[i], b.step_length[i],
+                           b.period[i] - b.double_support[i], np.abs(b.multipliers[i]).max()))
     say("load average after: %s" % (os.getloadavg(),))
 
 
@@ -179,7 +207,7 @@ if __name__ == "__main__":
         OUT.clear()
         t0 = time.perf_counter()
         {"hybrid": part_hybrid, "dhip": part_dhip, "rigid": part_rigid,
-         "fig11": part_fig11}[part]()
+         "rigid_paper": part_rigid_paper, "fig11": part_fig11}[part]()
         say("(%s: %.1f s wall; python benchmarks/continuation.py %s)"
             % (part, time.perf_counter() - t0, part))
         RESULTS.mkdir(exist_ok=True)

@@ -268,7 +268,7 @@ def continue_gait(params, parameter, stop, *, model="continuous", variant="paper
                   step_min=None, step_max=None, tol=None, locate_tol=None, params_of=None,
                   log=False, detect=("fold", "period_doubling", "neimark_sacker", "end"),
                   max_newton=8, executor=None, workers=None, fd_step=1e-5,
-                  options=None) -> Branch:
+                  options=None, at=()) -> Branch:
     """Follow the period-``period`` gait of ``params`` as ``parameter`` moves towards ``stop``.
 
     Parameters
@@ -317,6 +317,9 @@ def continue_gait(params, parameter, stop, *, model="continuous", variant="paper
     options : dict
         Step-map options (hybrid: `pdw.hybrid.DEFAULT_OPTIONS`; continuous: rtol, atol,
         event_tol, t_max, dt).
+    at : sequence of float
+        Parameter values at which the branch gets a point of its own (a natural correction
+        there, when the branch passes the value), e.g. to compare with a table.
 
     Returns
     -------
@@ -349,23 +352,28 @@ def continue_gait(params, parameter, stop, *, model="continuous", variant="paper
                             step=step, step_min=step_min, step_max=step_max, tol=tol,
                             locate_tol=locate_tol, detect=detect, max_newton=max_newton,
                             direction=details.get("direction"), origin=details.get("origin"),
-                            settings=dict(log=log, variant=variant, fd_step=fd_step), t0=t0)
+                            settings=dict(log=log, variant=variant, fd_step=fd_step), t0=t0,
+                            at=at)
 
 
 def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_points=200,
                      step=None, step_min=None, step_max=None, tol=1e-10, locate_tol=None,
                      detect=("fold", "period_doubling", "neimark_sacker", "end"), max_newton=8,
-                     direction=None, origin=None, settings=None, t0=None) -> Branch:
+                     direction=None, origin=None, settings=None, t0=None, at=()) -> Branch:
     """The continuation proper, on any problem object (`pdw.gait_maps`: ``dim``, ``evaluate``,
     ``coord``/``value``, ``gait``, ``ADMISSIBLE``, ...), from the fixed point z0 at ``value``
     towards ``stop``; the arguments as in `continue_gait` (``direction``: (dz, dmu) to orient
-    the first tangent; ``origin``: where a switched branch was born, for plots)."""
+    the first tangent; ``origin``: where a switched branch was born, for plots; ``at``:
+    parameter values where a point is also computed, by a natural correction, whenever the
+    branch passes them)."""
     t0 = time.perf_counter() if t0 is None else t0
     mu0, mu_stop = prob.coord(float(value)), prob.coord(float(stop))
     if not np.isfinite(mu_stop) or mu_stop == mu0:
         raise InvalidInputError("stop must differ from the start value %r, got %r"
                                 % (value, stop))
     scale = mu_stop - mu0          # signed: u runs from 0 to 1
+    if hasattr(prob, "lam_rel"):
+        prob.lam_step = prob.lam_rel * max(abs(mu0), abs(scale))
     eng = _Engine(prob, mu0, scale, tol, max_newton, method == "natural")
     ds = abs(step / scale) if step else 0.02
     step_min = 1e-6 if step_min is None else step_min
@@ -423,6 +431,13 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
             stop_reason = "reached stop = %r" % stop
             bifs = [f for f in bifs if (f.mu - mu0) / scale <= 1.0 + 1e-12]
             break
+        for ua in sorted((prob.coord(float(v)) - mu0) / scale for v in at):
+            if min(a.x[-1], u) < ua < max(a.x[-1], u):
+                c, evc, _ = eng.correct(a.x + (b.x - a.x) * (ua - a.x[-1]) / (u - a.x[-1]), e)
+                if c is not None:
+                    extra = _Point(c, evc, eng.tangent(evc, a.tangent), 0, 0.0)
+                    extra.tests = _tests(eng, extra)
+                    pts.append(extra)
         pts.append(b)
         if u < -1e-9 and not eng.natural:
             stop_reason = "the branch returned past the start value (after a fold)"

@@ -16,7 +16,8 @@ eigenvalues are the Floquet multipliers) and ``d P^n / d lambda``. Two models:
   (multipliers below ~1e-4 in modulus are not resolved). The 12 + 2 evaluations run on an
   executor (threads by default; the compiled loop releases the GIL).
 
-``d P^n / d lambda`` is a central difference in the (internal) parameter coordinate for both.
+``d P^n / d lambda`` is a central difference in the (internal) parameter coordinate for both, of
+relative step ``lam_rel`` (1e-6 hybrid, 1e-4 continuous) of the continuation's scale.
 Every evaluation also returns the gait's descriptors and its *admissibility* functions:
 quantities that must stay positive for the gait to exist as modelled (the end of a family when
 one crosses zero), see `HybridProblem.ADMISSIBLE` and `ContinuousProblem.ADMISSIBLE`.
@@ -56,6 +57,10 @@ class _Problem:
     dim = 0
     model = ""
     ADMISSIBLE: dict = {}
+
+    #: relative step of the central difference in the parameter coordinate (times
+    #: max(|mu_0|, |mu_stop - mu_0|), set by the continuation)
+    lam_rel = 1e-6
 
     def __init__(self, params, parameter, params_of=None, period=1, log=False, lam_step=1e-6):
         if not isinstance(params, Params):
@@ -176,6 +181,7 @@ class ContinuousProblem(_Problem):
 
     dim = 6
     model = "continuous"
+    lam_rel = 1e-4          # the map is reproducible to ~1e-10
     #: admissibility: the double support must last (> 0; else the feet are never both down and
     #: the section's event order changes), and the swing phase too
     ADMISSIBLE = {"double_support": "the double support vanishes (flight or swapped events)",
