@@ -164,11 +164,13 @@ def test_branch_csv_json_roundtrip(tmp_path, cascade):
     import json
     b = cascade[0]
     b.to_csv(tmp_path / "b.csv")
-    rows = list(csv.DictReader(open(tmp_path / "b.csv")))
+    with open(tmp_path / "b.csv", encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
     assert len(rows) == len(b)
     np.testing.assert_allclose([float(r["value"]) for r in rows], b.values, rtol=1e-15)
     b.to_json(tmp_path / "b.json")
-    js = json.load(open(tmp_path / "b.json"))
+    with open(tmp_path / "b.json", encoding="utf-8") as fh:
+        js = json.load(fh)
     assert js["bifurcations"][0]["kind"] == "period_doubling"
     assert js["bifurcations"][0]["value"] == b.bifurcations[0].value
 
@@ -250,3 +252,38 @@ def test_engine_locates_the_neimark_sacker_of_the_delayed_logistic_map():
     assert len(ns) == 1 and abs(ns[0].value - 2.0) < 1e-5
     assert not any(f.kind == "period_doubling" for f in b.bifurcations)
     assert b.stable[b.values < 2.0].all() and not b.stable[b.values > 2.0].any()
+
+
+# --- command line and figure ----------------------------------------------------------------------
+
+def test_cli_continue_writes_csv_json_and_diagram(tmp_path, capsys):
+    import csv
+    import json
+    import pathlib
+    from pdw.cli import main
+    spec = pathlib.Path(__file__).resolve().parent.parent / "docs/continuations/simplest_walker.toml"
+    assert main(["continue", str(spec), "--out", str(tmp_path)]) == 0
+    rows = list(csv.DictReader(open(tmp_path / "simplest_walker.csv", encoding="utf-8")))
+    assert {r["period_n"] for r in rows} == {"1", "2", "4"}
+    with open(tmp_path / "simplest_walker.json", encoding="utf-8") as fh:
+        js = json.load(fh)
+    assert js["spec"]["toml"].startswith("#") and js["map_evaluations"] > 0
+    pd = js["branches"][0]["bifurcations"][0]
+    assert pd["kind"] == "period_doubling" and abs(pd["value"] - 0.015) < 5e-4
+    assert (tmp_path / "simplest_walker.png").stat().st_size > 10000
+    assert "period_doubling" in capsys.readouterr().out
+
+
+def test_diagram_draws_stable_solid_and_unstable_dashed(cascade):
+    import matplotlib
+    matplotlib.use("Agg")
+    from pdw.plots_continuation import plot_branches
+    b = cascade[0]
+    ax = plot_branches([b], y="step_length")
+    styles = {ln.get_linestyle() for ln in ax.lines if ln.get_marker() in ("None", "")}
+    assert styles == {"-", "--"}                 # stable before the doubling, unstable after
+    pd = b.of_kind("period_doubling")[0]
+    marks = [ln for ln in ax.lines if ln.get_marker() == "o"]
+    assert len(marks) == 1 and marks[0].get_xdata()[0] == pytest.approx(pd.value)
+    import matplotlib.pyplot as plt
+    plt.close(ax.figure)
