@@ -22,9 +22,9 @@ sys.path.insert(0, str(ROOT))
 
 import pdw  # noqa: E402
 from pdw import hybrid as H  # noqa: E402
-from pdw.continuation import continue_gait, follow_cascade  # noqa: E402
-from pdw.continuation_cli import preset  # noqa: E402
-from pdw.plots_continuation import plot_branches  # noqa: E402
+from pdw.analysis.continuation import continue_gait, follow_cascade  # noqa: E402
+from pdw.present.cli_continue import preset  # noqa: E402
+from pdw.present.plots_continuation import plot_branches  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
 FIGS = ROOT / "docs" / "figures"
@@ -98,8 +98,11 @@ RIGID_TABLE = {  # docs/studies.md section 3 (benchmarks/rigid_limit.py), consis
     1e8: (0.564415, 0.339977), 3e8: (0.564285, 0.340119), 1e9: (0.564193, 0.340188)}
 
 
-def _rigid_params_of(k, p0=pdw.Params.paper_steady()):
-    return p0.replace(k_n=k, d_n=1e6 * (k / 1e5) ** (4 / 3))
+STEADY = pdw.Params.paper_steady()
+
+
+def _rigid_params_of(k):
+    return STEADY.replace(k_n=k, d_n=1e6 * (k / 1e5) ** (4 / 3))
 
 
 def part_rigid_paper():

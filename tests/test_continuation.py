@@ -1,14 +1,14 @@
-"""Continuation of gaits, exact monodromy, bifurcations (pdw.continuation, docs/continuation.md)."""
+"""Continuation of gaits, exact monodromy, bifurcations (pdw.analysis.continuation, docs/continuation.md)."""
 import numpy as np
 import pytest
 
 import pdw
-from pdw import _hybrid
 from pdw import hybrid as H
 from pdw import limit_cycle as LC
-from pdw.continuation import continue_gait, follow_cascade
-from pdw.errors import InvalidInputError
-from pdw.model import parameter_vector
+from pdw.analysis.continuation import continue_gait, follow_cascade
+from pdw.core import _hybrid
+from pdw.core.errors import InvalidInputError
+from pdw.core.model import parameter_vector
 
 COMPASS = H.compass_gait_params()
 DEG = np.pi / 180
@@ -201,7 +201,7 @@ def test_continuous_d_hip_branch_ends_in_a_fold():
 # --- the engine on maps with known bifurcations -----------------------------------------------
 
 class _Map:
-    """A duck-typed problem (pdw.gait_maps) for a smooth map with known bifurcations."""
+    """A duck-typed problem (pdw.analysis.gait_maps) for a smooth map with known bifurcations."""
 
     model, parameter, period, ADMISSIBLE = "map", "a", 1, {}
 
@@ -215,7 +215,7 @@ class _Map:
         return float(v)
 
     def evaluate(self, z, mu, jac=True):
-        from pdw.gait_maps import Evaluation
+        from pdw.analysis.gait_maps import Evaluation
         self.n_maps += 1
         h = 1e-7
         P_lam = (self.f(z, mu + h) - self.f(z, mu - h)) / (2 * h)
@@ -231,7 +231,7 @@ class _Map:
 def test_engine_locates_the_fold_and_period_doubling_of_a_quadratic_map():
     """z' = z + a - z^2: fixed points z = +-sqrt(a), a fold at a = 0, and on z = +sqrt(a) the
     multiplier 1 - 2 sqrt(a) passes -1 at a = 1."""
-    from pdw.continuation import run_continuation
+    from pdw.analysis.continuation import run_continuation
     m = _Map(lambda z, a: z + a - z ** 2, lambda z, a: np.array([[1 - 2 * z[0]]]), 1)
     b = run_continuation(m, [np.sqrt(2.0)], 2.0, -0.5, tol=1e-12, max_points=200)
     kinds = [(f.kind, f.value) for f in b.bifurcations]
@@ -243,7 +243,7 @@ def test_engine_locates_the_fold_and_period_doubling_of_a_quadratic_map():
 def test_engine_locates_the_neimark_sacker_of_the_delayed_logistic_map():
     """x' = y, y' = a y (1 - x): the fixed point's multipliers have |mu|^2 = a - 1, a complex
     pair crossing the unit circle at a = 2."""
-    from pdw.continuation import run_continuation
+    from pdw.analysis.continuation import run_continuation
     m = _Map(lambda z, a: np.array([z[1], a * z[1] * (1 - z[0])]),
              lambda z, a: np.array([[0.0, 1.0], [-a * z[1], a * (1 - z[0])]]), 2)
     a0 = 1.5
@@ -260,7 +260,8 @@ def test_cli_continue_writes_csv_json_and_diagram(tmp_path, capsys):
     import csv
     import json
     import pathlib
-    from pdw.cli import main
+
+    from pdw.present.cli import main
     spec = pathlib.Path(__file__).resolve().parent.parent / "docs/continuations/simplest_walker.toml"
     assert main(["continue", str(spec), "--out", str(tmp_path)]) == 0
     rows = list(csv.DictReader(open(tmp_path / "simplest_walker.csv", encoding="utf-8")))
@@ -277,7 +278,7 @@ def test_cli_continue_writes_csv_json_and_diagram(tmp_path, capsys):
 def test_diagram_draws_stable_solid_and_unstable_dashed(cascade):
     import matplotlib
     matplotlib.use("Agg")
-    from pdw.plots_continuation import plot_branches
+    from pdw.present.plots_continuation import plot_branches
     b = cascade[0]
     ax = plot_branches([b], y="step_length")
     styles = {ln.get_linestyle() for ln in ax.lines if ln.get_marker() in ("None", "")}
