@@ -25,7 +25,14 @@ def _quantity(branch, y, k=0):
 
 
 def _bif_y(branch, bif, y):
-    """The plotted quantity at a bifurcation: interpolated between its neighbouring points."""
+    """The plotted quantity at a bifurcation: its own gait's where known, else interpolated
+    between its neighbouring points."""
+    if y == "max_multiplier" and bif.multipliers is not None:
+        return float(np.max(np.abs(bif.multipliers)))
+    if y == "z0" and bif.z is not None:
+        return float(bif.z[0])
+    if bif.gait is not None and y in ("step_length", "period", "double_support"):
+        return float(getattr(bif.gait, y))
     i = min(bif.index, len(branch) - 2) if len(branch) > 1 else 0
     q = _quantity(branch, y)
     if len(branch) == 1:
