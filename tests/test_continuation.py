@@ -178,8 +178,10 @@ def test_branch_csv_json_roundtrip(tmp_path, cascade):
 # --- the continuous model -----------------------------------------------------------------------
 
 def test_continuous_branch_points_are_find_gait_fixed_points():
+    from concurrent.futures import ThreadPoolExecutor
     params = pdw.Params.paper_steady()
-    b = continue_gait(params, "k_hip", 0.97, max_points=3, step=0.01, workers=2)
+    with ThreadPoolExecutor(2) as ex:
+        b = continue_gait(params, "k_hip", 0.97, max_points=3, step=0.01, executor=ex)
     assert len(b) >= 2
     g = LC.find_gait(params.replace(k_hip=b.values[-1]), guess=b.z[-1])
     np.testing.assert_allclose(g.details["z"], b.z[-1], atol=1e-7)
@@ -288,3 +290,21 @@ def test_diagram_draws_stable_solid_and_unstable_dashed(cascade):
     assert len(marks) == 1 and marks[0].get_xdata()[0] == pytest.approx(pd.value)
     import matplotlib.pyplot as plt
     plt.close(ax.figure)
+
+
+@pytest.mark.slow
+def test_rigid_limit_continuation_reproduces_the_newton_table():
+    """k_n 1e5 -> 1e9 in log k_n, consistent variant, d_n ~ k_n^(4/3), a point at each k_n of
+    the rigid-limit table (docs/studies.md section 3, benchmarks/rigid_limit.py): the same
+    period and step length, to the table's 6 digits."""
+    table = {1e5: (0.574051, 0.300107), 1e7: (0.564938, 0.338931), 1e9: (0.564193, 0.340188)}
+    p0 = pdw.Params.paper_steady()
+    b = continue_gait(p0, "k_n", 1e9, variant="consistent", value=1e5, log=True,
+                      params_of=lambda k: p0.replace(k_n=k, d_n=1e6 * (k / 1e5) ** (4 / 3)),
+                      at=list(table))
+    assert not b.bifurcations and "reached stop" in b.stop_reason
+    for k, (P, L) in table.items():
+        i = int(np.argmin(np.abs(np.log(b.values / k))))
+        assert b.values[i] == pytest.approx(k, rel=1e-9)
+        assert b.period[i] == pytest.approx(P, abs=2e-6)
+        assert b.step_length[i] == pytest.approx(L, abs=2e-6)

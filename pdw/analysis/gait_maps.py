@@ -201,6 +201,10 @@ class ContinuousProblem(_Problem):
         s = np.asarray(state, dtype=float).reshape(-1)
         return LC.section_coordinates(s, 2) if s.size == 8 else s.copy()
 
+    def __getstate__(self):
+        # the tasks travel to process pools / Dask workers without the executor itself
+        return {**self.__dict__, "executor": None}
+
     def _run(self, tasks):
         fn = _ContinuousTask(self)
         if self.executor is not None:
@@ -255,7 +259,8 @@ class ContinuousProblem(_Problem):
 
 
 class _ContinuousTask:
-    """Picklable-by-reference callable: P^n at (z, mu) -> (P^n(z) or None, steps)."""
+    """Callable P^n at (z, mu) -> (P^n(z) or None, steps); picklable (for process pools and
+    Dask) when ``params_of`` is."""
 
     def __init__(self, prob):
         self.prob = prob
