@@ -428,7 +428,7 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
                 pts.append(last)
             else:
                 pts.append(b)
-            stop_reason = "reached stop = %r" % stop
+            stop_reason = "reached stop = %.10g" % float(stop)
             bifs = [f for f in bifs if (f.mu - mu0) / scale <= 1.0 + 1e-12]
             break
         for ua in sorted((prob.coord(float(v)) - mu0) / scale for v in at):
