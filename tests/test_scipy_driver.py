@@ -1,5 +1,5 @@
 """The scipy driver of the work-precision benchmark (benchmarks/scipy_driver.py): scipy's
-solve_ivp on pdw's compiled f and Jacobian, the flag switches of MODEL.md section 5 as terminal
+solve_ivp on pdw's compiled f and Jacobian, the flag switches of docs/model.md section 5 as terminal
 events. The comparison in docs/work_precision.md is fair only if the driver integrates the same
 hybrid system as pdw's loops: same switch rules, same event times."""
 import numpy as np
@@ -40,7 +40,7 @@ def test_touch_down_times_match_pdw_rodas4(rodas4_events, method):
 
 def test_update_flags_mirrors_the_c_rules():
     """One pass of update_flags on hand-made kinematics follows pdw_update_flags rule by rule."""
-    from pdw import _layout
+    from pdw.core import _layout
     K = {n: i for i, n in enumerate(_layout.KIN)}
 
     def kin(xd1, y1, vy1, xd2, y2, vy2, s1=0.1, s2=0.2):

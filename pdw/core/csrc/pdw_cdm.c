@@ -1,0 +1,82 @@
+/* The paper's central difference method, exactly as docs/model.md section 7 prints it (Eqs. 13-17).
+ *
+ *   start:    U_-1 = U_0 - dt U'_0 + dt^2/2 U''_0
+ *   step:     (M/dt^2 + C/(2dt)) U_{n+1} = Q_f - G + (2/dt^2) M U_n - (M/dt^2 - C/(2dt)) U_{n-1}
+ *   velocity: U'_{n+1} = (U_{n+1} - U_{n-1}) / (2dt)        (Eq. 17 as printed)
+ *
+ * M, C, Q_f, G are evaluated at (U_n, U'_n) with the flags updated from that state first (Fig. 3).
+ * First order: Eq. 17's velocity is the centred velocity at t_n, used at t_{n+1}. */
+#include <string.h>
+#include "pdw_sim.h"
+#include "pdw_linalg.h"
+
+int pdw_cdm_advance(pdw_sim *s)
+{
+    const pdw_kernel *k = s->kernel;
+    const double dt = s->dt, idt2 = 1.0/(dt*dt), ih = 0.5/dt;
+    double *trig = s->work + PDW_WORK_TRIG, *kin = s->work + PDW_WORK_KIN;
+    double *contact = s->work + PDW_WORK_CONTACT, *M = s->work + PDW_WORK_M;
+    double C[PDW_NQ*PDW_NQ], QmG[PDW_NQ], K[PDW_NQ*PDW_NQ], b[PDW_NQ], u[PDW_NQ], xnew[PDW_NX];
+
+    s->status = PDW_STATUS_RUNNING;
+    if (!s->started) {
+        double xdot[PDW_NX];
+        const int r = pdw_update_flags(s, 0.0);
+        if (r < 0) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
+        if (r > 0) { s->started = 1; pdw_record_final(s, 0.0); return s->status; }
+        k->rhs(s->x, s->p, s->disc.flags, s->disc.anchors, xdot, s->work);
+        for (int i = 0; i < PDW_NQ; ++i)
+            s->u_prev[i] = s->x[i] - dt*s->x[PDW_NQ + i] + 0.5*dt*dt*xdot[PDW_NQ + i];
+        s->started = 1;
+        s->n = 0;
+        s->t = 0.0;
+        s->n_rhs = 1;
+        pdw_record(s, 0.0);
+    }
+    while (s->n < s->n_steps) {
+        const double t = s->n * dt;
+        /* flags from (U_n, U'_n); this also leaves trig and kin of x_n in work (at n = 0 the
+         * start-up's update and right-hand side did) */
+        if (s->n > 0) {
+            const int r = pdw_update_flags(s, t);
+            if (r < 0) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
+            if (r > 0) { pdw_record_final(s, t); return s->status; }   /* a stop condition */
+        }
+        if (pdw_check_feet(s, t)) return s->status;
+        k->contact(kin, s->disc.flags, s->p, contact);
+        k->cdm_terms(s->x, trig, s->p, contact, M, C, QmG);
+        if (s->n > 0) pdw_record(s, t);  /* sample 0 was recorded at the start */
+        for (int i = 0; i < PDW_NQ; ++i) {
+            double mu = 0.0, ku = 0.0;
+            for (int j = 0; j < PDW_NQ; ++j) {
+                const double m = M[i*PDW_NQ + j], c = C[i*PDW_NQ + j];
+                K[i*PDW_NQ + j] = m*idt2 + c*ih;
+                mu += m * s->x[j];
+                ku += (m*idt2 - c*ih) * s->u_prev[j];
+            }
+            b[i] = QmG[i] + 2.0*idt2*mu - ku;
+        }
+        if (pdw_solve_dblock(K, b, u)) {
+            s->status = PDW_STATUS_SINGULAR;
+            s->failure.reason = PDW_REASON_SINGULAR; s->failure.leg = -1; s->failure.t = t;
+            memcpy(s->failure.x, s->x, sizeof s->x);
+            return s->status;
+        }
+        for (int i = 0; i < PDW_NQ; ++i) {
+            xnew[i] = u[i];
+            xnew[PDW_NQ + i] = (u[i] - s->u_prev[i]) * ih;
+        }
+        if (pdw_check_state(s, xnew, t)) return s->status;
+        for (int i = 0; i < PDW_NQ; ++i) s->u_prev[i] = s->x[i];
+        memcpy(s->x, xnew, sizeof xnew);
+        s->n++;
+        s->t = s->n * dt;
+        s->n_rhs++;
+    }
+    /* final sample: flags and forces at t_end */
+    const int r = pdw_update_flags(s, s->n * dt);
+    if (r < 0) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
+    pdw_record_final(s, s->n * dt);
+    if (r == 0) s->status = PDW_STATUS_DONE;      /* else: the stop condition's status */
+    return s->status;
+}
