@@ -120,8 +120,10 @@ def rhs(x, params=None, flags=(0, 1), anchors=(0.0, 0.0), variant="paper", featu
             fn = _rhs_function(params, variant, flags, anchors)
         except TypeError:       # unhashable arguments (a list of flags): the general path
             fn = None
-        if fn is not None and np.isfinite(x).all():
-            return fn(0.0, np.ascontiguousarray(x))
+        if fn is not None and x.flags.c_contiguous:
+            out = fn.checked(x)
+            if out is not None:
+                return out
     X, single, *_, xdot, _ = _evaluate(x, params, flags, anchors, variant, features)
     return xdot[0] if single else xdot
 

@@ -1,0 +1,74 @@
+"""Cost of pdw where it meets other software (issue 14).
+
+1. Per call: the model object ``pdw.ode_function`` (f and jac), ``pdw.rhs`` on its fast path
+   (one float64 state, default features) and on the general, checked path (what every call
+   cost before: ``features`` given forces it), against the bare kernel in a C loop.
+2. ``simulate()`` (default: cdm, dt 1e-4, 3.5 s) in a fresh process, first call, with full
+   recording vs ``record_every=0``, and a second call in the same process (memory reused).
+
+Interleaved repetitions, medians; the load average is printed (the machine is shared).
+Run: ``.venv/bin/python benchmarks/bench_io.py [--update-docs]``.
+"""
+import os
+import subprocess
+import sys
+import timeit
+
+import numpy as np
+
+from _results import publish
+
+import pdw
+from pdw.core import _core
+from pdw.core.model import parameter_vector
+
+X = np.array(pdw.X0_PAPER)
+FRESH = r"""
+import time, sys, pdw
+rec = int(sys.argv[1])
+t0 = time.perf_counter(); pdw.simulate(record_every=rec, check_step="off"); t1 = time.perf_counter()
+pdw.simulate(record_every=rec, check_step="off"); t2 = time.perf_counter()
+print(t1 - t0, t2 - t1)
+"""
+
+
+def per_call(fn, n):
+    return min(timeit.repeat(fn, number=n, repeat=5)) / n * 1e6
+
+
+def main():
+    f = pdw.ode_function()
+    XL = X.tolist()    # a list takes the general path, the code every call ran before
+    rows = {k: [] for k in ("kernel rhs (C loop)", "kernel jacobian (C loop)", "ode_function f(t, x)",
+                            "ode_function jac(t, x)", "ode_function batch, per state (N=10^4)",
+                            "pdw.rhs fast path", "pdw.rhs general path (= before)")}
+    XB = np.tile(X, (10_000, 1))
+    p = parameter_vector(None)
+    for _ in range(3):
+        rows["kernel rhs (C loop)"].append(_core.bench(0, "rhs", X, p, 0, 1, 0, 0, 10**6) / 1e3)
+        rows["kernel jacobian (C loop)"].append(_core.bench(0, "jacobian", X, p, 0, 1, 0, 0, 10**5) / 1e3)
+        rows["ode_function f(t, x)"].append(per_call(lambda: f(0.0, X), 20_000))
+        rows["ode_function jac(t, x)"].append(per_call(lambda: f.jac(0.0, X), 20_000))
+        rows["ode_function batch, per state (N=10^4)"].append(per_call(lambda: f.batch(XB), 20) / 1e4)
+        rows["pdw.rhs fast path"].append(per_call(lambda: pdw.rhs(X), 10_000))
+        rows["pdw.rhs general path (= before)"].append(per_call(lambda: pdw.rhs(XL), 2_000))
+    lines = ["# bench_io: per-call cost [us] (median of 3 interleaved rounds, each the best of 5)",
+             "# load average before: %s" % (os.getloadavg(),)]
+    for k, v in rows.items():
+        lines.append("%-42s %8.3f us" % (k, np.median(v)))
+    fresh = {1: [], 0: []}
+    for _ in range(5):
+        for rec in (1, 0):
+            out = subprocess.run([sys.executable, "-c", FRESH, str(rec)], capture_output=True,
+                                 text=True, check=True).stdout.split()
+            fresh[rec].append([float(v) * 1e3 for v in out])
+    lines.append("# simulate() default (cdm, dt 1e-4, 3.5 s), fresh process, median of 5 interleaved")
+    for rec, name in ((1, "full recording"), (0, "record_every=0")):
+        a = np.median(np.array(fresh[rec]), axis=0)
+        lines.append("%-42s first call %7.2f ms, second call %7.2f ms" % (name, a[0], a[1]))
+    lines.append("# load average after: %s" % (os.getloadavg(),))
+    publish("io.txt", lines)
+
+
+if __name__ == "__main__":
+    main()
