@@ -15,9 +15,11 @@ import numpy as np
 
 from ..core import _core, _layout
 from ..core.errors import DivergedError, InvalidInputError, SingularSystemError
+from ..core import integrators as _integrators
 from ..core.integrators import METHODS
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
 from ..core.params import X0_PAPER, Params
+from . import dense as _dense
 from . import stepsize as _stepsize
 from .gait import Steps, steps_from_rows
 
@@ -81,6 +83,8 @@ class Result:
         ``"t_end"``, ``"steps"`` (stop_steps reached), ``"periodic"``, or the failure status.
     energies : dict or None
         With ``record_energies``: T, V_gravity, V_hip and E [J] at the recorded samples.
+    sol : DenseOutput or None
+        With ``dense_output=True``: the interpolant between accepted steps (`pdw.sim.dense`).
     """
 
     t: np.ndarray
@@ -109,6 +113,7 @@ class Result:
     energies: dict | None = None
     features: tuple = _layout.FEATURES
     scene: object = None
+    sol: object = None
 
     @property
     def walked(self) -> bool:
@@ -172,7 +177,8 @@ _DEFAULTS = dict(t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
                  record_every=1, record_forces=True, on_failure="raise", fall_hip_height=None,
                  fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8, h_max=None, event_tol=1e-9,
                  features=None, record_events=True, record_energies=False, stop_steps=0,
-                 periodic_steps=0, periodic_tol=1e-3, check_step="warn")
+                 periodic_steps=0, periodic_tol=1e-3, check_step="warn", t_eval=None,
+                 dense_output=False)
 
 
 def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
@@ -180,7 +186,7 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
              fall_hip_height=None, fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8,
              h_max=None, event_tol=1e-9, *, features=None, record_events=True,
              record_energies=False, stop_steps=0, periodic_steps=0, periodic_tol=1e-3,
-             check_step="warn"):
+             check_step="warn", t_eval=None, dense_output=False):
     """Simulate the walker from ``x0`` for ``t_end`` seconds (or run a `pdw.Scene`).
 
     ``simulate(scene)`` runs the scene (as `pdw.run`); no other argument may be given then.
@@ -246,6 +252,15 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
         Fixed-step methods: compare dt with `pdw.sim.stepsize.step_limit` (the method's estimated
         stability limit for these parameters) and warn (`pdw.StepSizeWarning`) or refuse
         (`pdw.StepSizeError`) above it, naming the limit and the force that sets it.
+    t_eval : array_like (M,), optional
+        Times [s] (non-decreasing, in [0, t_end]) at which to return the solution, as
+        ``solve_ivp``: ``Result.t`` is then t_eval (up to the run's end) and ``x``, ``flags``,
+        ``Fn``, ``Ft`` (and ``energies``) are their values there, from the method's dense
+        output (`pdw.sim.dense`: quintic Hermite for methods of order >= 4, cubic for cdm and
+        verlet). Needs ``record_every=1``.
+    dense_output : bool
+        Also return the interpolant: ``Result.sol(t)`` -> (8,) or (len(t), 8), exact at every
+        accepted step (``Result.sol.t``).
 
     Returns
     -------
@@ -301,6 +316,11 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
         raise InvalidInputError("periodic_steps must be 0 (off) or in [2, %d], got %d"
                                 % (_layout.STEP_RING, periodic_steps))
     periodic_tol = _check_positive("periodic_tol", periodic_tol)
+    if t_eval is not None:
+        t_eval = _dense.check_t_eval(t_eval, t_end)
+    if (t_eval is not None or dense_output) and record_every != 1:
+        raise InvalidInputError("t_eval and dense_output interpolate between the accepted steps: "
+                                "record_every must be 1, got %r" % (record_every,))
 
     k = kernel_index(variant, feats)
     if feats != _layout.FEATURES:
@@ -320,8 +340,12 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
             _core.energies_batch(k, np.ascontiguousarray(raw["x"]), p, e)
         energies = {name: e[:, i] for i, name in enumerate(_layout.ENERGY)}
         energies["E"] = e.sum(axis=1)
-    return _result(raw, params, variant, method, dt, t_end, wall, on_failure, feats,
-                   bool(record_events), energies)
+    res = _result(raw, params, variant, method, dt, t_end, wall, on_failure, feats,
+                  bool(record_events), energies)
+    if t_eval is not None or dense_output:
+        res = _dense.attach(res, t_eval, dense_output, params, variant, feats,
+                            _integrators.get(method).order, record_energies)
+    return res
 
 
 def _same(a, b):

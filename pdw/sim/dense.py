@@ -1,0 +1,165 @@
+"""Dense output of `pdw.simulate`: a piecewise Hermite interpolant between accepted steps.
+
+Every method records its state at every accepted step (``record_every=1``), and the flags
+recorded at step n are the ones in force on [t_n, t_{n+1}] (the loops update the discrete
+state at a step's start, and adaptive ones end a step at each located flag switch). On that
+interval the solution of x' = f(x; flags_n, anchors_n) (Eq. A.4) is interpolated from the
+recorded end points and their derivatives under the interval's discrete state:
+
+- methods of order >= 4 (``rk4``, ``dopri5``, ``rodas4``): quintic Hermite from x, f(x) and
+  x'' = (df/dx) f at both ends, interpolation error O(h^6) per step, above the methods' order;
+- methods of order <= 2 (``cdm``, ``verlet``): cubic Hermite from x and f(x), O(h^4).
+
+The interpolant passes through the recorded states exactly, is C^1 inside each smooth stretch,
+and its error between steps converges with the method's order (tests/test_dense_output.py).
+The tangential anchors (docs/model.md section 6) are not recorded; they are rebuilt from the
+touch-downs (the rolling coordinate s_i at the step where flag i became 1), as the loops set
+them.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..core import _core
+from ..core.errors import InvalidInputError
+from ..core.model import contact_forces, kernel_index, parameter_vector
+
+
+def _anchors(x, flags, params, variant):
+    """Anchors in force at each recorded step, shape (N, 2) [m]."""
+    s = contact_forces(x, params, flags=(0, 0), variant=variant).s   # s does not use anchors
+    s = np.atleast_2d(s)
+    a = np.zeros((len(x), 2))
+    for i in range(2):
+        f = flags[:, i]
+        down = f.astype(bool) & np.r_[True, f[:-1] == 0]          # touch-downs (and start)
+        last = np.maximum.accumulate(np.where(down, np.arange(len(x)), -1))
+        ok = last >= 0
+        a[ok, i] = s[last[ok], i]
+    return a
+
+
+class DenseOutput:
+    """Piecewise Hermite interpolant of a recorded run; ``sol(t)`` -> (8,) or (len(t), 8).
+
+    Attributes ``t`` (N,), ``x`` (N, 8), ``flags`` (N, 2), ``anchors`` (N, 2) are the recorded
+    steps; ``order`` is 3 (cubic) or 5 (quintic).
+    """
+
+    def __init__(self, t, x, flags, params, variant, features, order):
+        self.t = np.ascontiguousarray(t, dtype=float)
+        self.x = np.ascontiguousarray(x, dtype=float)
+        self.flags = np.ascontiguousarray(flags, dtype=np.intc)
+        if len(self.t) < 2:
+            raise InvalidInputError("dense output needs at least two recorded steps")
+        self.order = order
+        self.anchors = _anchors(self.x, self.flags, params, variant)
+        k = kernel_index(variant, features)
+        p = parameter_vector(params)
+        fl = np.ascontiguousarray(self.flags[:-1])
+        an = np.ascontiguousarray(self.anchors[:-1])
+        n = len(self.t) - 1
+        self._fl, self._an, self._k, self._p = fl, an, k, p
+        ends = []
+        for xs in (np.ascontiguousarray(self.x[:-1]), np.ascontiguousarray(self.x[1:])):
+            f = np.empty((n, 8))
+            _core.rhs_batch(k, xs, p, fl, an, f, np.empty((n, _core.NWORK)))
+            a = None
+            if order == 5:
+                J = np.empty((n, 64))
+                _core.jacobian_batch(k, xs, p, fl, an, J, np.empty((n, _core.NWORK)))
+                a = np.einsum("nij,nj->ni", J.reshape(n, 8, 8), f)
+            ends.append((f, a))
+        (self.f0, self.a0), (self.f1, self.a1) = ends
+
+    def interval(self, tq):
+        """Index n of the step [t_n, t_{n+1}] holding each time (right-continuous)."""
+        i = np.searchsorted(self.t, tq, side="right") - 1
+        return np.clip(i, 0, len(self.t) - 2)
+
+    def __call__(self, tq):
+        tq = np.asarray(tq, dtype=float)
+        scalar = tq.ndim == 0
+        tq = np.atleast_1d(tq)
+        if np.any(tq < self.t[0]) or np.any(tq > self.t[-1]) or not np.isfinite(tq).all():
+            raise InvalidInputError("t must lie in the recorded span [%g, %g] s"
+                                    % (self.t[0], self.t[-1]))
+        i = self.interval(tq)
+        h = self.t[i + 1] - self.t[i]
+        safe = np.where(h > 0, h, 1.0)
+        th = np.where(h > 0, (tq - self.t[i]) / safe, 0.0)[:, None]
+        hh = h[:, None]
+        y0, y1 = self.x[i], self.x[i + 1]
+        if self.order == 3:
+            out = ((2 * th**3 - 3 * th**2 + 1) * y0 + (th**3 - 2 * th**2 + th) * hh * self.f0[i]
+                   + (-2 * th**3 + 3 * th**2) * y1 + (th**3 - th**2) * hh * self.f1[i])
+        else:
+            t2, t3, t4, t5 = th**2, th**3, th**4, th**5
+            out = ((1 - 10 * t3 + 15 * t4 - 6 * t5) * y0
+                   + (th - 6 * t3 + 8 * t4 - 3 * t5) * hh * self.f0[i]
+                   + 0.5 * (t2 - 3 * t3 + 3 * t4 - t5) * hh**2 * self.a0[i]
+                   + 0.5 * (t3 - 2 * t4 + t5) * hh**2 * self.a1[i]
+                   + (-4 * t3 + 7 * t4 - 3 * t5) * hh * self.f1[i]
+                   + (10 * t3 - 15 * t4 + 6 * t5) * y1)
+        out[th[:, 0] == 0.0] = y0[th[:, 0] == 0.0]          # exactly the recorded steps
+        return out[0] if scalar else out
+
+    def flags_at(self, tq):
+        """Support flags in force at each time, shape (len(t), 2)."""
+        return self.flags[self.interval(np.atleast_1d(np.asarray(tq, dtype=float)))]
+
+    def anchors_at(self, tq):
+        return self.anchors[self.interval(np.atleast_1d(np.asarray(tq, dtype=float)))]
+
+
+def check_t_eval(t_eval, t_end):
+    """t_eval as a sorted 1-D array in [0, t_end] [s], or InvalidInputError."""
+    try:
+        te = np.asarray(t_eval, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidInputError("t_eval must be a 1-D array of times [s], got %r"
+                                % (t_eval,)) from None
+    if te.ndim != 1 or len(te) == 0:
+        raise InvalidInputError("t_eval must be a non-empty 1-D array of times [s], got shape %s"
+                                % (te.shape,))
+    if not np.isfinite(te).all() or te[0] < 0 or te[-1] > t_end or np.any(np.diff(te) < 0):
+        raise InvalidInputError("t_eval must be finite, non-decreasing and within [0, t_end = %g] s"
+                                % t_end)
+    return te
+
+
+def resample(res, sol, t_eval, params, variant):
+    """Replace the Result's records (t, x, flags, Fn, Ft) by their values at t_eval (those up to
+    the run's last recorded time); the steps stay in ``res.sol``."""
+    te = t_eval[t_eval <= sol.t[-1]]
+    x = sol(te) if len(te) else np.zeros((0, 8))
+    fl = sol.flags_at(te) if len(te) else np.zeros((0, 2), dtype=np.intc)
+    res.t, res.x, res.flags = te, x, fl
+    if len(res.Fn):
+        Fn = np.zeros((len(te), 2))
+        Ft = np.zeros((len(te), 2))
+        an = sol.anchors_at(te) if len(te) else np.zeros((0, 2))
+        for f in np.unique(fl, axis=0):
+            m = np.all(fl == f, axis=1)
+            for a in np.unique(an[m], axis=0):
+                mm = m & np.all(an == a, axis=1)
+                c = contact_forces(x[mm], params, flags=tuple(int(v) for v in f),
+                                   anchors=tuple(a), variant=variant, features=None)
+                Fn[mm], Ft[mm] = np.atleast_2d(c.F_n), np.atleast_2d(c.F_t)
+        res.Fn, res.Ft = Fn, Ft
+    return res
+
+
+def attach(res, t_eval, dense_output, params, variant, features, order, record_energies):
+    """Give a Result its dense output (``res.sol``) and, with t_eval, its samples there."""
+    sol = DenseOutput(res.t, res.x, res.flags, params, variant, features,
+                      3 if order <= 3 else 5)
+    if t_eval is not None:
+        resample(res, sol, t_eval, params, variant)
+        if record_energies:
+            from ..core.model import energies
+            e = energies(res.x, params) if len(res.x) else {}
+            res.energies = {k: np.atleast_1d(v) for k, v in e.items()}
+    if dense_output:
+        res.sol = sol
+    return res

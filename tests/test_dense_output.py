@@ -1,0 +1,94 @@
+"""simulate(t_eval=..., dense_output=True): the interpolant between accepted steps."""
+import numpy as np
+import pytest
+
+import pdw
+from pdw.sim import dense
+
+# flight: both feet swing, hip 1.5 m above the slope; smooth (gravity, hip spring and damper),
+# no flag change within T
+X_FLIGHT = np.array([0.0, 1.5, -0.3, 0.25, 0.4, 0.5, 2.0, -1.5])
+T = 0.3
+KW = dict(flags0=(0, 0), check_step="off", fall_hip_height=0.1)
+
+
+@pytest.fixture(scope="module")
+def reference():
+    r = pdw.simulate(X_FLIGHT, t_end=T, method="rodas4", rtol=1e-12, atol=1e-14, dt=1e-6,
+                     dense_output=True, **KW)
+    assert r.events == [] and r.walked
+    return r
+
+
+@pytest.mark.parametrize("method", pdw.METHODS)
+def test_t_eval_at_the_recorded_steps_is_the_recorded_state(method):
+    dt = 1e-3
+    r = pdw.simulate(pdw.X0_PAPER, t_end=0.6, method=method, dt=2e-6 if method in ("rk4", "dopri5")
+                     else dt, check_step="off", dense_output=True)
+    pick = r.t[:: max(1, len(r.t) // 50)]
+    s = pdw.simulate(pdw.X0_PAPER, t_end=0.6, method=method, dt=2e-6 if method in ("rk4", "dopri5")
+                     else dt, check_step="off", t_eval=pick)
+    np.testing.assert_array_equal(s.t, pick)
+    idx = np.searchsorted(r.t, pick, side="right") - 1
+    np.testing.assert_array_equal(s.x, r.x[idx])
+    np.testing.assert_array_equal(s.flags, r.flags[idx])
+    np.testing.assert_allclose(s.Fn, r.Fn[idx], rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(s.Ft, r.Ft[idx], rtol=1e-12, atol=1e-9)
+    assert len(r.events) > 0 and [e.t for e in s.events] == [e.t for e in r.events]
+
+
+@pytest.mark.parametrize("method, dts", [("cdm", (4e-3, 2e-3, 1e-3)), ("verlet", (4e-3, 2e-3, 1e-3)),
+                                         ("rk4", (2e-2, 1e-2, 5e-3))])
+def test_between_steps_converges_with_the_method_order(method, dts, reference):
+    order = pdw.core.integrators.get(method).order
+    errs = []
+    for dt in dts:
+        t_mid = (np.arange(int(round(T / dt))) + 0.5) * dt      # midway between steps
+        r = pdw.simulate(X_FLIGHT, t_end=T, method=method, dt=dt, t_eval=t_mid, **KW)
+        errs.append(np.max(np.abs(r.x - reference.sol(t_mid))))
+    observed = np.log2(np.array(errs[:-1]) / np.array(errs[1:]))
+    assert np.all(observed > order - 0.4) and np.all(observed < order + 1.0), (errs, observed)
+
+
+@pytest.mark.parametrize("method", ["dopri5", "rodas4"])
+def test_adaptive_between_steps_is_as_accurate_as_at_steps(method, reference):
+    """Adaptive methods: at each tolerance the error midway between accepted steps is within
+    a small factor of the error at the steps, and both fall with the tolerance."""
+    mids, ats = [], []
+    for rtol in (1e-5, 1e-7, 1e-9):
+        r = pdw.simulate(X_FLIGHT, t_end=T, method=method, rtol=rtol, atol=rtol * 1e-2, dt=1e-4,
+                         dense_output=True, **KW)
+        tm = 0.5 * (r.sol.t[1:] + r.sol.t[:-1])
+        mids.append(np.max(np.abs(r.sol(tm) - reference.sol(tm))))
+        ats.append(np.max(np.abs(r.x - reference.sol(r.t))))
+    assert mids[0] > 10 * mids[2], mids
+    assert all(m < 5 * a + 1e-12 for m, a in zip(mids, ats)), (mids, ats)
+
+
+def test_quintic_interpolant_is_exact_for_quintics():
+    """The basis reproduces a degree-5 polynomial from values and two derivatives."""
+    t = np.array([0.0, 0.7, 1.5])
+    c = np.arange(1, 7.0)
+    P = np.polynomial.Polynomial(c)
+    sol = dense.DenseOutput.__new__(dense.DenseOutput)
+    sol.t, sol.order = t, 5
+    sol.x = np.repeat(P(t)[:, None], 8, axis=1)
+    sol.f0 = sol.f1 = None
+    d1, d2 = P.deriv(1), P.deriv(2)
+    sol.f0 = np.repeat(d1(t[:-1])[:, None], 8, axis=1)
+    sol.f1 = np.repeat(d1(t[1:])[:, None], 8, axis=1)
+    sol.a0 = np.repeat(d2(t[:-1])[:, None], 8, axis=1)
+    sol.a1 = np.repeat(d2(t[1:])[:, None], 8, axis=1)
+    tq = np.linspace(0, 1.5, 37)
+    np.testing.assert_allclose(sol(tq)[:, 3], P(tq), rtol=1e-12)
+
+
+@pytest.mark.parametrize("bad", [[0.2, 0.1], [-0.1], [0.0, 99.0], [[0.1]], [np.nan]])
+def test_bad_t_eval_is_refused(bad):
+    with pytest.raises(pdw.InvalidInputError, match="t_eval"):
+        pdw.simulate(t_end=0.5, t_eval=bad)
+
+
+def test_t_eval_needs_every_step_recorded():
+    with pytest.raises(pdw.InvalidInputError, match="record_every"):
+        pdw.simulate(t_end=0.5, t_eval=[0.1], record_every=10)
