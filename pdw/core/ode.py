@@ -12,8 +12,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from . import _core, _layout
 from .errors import InvalidInputError
 from .model import check_variant, kernel_index, parameter_vector

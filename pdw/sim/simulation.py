@@ -14,8 +14,8 @@ from typing import NamedTuple
 import numpy as np
 
 from ..core import _core, _layout
-from ..core.errors import DivergedError, InvalidInputError, SingularSystemError
 from ..core import integrators as _integrators
+from ..core.errors import DivergedError, InvalidInputError, SingularSystemError
 from ..core.integrators import METHODS
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
 from ..core.params import X0_PAPER, Params

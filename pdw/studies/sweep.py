@@ -39,7 +39,6 @@ import math
 import os
 import pathlib
 import platform
-import subprocess
 import sys
 import time
 
@@ -47,6 +46,7 @@ import numpy as np
 
 from ..core.errors import InvalidInputError, PdwError
 from ..core.params import Params
+from ..core.provenance import source_revision
 from .study import COLUMNS, Study, load_study, parse_study  # noqa: F401 (pdw.sweep.parse_study)
 
 # --- the worker -------------------------------------------------------------------------------
@@ -228,15 +228,9 @@ class Progress:
 # --- provenance -----------------------------------------------------------------------------------
 
 def git_describe(path=None):
-    """``git describe --always --dirty --tags`` of the repository holding ``path`` (default:
-    this package), or None."""
-    where = pathlib.Path(path or __file__).resolve().parent
-    try:
-        out = subprocess.run(["git", "-C", str(where), "describe", "--always", "--dirty",
-                              "--tags"], capture_output=True, text=True, timeout=10)
-    except (OSError, subprocess.SubprocessError):
-        return None
-    return out.stdout.strip() or None if out.returncode == 0 else None
+    """pdw's own source revision (`pdw.core.provenance.source_revision`; ``path``: another
+    pdw package directory), or None when pdw is not imported from its git checkout."""
+    return source_revision(None if path is None else str(path))
 
 
 def provenance(study, **extra) -> dict:
