@@ -15,7 +15,6 @@ import sys
 import timeit
 
 import numpy as np
-
 from _results import publish
 
 import pdw

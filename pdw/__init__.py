@@ -63,6 +63,7 @@ from .core.ode import OdeFunction, ode_function
 from .core.params import X0_DISTURBED, X0_PAPER, Params
 from .sim import scene
 from .sim.gait import Steps, steps
+from .sim.io import load
 from .sim.scene import Scene, run
 from .sim.simulation import Event, Result, simulate
 from .studies import sweep
@@ -81,5 +82,5 @@ __all__ = [
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait", "Scene", "run",
     "limit_cycle", "cell_mapping", "find_gait", "sweep",
     "StepSizeWarning", "StepSizeError", "examples", "continue_gait", "Branch", "Bifurcation",
-    "ode_function", "OdeFunction",
+    "ode_function", "OdeFunction", "load",
 ]

@@ -54,6 +54,11 @@ class Steps:
             out["spread_" + name] = float(np.max(np.abs(np.diff(a)))) if len(a) > 1 else float("nan")
         return out
 
+    def to_dataframe(self):
+        """One row per step as a pandas DataFrame (`pdw.sim.io.steps_to_dataframe`)."""
+        from .io import steps_to_dataframe
+        return steps_to_dataframe(self)
+
     def describe_step(self, k: int = -1) -> str:
         """One step in words: ``"leg 2, L 0.3685 m, P 0.5644 s, v 0.653 m/s, double support
         16.5 ms (2.84 %)"`` (the last complete step by default)."""

@@ -114,6 +114,7 @@ class Result:
     features: tuple = _layout.FEATURES
     scene: object = None
     sol: object = None
+    provenance: dict | None = None
 
     @property
     def walked(self) -> bool:
@@ -140,6 +141,21 @@ class Result:
         if self.failure:
             lines.append("  failure: %s at t = %.6g s" % (self.failure["reason"], self.failure["t"]))
         return "\n".join(lines) + ">"
+
+    def to_dataframe(self):
+        """The recorded samples as a pandas DataFrame (`pdw.sim.io.result_to_dataframe`)."""
+        from .io import result_to_dataframe
+        return result_to_dataframe(self)
+
+    def to_xarray(self):
+        """The run as an xarray Dataset with units and provenance (`pdw.sim.io`)."""
+        from .io import result_to_xarray
+        return result_to_xarray(self)
+
+    def save(self, path):
+        """Write to ``path`` (.npz or .nc) with provenance; read back with `pdw.load`."""
+        from .io import save
+        return save(self, path)
 
     def summary(self) -> str:
         n_ev = sum(self.event_counts.values()) if self.event_counts else len(self.events)
