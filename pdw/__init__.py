@@ -62,6 +62,7 @@ from .core.model import (
 from .core.ode import OdeFunction, ode_function
 from .core.params import X0_DISTURBED, X0_PAPER, Params
 from .sim import scene
+from .sim.buffers import RecordBuffer
 from .sim.gait import Steps, steps
 from .sim.io import load
 from .sim.scene import Scene, run
@@ -82,5 +83,5 @@ __all__ = [
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait", "Scene", "run",
     "limit_cycle", "cell_mapping", "find_gait", "sweep",
     "StepSizeWarning", "StepSizeError", "examples", "continue_gait", "Branch", "Bifurcation",
-    "ode_function", "OdeFunction", "load",
+    "ode_function", "OdeFunction", "load", "RecordBuffer",
 ]

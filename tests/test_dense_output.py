@@ -92,3 +92,18 @@ def test_bad_t_eval_is_refused(bad):
 def test_t_eval_needs_every_step_recorded():
     with pytest.raises(pdw.InvalidInputError, match="record_every"):
         pdw.simulate(t_end=0.5, t_eval=[0.1], record_every=10)
+
+
+@pytest.mark.parametrize("method", ["cdm", "rodas4"])
+def test_record_buffer_gives_the_same_run(method):
+    buf = pdw.RecordBuffer()
+    fresh = pdw.simulate(t_end=0.8, method=method, check_step="off")
+    a = pdw.simulate(t_end=0.8, method=method, check_step="off", out=buf)
+    for k in ("t", "x", "flags", "Fn", "Ft"):
+        np.testing.assert_array_equal(getattr(a, k), getattr(fresh, k))
+    if method == "cdm":
+        assert np.shares_memory(a.x, buf.x)
+        b = pdw.simulate(t_end=0.8, x0=pdw.X0_DISTURBED, method=method, check_step="off", out=buf)
+        assert np.array_equal(a.x, b.x)          # a view: overwritten by the next run
+    with pytest.raises(pdw.InvalidInputError, match="out"):
+        pdw.simulate(t_end=0.1, out=np.zeros(3))

@@ -272,7 +272,8 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         double fall_hip_height, double fall_depth, double max_speed,
         double rtol=1e-6, double atol=1e-8, double h_max=0.0, long max_records=0,
         long event_capacity=256, double event_tol=1e-9, bint record_events=True,
-        long stop_steps=0, int periodic_k=0, double periodic_tol=0.0, double t_end=0.0):
+        long stop_steps=0, int periodic_k=0, double periodic_tol=0.0, double t_end=0.0,
+        buffers=None):
     """Run one simulation in compiled code (GIL released). Returns a dict of arrays and status.
 
     The online gait analysis runs for every method: the result's "gait" holds the last
@@ -314,10 +315,18 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     s.fall_hip_height = fall_hip_height
     s.fall_depth = fall_depth
     s.max_speed = max_speed
-    rec_t = np.zeros(n_rec_cap)
-    rec_x = np.zeros((n_rec_cap, PDW_NX))
-    rec_flags = np.zeros((n_rec_cap, 2), dtype=np.intc)
-    rec_contact = np.zeros((n_rec_cap if record_contact else 0, PDW_NREC))
+    if buffers is not None and record_every > 0:
+        # caller-owned record arrays (reused between runs: no fresh pages to fault in);
+        # an adaptive run that fills them continues in fresh, larger copies
+        rec_t, rec_x, rec_flags, rec_contact = buffers
+        n_rec_cap = rec_t.shape[0]
+        if not record_contact:
+            rec_contact = np.zeros((0, PDW_NREC))
+    else:
+        rec_t = np.zeros(n_rec_cap)
+        rec_x = np.zeros((n_rec_cap, PDW_NX))
+        rec_flags = np.zeros((n_rec_cap, 2), dtype=np.intc)
+        rec_contact = np.zeros((n_rec_cap if record_contact else 0, PDW_NREC))
     events = np.zeros((max(event_capacity, 4) if record_events else 1, PDW_NEVENT))
     cdef double[::1] v_t = rec_t
     cdef double[:, ::1] v_x = rec_x

@@ -21,6 +21,7 @@ from ..core.model import STATE, check_variant, kernel_index, parameter_vector
 from ..core.params import X0_PAPER, Params
 from . import dense as _dense
 from . import stepsize as _stepsize
+from .buffers import RecordBuffer
 from .gait import Steps, steps_from_rows
 
 _STATUS = {i: s for i, s in enumerate(_layout.STATUS)}
@@ -194,7 +195,7 @@ _DEFAULTS = dict(t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
                  fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8, h_max=None, event_tol=1e-9,
                  features=None, record_events=True, record_energies=False, stop_steps=0,
                  periodic_steps=0, periodic_tol=1e-3, check_step="warn", t_eval=None,
-                 dense_output=False)
+                 dense_output=False, out=None)
 
 
 def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
@@ -202,7 +203,7 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
              fall_hip_height=None, fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8,
              h_max=None, event_tol=1e-9, *, features=None, record_events=True,
              record_energies=False, stop_steps=0, periodic_steps=0, periodic_tol=1e-3,
-             check_step="warn", t_eval=None, dense_output=False):
+             check_step="warn", t_eval=None, dense_output=False, out=None):
     """Simulate the walker from ``x0`` for ``t_end`` seconds (or run a `pdw.Scene`).
 
     ``simulate(scene)`` runs the scene (as `pdw.run`); no other argument may be given then.
@@ -277,6 +278,10 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     dense_output : bool
         Also return the interpolant: ``Result.sol(t)`` -> (8,) or (len(t), 8), exact at every
         accepted step (``Result.sol.t``).
+    out : RecordBuffer, optional
+        Record into these reusable arrays (`pdw.sim.buffers.RecordBuffer`) instead of fresh
+        ones: no page faults on a repeated run. The Result's t, x, flags, Fn, Ft are then views
+        into ``out``, overwritten by the next run that uses it.
 
     Returns
     -------
@@ -344,10 +349,19 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     _stepsize.check_step(dt, params, method, variant, check_step)
     p = parameter_vector(params)
     start = time.perf_counter()
+    buffers = None
+    if out is not None and not isinstance(out, RecordBuffer):
+        raise InvalidInputError("out must be a pdw.RecordBuffer, got %s" % type(out).__name__)
+    if out is not None and record_every:
+        rows = n_steps // int(record_every) + 2
+        if _integrators.get(method).adaptive:     # unknown step count: what the buffer has
+            rows = max(min(rows, 4096), out.capacity)
+        buffers = out.arrays(rows)
     raw = _core.run(k, METHODS.index(method), x, p, f0[0], f0[1], dt, n_steps, int(record_every),
                     bool(record_forces), hip, depth, max_speed, rtol, atol, h_max,
                     event_tol=event_tol, record_events=bool(record_events), stop_steps=stop_steps,
-                    periodic_k=periodic_steps, periodic_tol=periodic_tol, t_end=t_end)
+                    periodic_k=periodic_steps, periodic_tol=periodic_tol, t_end=t_end,
+                    buffers=buffers)
     wall = time.perf_counter() - start
     energies = None
     if record_energies:
