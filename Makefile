@@ -10,7 +10,7 @@ SOURCES := $(wildcard generated/*.c generated/*.h pdw/core/*.pyx pdw/core/csrc/*
 # an extra's requirements, read from pyproject.toml (installed without rebuilding pdw)
 EXTRA_REQS = $(PY) -c "import sys, tomllib; print('\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies'][sys.argv[1]]))"
 
-.PHONY: all run test lint test-all derive check-generated bench study clean distclean
+.PHONY: docs all run test lint test-all derive check-generated bench study clean distclean
 
 all: $(STAMP)
 
@@ -80,3 +80,10 @@ clean:
 
 distclean: clean
 	rm -rf $(VENV) *.egg-info
+
+## docs: the documentation site (Sphinx: API reference, docs/*.md, the executed gallery) in
+## out/docs/html; warnings are errors
+docs: $(STAMP)
+	$(EXTRA_REQS) docs > $(VENV)/requirements-docs.txt
+	$(PIP) install --quiet --disable-pip-version-check -r $(VENV)/requirements-docs.txt
+	$(PY) -m sphinx -W --keep-going -q -b html docs out/docs/html

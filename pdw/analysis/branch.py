@@ -83,7 +83,7 @@ class Branch:
     Per-point arrays have length N (the number of points): ``values`` (parameter), ``period``
     (touch-down to touch-down of the whole n-step cycle [s]), ``step_length`` [m] (mean),
     ``double_support`` [s] (mean; 0 for the hybrid model), ``multipliers`` (N, dim) complex,
-    sorted by decreasing modulus, ``stable`` (all |multiplier| < 1), ``state`` (N, 4 hybrid /
+    sorted by decreasing modulus, ``stable`` (all moduli < 1), ``state`` (N, 4 hybrid /
     8 continuous: the `Gait.state` of each point), ``z`` (N, dim) section coordinates,
     ``orbit`` (N, n, dim) the n section points of each period-n gait (``orbit[:, 0] == z``),
     ``tangents`` (N, dim + 1), ``step_size`` (N: the arclength step that reached the point;
@@ -137,7 +137,7 @@ class Branch:
                "max_abs_multiplier")
 
     def rows(self):
-        """One dict per point (the CSV's rows): the descriptors, |multipliers| and z."""
+        """One dict per point (the CSV's rows): the descriptors, the moduli of the multipliers and z."""
         out = []
         for i in range(len(self)):
             m = self.multipliers[i]

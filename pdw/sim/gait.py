@@ -45,7 +45,7 @@ class Steps:
 
     def steady(self, last: int = 4) -> dict:
         """Mean of the last ``last`` complete steps, and how much successive steps still
-        differ there (``spread_<name>``: largest |difference| between consecutive steps)."""
+        differ there (``spread_<name>``: largest absolute difference between consecutive steps)."""
         out = {"n_steps": len(self), "last": min(last, len(self))}
         for name in ("L", "travel", "P", "v", "cycle", "double_support", "ds_fraction"):
             a = self.table[name]

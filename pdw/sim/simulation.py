@@ -264,7 +264,7 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     periodic_steps, periodic_tol : int, float
         With ``periodic_steps = k >= 2``: stop (status ``"periodic"``) as soon as the last k
         steps agree, each of L, travel, P and cycle within ``periodic_tol`` relative
-        (max - min <= tol |latest|). 0: off.
+        (``max - min <= tol * abs(latest)``). 0: off.
     check_step : {"warn", "error", "off"}
         Fixed-step methods: compare dt with `pdw.sim.stepsize.step_limit` (the method's estimated
         stability limit for these parameters) and warn (`pdw.StepSizeWarning`) or refuse
