@@ -64,9 +64,8 @@ from .core.params import X0_DISTURBED, X0_PAPER, Params
 from .sim import scene
 from .sim.buffers import RecordBuffer
 from .sim.gait import Steps, steps
-from .sim.io import load
 from .sim.scene import Scene, run
-from .sim.simulation import Event, Result, simulate
+from .sim.simulation import Event, Result, load, simulate
 from .studies import sweep
 
 # The public modules of __all__ keep their flat import paths (``import pdw.hybrid``,

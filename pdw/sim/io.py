@@ -4,7 +4,7 @@
   pandas``), one row per recorded sample / per gait step, units in ``df.attrs["units"]``.
 - `result_to_xarray`: an ``xarray.Dataset`` with named dimensions (time, state, leg), units
   per variable and the provenance as attributes (optional dependency ``xarray``).
-- `save` / `load`: a Result to one file and back. ``.npz`` (NumPy only): the arrays plus a
+- `save` / `read` (`pdw.load`): a Result to one file and back. ``.npz`` (NumPy only): the arrays plus a
   JSON ``meta`` entry; ``.nc`` (NetCDF through xarray). Both keep the provenance: pdw version,
   INPUT_HASH, pdw's own source revision (`pdw.core.provenance`), the run's settings (or its
   scene, as TOML) and the time of writing.
@@ -19,9 +19,10 @@ import numpy as np
 
 from ..core import _layout
 from ..core.errors import InvalidInputError
-from ..core.params import Params
 from ..core.provenance import provenance
 
+STEP_UNITS = {"leg": "", "t_lift_off": "s", "t_touch_down": "s", "L": "m", "travel": "m",
+              "P": "s", "v": "m/s", "cycle": "s", "double_support": "s", "ds_fraction": ""}
 UNITS = dict(zip(_layout.STATE, ("m", "m", "rad", "rad", "m/s", "m/s", "rad/s", "rad/s")))
 FORMAT = "pdw-result-1"
 
@@ -69,30 +70,6 @@ def _arrays(res) -> dict:
     return out
 
 
-def _result_from(arrays: dict, meta: dict):
-    from .gait import Steps
-    from .simulation import Event, Result
-    s = meta["settings"]
-    events = [Event(float(e[0]), int(e[1]), _layout.EVENT_KIND[int(e[2])], float(e[3]), float(e[4]))
-              for e in arrays["events"]]
-    gait = {k[5:]: v for k, v in arrays.items() if k.startswith("gait_")}
-    energies = {k[7:]: v for k, v in arrays.items() if k.startswith("energy_")} or None
-    failure = meta["failure"]
-    if failure:
-        failure = dict(failure, x=np.array(failure["x"]))
-    res = Result(t=arrays["t"], x=arrays["x"], flags=arrays["flags"], Fn=arrays["Fn"],
-                 Ft=arrays["Ft"], events=events, status=meta["status"], failure=failure,
-                 x_final=arrays["x_final"], t_final=meta["t_final"], params=Params(**s["params"]),
-                 variant=s["variant"], method=s["method"], dt=s["dt"], t_end=s["t_end"],
-                 n_steps=meta["n_steps"], wall_time=meta["wall_time"], stats=meta["stats"],
-                 gait=Steps(gait) if gait else None, n_gait_steps=meta["n_gait_steps"],
-                 event_counts=meta["event_counts"], events_recorded=meta["events_recorded"],
-                 stop_reason=meta["stop_reason"], energies=energies,
-                 features=tuple(s["features"]))
-    res.provenance = meta
-    return res
-
-
 def save(res, path) -> pathlib.Path:
     """Write a Result to ``path`` (``.npz``, or ``.nc`` through xarray) with its provenance."""
     path = pathlib.Path(path)
@@ -105,9 +82,9 @@ def save(res, path) -> pathlib.Path:
     return path
 
 
-def load(path):
-    """Read a Result written by `save` (``.npz`` or ``.nc``); ``res.provenance`` holds the
-    metadata (pdw version, INPUT_HASH, source revision, settings, scene, time of writing)."""
+def read(path):
+    """(arrays, metadata) of a file written by `save` (``.npz`` or ``.nc``); `pdw.load`
+    makes a Result of them."""
     path = pathlib.Path(path)
     if path.suffix == ".nc":
         xr = _need("xarray")
@@ -125,7 +102,7 @@ def load(path):
         raise InvalidInputError("path must end in .npz or .nc, got %r" % str(path))
     if meta.get("format") != FORMAT:
         raise InvalidInputError("%s is not a pdw result file (format %r)" % (path, meta.get("format")))
-    return _result_from(arrays, meta)
+    return arrays, meta
 
 
 def result_to_dataframe(res):
@@ -153,7 +130,6 @@ def result_to_dataframe(res):
 def steps_to_dataframe(steps):
     """One row per gait step (columns `pdw.core._layout.STEP`); units in ``df.attrs``."""
     pd = _need("pandas")
-    from .gait import UNITS as STEP_UNITS
     df = pd.DataFrame({k: np.asarray(v) for k, v in steps.table.items()})
     df.index.name = "step"
     if "leg" in df:
@@ -180,7 +156,6 @@ def result_to_xarray(res):
     else:
         dv["Fn"] = (("nf", "leg"), a["Fn"], {"units": "N"})
         dv["Ft"] = (("nf", "leg"), a["Ft"], {"units": "N"})
-    from .gait import UNITS as STEP_UNITS
     for k, v in a.items():
         if k.startswith("energy_"):
             dv[k] = (("time",), v, {"units": "J"})

@@ -20,6 +20,7 @@ from ..core.integrators import METHODS
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
 from ..core.params import X0_PAPER, Params
 from . import dense as _dense
+from . import io as _io
 from . import stepsize as _stepsize
 from .buffers import RecordBuffer
 from .gait import Steps, steps_from_rows
@@ -145,18 +146,15 @@ class Result:
 
     def to_dataframe(self):
         """The recorded samples as a pandas DataFrame (`pdw.sim.io.result_to_dataframe`)."""
-        from .io import result_to_dataframe
-        return result_to_dataframe(self)
+        return _io.result_to_dataframe(self)
 
     def to_xarray(self):
         """The run as an xarray Dataset with units and provenance (`pdw.sim.io`)."""
-        from .io import result_to_xarray
-        return result_to_xarray(self)
+        return _io.result_to_xarray(self)
 
     def save(self, path):
         """Write to ``path`` (.npz or .nc) with provenance; read back with `pdw.load`."""
-        from .io import save
-        return save(self, path)
+        return _io.save(self, path)
 
     def summary(self) -> str:
         n_ev = sum(self.event_counts.values()) if self.event_counts else len(self.events)
@@ -448,4 +446,30 @@ def _result(raw, params, variant, method, dt, t_end, wall, on_failure,
                   % (failure["t"], raw["n_steps"], dt, method, failure["reason"],
                      np.array2string(failure["x"], precision=5)),
                   t=failure["t"], x=failure["x"], reason=failure["reason"], result=res)
+    return res
+
+
+def load(path) -> Result:
+    """Read a Result written by `Result.save` (``.npz`` or ``.nc``); ``res.provenance`` holds
+    the metadata (pdw version, INPUT_HASH, pdw's source revision, settings, scene, time of
+    writing)."""
+    arrays, meta = _io.read(path)
+    s = meta["settings"]
+    events = [Event(float(e[0]), int(e[1]), _layout.EVENT_KIND[int(e[2])], float(e[3]), float(e[4]))
+              for e in arrays["events"]]
+    gait = {k[5:]: v for k, v in arrays.items() if k.startswith("gait_")}
+    energies = {k[7:]: v for k, v in arrays.items() if k.startswith("energy_")} or None
+    failure = meta["failure"]
+    if failure:
+        failure = dict(failure, x=np.array(failure["x"]))
+    res = Result(t=arrays["t"], x=arrays["x"], flags=arrays["flags"], Fn=arrays["Fn"],
+                 Ft=arrays["Ft"], events=events, status=meta["status"], failure=failure,
+                 x_final=arrays["x_final"], t_final=meta["t_final"], params=Params(**s["params"]),
+                 variant=s["variant"], method=s["method"], dt=s["dt"], t_end=s["t_end"],
+                 n_steps=meta["n_steps"], wall_time=meta["wall_time"], stats=meta["stats"],
+                 gait=Steps(gait) if gait else None, n_gait_steps=meta["n_gait_steps"],
+                 event_counts=meta["event_counts"], events_recorded=meta["events_recorded"],
+                 stop_reason=meta["stop_reason"], energies=energies,
+                 features=tuple(s["features"]))
+    res.provenance = meta
     return res
