@@ -214,8 +214,9 @@ def test_progress_bar_lines(capsys):
     bar = S.Progress(20, 0, label="x", stream=buf)
     for _ in range(20):
         bar.update()
-    lines = buf.getvalue().splitlines()
-    assert 10 <= len(lines) <= 12 and lines[-1].startswith("x: [") and "20/20 (100%)" in lines[-1]
+    # one mechanism for every long job (pdw.core.progress, tests/test_progress.py): quiet when
+    # the stream is not a terminal
+    assert buf.getvalue() == ""
 
 
 def test_cli_sweep(tmp_path, capsys):

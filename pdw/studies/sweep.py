@@ -25,7 +25,7 @@ the local cores (the compiled loop releases the GIL, so threads run in parallel)
 pool (``backend="process"``), or a Dask cluster unchanged (``executor=client.get_executor()``).
 Each finished point is appended to the CSV at once (flushed), so an interrupted sweep resumes
 from its CSV: rerunning skips the points already there and computes only the others
-(``resume=False`` starts afresh). A progress bar is written to stderr (no dependency).
+(``resume=False`` starts afresh). A progress bar is written to stderr on a terminal (`pdw.core.progress`: tqdm if installed).
 """
 from __future__ import annotations
 
@@ -46,6 +46,7 @@ import numpy as np
 
 from ..core.errors import InvalidInputError, PdwError
 from ..core.params import Params
+from ..core.progress import Progress  # noqa: F401 (pdw.sweep.Progress)
 from ..core.provenance import source_revision
 from .study import COLUMNS, Study, load_study, parse_study  # noqa: F401 (pdw.sweep.parse_study)
 
@@ -181,49 +182,6 @@ def _csv_line(row, header):
 
 
 # --- progress -------------------------------------------------------------------------------------
-
-class Progress:
-    """A plain progress bar on stderr: redrawn in place on a terminal, a line every 10 %
-    otherwise. ``enabled=False`` prints nothing."""
-
-    def __init__(self, total, done=0, label="sweep", stream=None, enabled=True):
-        self.total, self.done, self.label = total, done, label
-        self.start_done = done
-        self.stream = sys.stderr if stream is None else stream
-        self.enabled = enabled and total > 0
-        self.t0 = time.perf_counter()
-        self._last = 0.0
-        self._decile = -1
-        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
-        self.update(0)
-
-    def update(self, n=1):
-        self.done += n
-        if not self.enabled:
-            return
-        now = time.perf_counter()
-        el = now - self.t0
-        new = self.done - self.start_done
-        left = self.total - self.done
-        eta = el / new * left if new > 0 else float("nan")
-        frac = self.done / self.total
-        text = "%s: [%-30s] %d/%d (%3.0f%%) %.1f s, ETA %s" % (
-            self.label, "#" * int(30 * frac), self.done, self.total, 100 * frac, el,
-            "%.1f s" % eta if math.isfinite(eta) else "?")
-        if self.tty:
-            if now - self._last > 0.1 or self.done >= self.total:
-                self.stream.write("\r" + text)
-                if self.done >= self.total:
-                    self.stream.write("\n")
-                self.stream.flush()
-                self._last = now
-        else:
-            dec = int(10 * frac)
-            if dec != self._decile:
-                self._decile = dec
-                self.stream.write(text + "\n")
-                self.stream.flush()
-
 
 # --- provenance -----------------------------------------------------------------------------------
 
