@@ -109,3 +109,16 @@ def test_source_revision_is_pdws_own_not_the_cwds(tmp_path):
     fake.mkdir(parents=True)
     (fake / "__init__.py").write_text("")
     assert provenance.source_revision(str(fake)) is None
+
+
+def test_cli_run_writes_the_trajectory(tmp_path):
+    from pdw.present import cli
+    scene = pdw.Scene(stop={"t_end": 0.5}, integrator={"method": "rodas4"})
+    scene.save(tmp_path / "s.toml")
+    assert cli.main(["run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "o")]) == 0
+    back = pdw.load(tmp_path / "o" / "trajectory.npz")
+    ref = pdw.simulate(scene)
+    np.testing.assert_array_equal(back.x, ref.x)
+    assert pdw.Scene.from_toml(back.provenance["scene"]) == scene
+    meta = json.loads((tmp_path / "o" / "run.json").read_text())
+    assert meta["provenance"]["input_hash"] == pdw.INPUT_HASH

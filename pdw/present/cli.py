@@ -31,6 +31,7 @@ import numpy as np
 from .. import examples
 from ..core.errors import PdwError
 from ..core.integrators import METHODS
+from ..core.provenance import provenance
 from ..sim.gait import steps
 from ..sim.scene import PRESETS, Scene
 from .cli_continue import add_cli as add_continue_cli
@@ -84,7 +85,8 @@ def _jsonable(v):
 
 
 def _write_run(scene, res, st, out) -> list:
-    """steps.csv, run.json and scene.toml of a run in ``out``; returns the paths."""
+    """steps.csv, run.json, scene.toml and (for a run with recorded samples) the trajectory,
+    trajectory.npz (`pdw.load`), of a run in ``out``; returns the paths."""
     out.mkdir(parents=True, exist_ok=True)
     _write_steps_csv(st, out / "steps.csv")
     scene.save(out / "scene.toml")
@@ -92,9 +94,14 @@ def _write_run(scene, res, st, out) -> list:
                 t_final=res.t_final, n_steps=res.n_steps, n_gait_steps=res.n_gait_steps,
                 event_counts=res.event_counts, wall_time_s=res.wall_time, stats=res.stats,
                 params=res.params.as_dict(), features=list(res.features),
-                steady=st.steady() if (len(st) and res.walked) else None, failure=res.failure)
+                steady=st.steady() if (len(st) and res.walked) else None, failure=res.failure,
+                provenance=provenance())
     (out / "run.json").write_text(json.dumps(_jsonable(meta), indent=2) + "\n")
-    return [out / "steps.csv", out / "run.json", out / "scene.toml"]
+    written = [out / "steps.csv", out / "run.json", out / "scene.toml"]
+    if len(res.t):
+        res.scene = scene
+        written.append(res.save(out / "trajectory.npz"))
+    return written
 
 
 # --- pdw walk -----------------------------------------------------------------------------------
