@@ -43,6 +43,8 @@ def load_scene(path) -> dict:
         data = tomllib.loads(path.read_text())
     except (OSError, tomllib.TOMLDecodeError) as e:
         raise PdwError("cannot read scene file %s: %s" % (path, e)) from None
+    except RecursionError:
+        raise PdwError("cannot read scene file %s: TOML nested too deeply" % path) from None
     for key, value in data.items():
         if key not in WALK_KEYS:
             raise PdwError("%s: unknown key %r; allowed: %s" % (path, key, ", ".join(WALK_KEYS)))

@@ -381,10 +381,12 @@ def _honest(raw, status, params, x0, energies):
     reason = None
     if bad.any():
         i = int(np.argmax(bad))
-        reason = ("runaway: the hip rose to y_o = %.4g m (more than %g l above its start) or a leg "
-                  "turned past %.3g rad (theta = %.4g, %.4g): not walking; the step is far too "
-                  "large for these parameters" % (X[i, 1], RUNAWAY_HIP, RUNAWAY_ANGLE, X[i, 2],
-                                                   X[i, 3]))
+        if X[i, 1] > hip_max:
+            reason = ("runaway: the hip rose to y_o = %.4g m, more than %g l above its start "
+                      "(airborne): not walking" % (X[i, 1], RUNAWAY_HIP))
+        else:
+            reason = ("runaway: a leg turned past %.3g rad (theta1, theta2 = %.4g, %.4g): not "
+                      "walking" % (RUNAWAY_ANGLE, X[i, 2], X[i, 3]))
     elif energies is not None and not all(np.isfinite(v).all() for v in energies.values()):
         i = int(np.argmax(~np.isfinite(energies["E"])))
         reason = "the energies are not finite at a finite state (overflow)"

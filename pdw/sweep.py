@@ -31,6 +31,7 @@ from __future__ import annotations
 import concurrent.futures as cf
 import csv
 import dataclasses
+import fcntl
 import datetime
 import hashlib
 import io
@@ -40,14 +41,18 @@ import math
 import os
 import pathlib
 import platform
+import re
+import signal
 import subprocess
 import sys
+import tempfile
+import threading
 import time
 import tomllib
 
 import numpy as np
 
-from . import _layout
+from . import _layout, checks
 from .errors import InvalidInputError, PdwError
 from .params import Params
 from .simulation import METHODS, X0_PAPER
@@ -64,7 +69,14 @@ RUN_DEFAULTS = {"mode": "simulate", "t_end": 16.0, "dt": 1e-4, "steady": 4, "rto
                 "fallback": True}
 #: Result columns of a point (after the index and the axis values).
 COLUMNS = ("status", "gait", "source", "L", "P", "v", "cycle", "double_support", "ds_fraction", "travel",
-           "spread_L", "spread_cycle", "n_steps", "max_multiplier", "t_final", "wall_s", "error")
+           "spread_L", "spread_cycle", "n_steps", "max_multiplier", "t_final", "wall_s", "error",
+           "settings")
+#: A study name is a plain file name: letters, digits, "_", "-", "+", "." (not first).
+NAME_RE = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.+-]{0,99}")
+#: Most points one study may have, and most values one axis may have.
+MAX_POINTS = 10 ** 6
+#: The lock file that keeps a second sweep out of an output folder.
+LOCK_NAME = ".pdw-sweep.lock"
 
 
 # --- the study --------------------------------------------------------------------------------
@@ -102,14 +114,36 @@ class Study:
         return out
 
     def task(self, index, values) -> dict:
-        """The worker's input for one point (plain data: picklable, small)."""
+        """The worker's input for one point (plain data: picklable, small); ``settings`` is
+        the hash of everything that affects the point's row (`settings_hash`)."""
         p = self.base_params().as_dict()
         p.update(values)
-        return {"index": index, "values": dict(values), "params": p, "variant": self.variant,
+        task = {"index": index, "values": dict(values), "params": p, "variant": self.variant,
                 "method": self.method, "run": dict(self.run)}
+        task["settings"] = settings_hash(task)
+        return task
 
     def digest(self) -> str:
         return hashlib.sha256(self.source.encode()).hexdigest()
+
+
+def settings_hash(task) -> str:
+    """16 hex digits of the SHA-256 of everything that decides a point's row: its full
+    parameter set, variant, method, the [run] settings and the model's input hash
+    (`pdw.INPUT_HASH`). A resumed sweep recomputes every row whose hash differs."""
+    key = {"params": task["params"], "variant": task["variant"], "method": task["method"],
+           "run": task["run"], "model": _layout.INPUT_HASH}
+    text = json.dumps(key, sort_keys=True, default=repr)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def check_name(name, where="study"):
+    """A study name must be a plain file name (no folder, no "..", no absolute path)."""
+    if not isinstance(name, str) or not NAME_RE.fullmatch(name) or name in (".", ".."):
+        raise InvalidInputError("%s: name must be a plain file name (letters, digits, '_', '-', "
+                                "'+', '.'; not starting with '.'; at most 100 characters), got %r"
+                                % (where, name))
+    return name
 
 
 def _typecheck(where, key, value, typ):
@@ -127,6 +161,8 @@ def parse_study(text, name="study", path="") -> Study:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise InvalidInputError("%s: not valid TOML: %s" % (where, e)) from None
+    except RecursionError:
+        raise InvalidInputError("%s: TOML nested too deeply" % where) from None
     for k, v in data.items():
         if k not in STUDY_KEYS:
             raise InvalidInputError("%s: unknown key %r; allowed: %s"
@@ -179,8 +215,9 @@ def parse_study(text, name="study", path="") -> Study:
             missing = [k for k in ("start", "stop", "num") if k not in ax]
             if missing:
                 raise InvalidInputError("%s: missing %s (or give values)" % (w, ", ".join(missing)))
-            if ax["num"] < 1:
-                raise InvalidInputError("%s: num must be >= 1" % w)
+            checks.count(w + ": num", ax["num"], lo=1, hi=MAX_POINTS)
+            checks.number(w + ": start", ax["start"])
+            checks.number(w + ": stop", ax["stop"])
             if ax.get("log", False):
                 if ax["start"] <= 0 or ax["stop"] <= 0:
                     raise InvalidInputError("%s: a log axis needs start, stop > 0" % w)
@@ -198,10 +235,11 @@ def parse_study(text, name="study", path="") -> Study:
     if run["mode"] not in ("simulate", "newton"):
         raise InvalidInputError("%s [run]: mode must be 'simulate' or 'newton', got %r"
                                 % (where, run["mode"]))
-    if len(run["x0"]) != 8 or len(run["flags0"]) != 2:
-        raise InvalidInputError("%s [run]: x0 needs 8 numbers and flags0 two" % where)
-    if run["steady"] < 1 or run["t_end"] <= 0 or run["dt"] <= 0:
-        raise InvalidInputError("%s [run]: steady >= 1, t_end > 0, dt > 0 required" % where)
+    _check_run(run, where + " [run]")
+    if int(np.prod([len(v) for _, v in axes])) > MAX_POINTS:
+        raise InvalidInputError("%s: %d points; at most %d" % (
+            where, int(np.prod([len(v) for _, v in axes])), MAX_POINTS))
+    check_name(data.get("name", name), where)
     study = Study(name=data.get("name", name), title=data.get("title", data.get("name", name)),
                   preset=preset, variant=variant, method=method, params=params, axes=axes,
                   run=run, paper=dict(data.get("paper", {})), source=text, path=str(path))
@@ -212,6 +250,20 @@ def parse_study(text, name="study", path="") -> Study:
     except ValueError as e:
         raise InvalidInputError("%s: %s" % (where, e)) from None
     return study
+
+
+def _check_run(run, where):
+    """The [run] table, with the checks `pdw.simulate` applies (pdw.checks)."""
+    from .simulation import DT_MIN
+    from .simulation import check_state
+    run["x0"] = check_state(run["x0"], where + " x0").tolist()
+    run["flags0"] = list(checks.flags(where + " flags0", run["flags0"]))
+    checks.positive(where + " t_end", run["t_end"])
+    checks.number(where + " dt", run["dt"], lo=DT_MIN, hi=run["t_end"])
+    checks.number(where + " rtol", run["rtol"], lo=0.0, hi=1.0, lo_open=True)
+    checks.positive(where + " atol", run["atol"])
+    checks.positive(where + " period_tol", run["period_tol"])
+    checks.count(where + " steady", run["steady"], lo=1, hi=10 ** 6)
 
 
 def load_study(path) -> Study:
@@ -249,6 +301,7 @@ def run_point(task) -> dict:
     t0 = time.perf_counter()
     row = {"index": int(task["index"]), **task["values"]}
     row.update({c: "" for c in COLUMNS})
+    row["settings"] = task.get("settings", "")
     run = task["run"]
     try:
         params = Params(**task["params"])
@@ -317,7 +370,9 @@ def _parse(v):
 
 def read_rows(path, study) -> dict:
     """Rows already in a study's CSV, by index; checks that they belong to ``study`` (same
-    columns, same axis values). Malformed lines (a write cut by a kill) are dropped."""
+    columns, same axis values). Malformed lines (a write cut by a kill), rows computed under
+    other settings (their ``settings`` hash differs: another preset, method, [run], fixed
+    parameter or model) and ``error`` rows are dropped: they are computed again."""
     path = pathlib.Path(path)
     if not path.exists():
         return {}
@@ -344,7 +399,7 @@ def read_rows(path, study) -> dict:
                                for a in study.axis_names):
             raise PdwError("%s: row %s does not match this study's point %s; use a fresh output "
                            "folder or resume=False (--fresh)" % (path, row["index"], pts.get(k)))
-        if row["status"] == "":
+        if row["status"] in ("", "error") or row["settings"] != study.task(k, pts[k])["settings"]:
             continue
         rows[k] = {c: (int(row[c]) if c == "index" else _parse(row[c])) for c in header}
     return rows
@@ -451,12 +506,80 @@ class StudyResult:
             if name not in ("status", "gait", "error") else [r[name] for r in self.rows]
 
 
+def _die_with_parent(ppid):
+    """Process-pool worker initializer: the worker ends when its parent does (even SIGKILLed).
+    Linux: prctl(PR_SET_PDEATHSIG, SIGKILL); everywhere: a thread watching the parent id."""
+    try:
+        import ctypes
+        ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGKILL))   # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+    if os.getppid() != ppid:
+        os._exit(1)
+
+    def watch():
+        while os.getppid() == ppid:
+            time.sleep(1.0)
+        os._exit(1)
+    threading.Thread(target=watch, daemon=True, name="pdw-parent-watch").start()
+
+
+class _FolderLock:
+    """An exclusive lock (fcntl.flock) on ``<out>/.pdw-sweep.lock``: one sweep per folder."""
+
+    def __init__(self, folder):
+        self.path = pathlib.Path(folder) / LOCK_NAME
+        self.f = None
+
+    def __enter__(self):
+        f = open(self.path, "a+")
+        try:
+            fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            f.seek(0)
+            holder = f.read().strip() or "?"
+            f.close()
+            raise PdwError("%s is in use by another sweep (process %s holds %s): wait for it to "
+                           "finish, or write to another folder (--out)"
+                           % (self.path.parent, holder, self.path.name)) from None
+        f.seek(0)
+        f.truncate()
+        f.write("%d\n" % os.getpid())
+        f.flush()
+        self.f = f
+        return self
+
+    def __exit__(self, *exc):
+        fcntl.flock(self.f, fcntl.LOCK_UN)
+        self.f.close()
+        return False
+
+
+def _write_atomic(path, text):
+    """Write ``text`` to ``path`` through a temporary file in the same folder (fsync, rename):
+    readers see the old file or the new one, never a part."""
+    path = pathlib.Path(path)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix="." + path.name + ".", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", newline="") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
 def _make_executor(backend, workers):
     n = max(1, int(workers or os.cpu_count() or 1))
     if backend == "thread":
         return cf.ThreadPoolExecutor(n), n
     if backend == "process":
-        return cf.ProcessPoolExecutor(n), n
+        return cf.ProcessPoolExecutor(n, initializer=_die_with_parent, initargs=(os.getpid(),)), n
     raise InvalidInputError("backend must be 'thread', 'process' or 'serial', got %r" % (backend,))
 
 
@@ -489,8 +612,14 @@ def run_study(study, out=None, *, executor=None, workers=None, backend="thread",
     """
     if not isinstance(study, Study):
         study = load_study(study)
+    check_name(study.name)
     out = pathlib.Path(out or pathlib.Path("out") / "studies" / study.name)
     out.mkdir(parents=True, exist_ok=True)
+    with _FolderLock(out):
+        return _run_locked(study, out, executor, workers, backend, resume, progress, figures)
+
+
+def _run_locked(study, out, executor, workers, backend, resume, progress, figures):
     csv_path, json_path = out / (study.name + ".csv"), out / (study.name + ".json")
     header = _header(study)
     t_start = time.perf_counter()
@@ -498,13 +627,10 @@ def run_study(study, out=None, *, executor=None, workers=None, backend="thread",
     done = read_rows(csv_path, study) if resume else {}
     points = study.points()
     todo = [(k, v) for k, v in points if k not in done]
-    # rewrite the CSV with what is kept (drops torn lines), then append as points finish
-    tmp = csv_path.with_suffix(".csv.tmp")
-    with open(tmp, "w", newline="") as f:
-        f.write(",".join(header) + "\n")
-        for k in sorted(done):
-            f.write(_csv_line(done[k], header))
-    os.replace(tmp, csv_path)
+    # rewrite the CSV with what is kept (drops torn lines and stale rows), then append as
+    # points finish
+    _write_atomic(csv_path, ",".join(header) + "\n"
+                  + "".join(_csv_line(done[k], header) for k in sorted(done)))
 
     own = None
     if executor is None and backend != "serial" and todo:
@@ -553,11 +679,7 @@ def run_study(study, out=None, *, executor=None, workers=None, backend="thread",
         raise error
     rows = [done[k] for k, _ in points]
     # final CSV in index order (atomic)
-    with open(tmp, "w", newline="") as f:
-        f.write(",".join(header) + "\n")
-        for r in rows:
-            f.write(_csv_line(r, header))
-    os.replace(tmp, csv_path)
+    _write_atomic(csv_path, ",".join(header) + "\n" + "".join(_csv_line(r, header) for r in rows))
     wall = time.perf_counter() - t_start
     statuses = {}
     for r in rows:
@@ -575,7 +697,7 @@ def run_study(study, out=None, *, executor=None, workers=None, backend="thread",
             paths["png"] = plot_study(study, rows, out / (study.name + ".png"))
         except ImportError:
             meta["figure"] = "not written: matplotlib is not installed"
-    json_path.write_text(json.dumps(meta, indent=2, default=_jsonable) + "\n")
+    _write_atomic(json_path, json.dumps(meta, indent=2, default=_jsonable) + "\n")
     return StudyResult(study=study, rows=rows, paths=paths, computed=sorted(computed),
                        resumed=sorted(set(done) - set(computed)), wall_s=wall)
 
@@ -638,8 +760,11 @@ def plot_study(study, rows, path):
         axs.flat[0].legend(handles, labels, fontsize=7)
     fig.suptitle("%s\n(%s, variant %s, %s, %s)" % (study.title, study.preset, study.variant,
                                                    study.method, study.run["mode"]), fontsize=9)
-    fig.savefig(path, dpi=110)
+    path = pathlib.Path(path)
+    tmp = path.with_name("." + path.stem + ".%d.tmp%s" % (os.getpid(), path.suffix))
+    fig.savefig(tmp, dpi=110)
     plt.close(fig)
+    os.replace(tmp, path)
     return path
 
 
