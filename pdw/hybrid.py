@@ -404,10 +404,12 @@ def simulate_hybrid(params=None, state0=None, n_steps=10, *, dt_out=0.002, stanc
     t_max = opts.get("t_max", DEFAULT_OPTIONS["t_max"])
     per_step = int(t_max / dt_out) + 4 if dt_out > 0 else int(opts.get("max_steps", 10000)) + 4
     cap = int(n_steps) * min(per_step, 20000)
+    if cap > 10 ** 6:       # a large record: walk unrecorded first (cheap) to size it
+        cap = 0
     res, t, y, k = _hybrid.walk(p, y0, float(s0), int(n_steps), opts, cap)
-    if any(r["rec_full"] for r in res):
-        # the walk went on unrecorded: size the record from the steps it took and walk again
-        # (the steps are deterministic, so the second walk is the first one, recorded whole)
+    if cap == 0 or any(r["rec_full"] for r in res):
+        # size the record from the steps the walk took and walk again (the steps are
+        # deterministic: the second walk is the first one, recorded whole)
         need = sum((int(r["t_strike"] / dt_out) + 4) if dt_out > 0 else r["n_steps"] + 4
                    for r in res) + 16
         if need * 48 > MAX_RECORD_BYTES:

@@ -181,7 +181,9 @@ int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx)
             s->status = PDW_STATUS_RECORDS_FULL;
             return s->status;
         }
-        if (pdw_poll_due(s)) return s->status;
+        /* poll only where a resumed call continues exactly (new_point and last_rejected are
+         * what a fresh call starts with: right after an accepted step) */
+        if (new_point && !last_rejected && pdw_poll_due(s)) return s->status;
         if (s->max_steps > 0 && s->n + s->n_rejected >= s->max_steps) {
             fail_step_size(s);
             s->failure.reason = PDW_REASON_BUDGET;
