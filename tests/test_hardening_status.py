@@ -22,8 +22,7 @@ import numpy as np
 import pytest
 
 import pdw
-from pdw import hybrid
-
+from pdw.analysis import hybrid
 
 # --- finding 2 -------------------------------------------------------------------------------
 
@@ -99,8 +98,8 @@ def test_a_fixed_step_run_longer_than_the_budget_is_refused():
 def test_polling_changes_no_number():
     """The loop returns to Python every POLL_EVERY iterations and resumes exactly: a run with a
     poll every 7 iterations equals one with none, bit for bit (fixed and adaptive)."""
-    from pdw import _core
-    from pdw.model import kernel_index, parameter_vector
+    from pdw.core import _core
+    from pdw.core.model import kernel_index, parameter_vector
     p = parameter_vector(pdw.Params.paper())
     x0 = np.array(pdw.X0_PAPER)
     for m in (0, pdw.METHODS.index("rodas4"), pdw.METHODS.index("rk4")):
@@ -153,7 +152,7 @@ def test_non_finite_energies_at_a_finite_state_make_the_run_diverged():
     """Result.energies used to hold inf/NaN while x was finite (velocities near 1e160 with
     max_speed out of the way): the status check now calls that run diverged, at the last
     sample before the first non-finite energy."""
-    from pdw.simulation import _honest
+    from pdw.sim.simulation import _honest
     r = pdw.simulate(t_end=0.01, record_every=1, check_step="off", record_energies=True)
     raw = {"x": r.x, "t": r.t, "x_final": r.x_final, "t_final": r.t_final,
            "event_counts": {"touch_down": 1}, "failure": None}
@@ -191,5 +190,5 @@ def test_tiny_dt_is_refused_and_singular_advice_is_not_smaller_dt():
     with pytest.raises(pdw.InvalidInputError, match="dt"):
         pdw.simulate(dt=1e-160, t_end=1e-150)
     import inspect
-    src = inspect.getsource(pdw.simulation._result)
+    src = inspect.getsource(pdw.sim.simulation._result)
     assert "Check the masses and inertias" in src
