@@ -114,8 +114,11 @@ def test_polling_changes_no_number():
 
 
 _SIGINT_CHILD = """
-import time, sys
+import signal, time, sys
 import pdw
+# Python's Ctrl-C handler (a background job of a non-interactive shell starts with SIGINT
+# ignored, and Python then leaves it ignored)
+signal.signal(signal.SIGINT, signal.default_int_handler)
 print("start", flush=True)
 t0 = time.time()
 try:
