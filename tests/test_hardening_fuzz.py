@@ -215,31 +215,41 @@ test_fuzz_scene, test_fuzz_scene_study = _twin("scene", _scene, st.fixed_diction
     "run": st.lists(st.tuples(SCENE_KEYS, TOML_VALUE), max_size=3, unique_by=lambda t: t[0]),
 }))
 
-STUDY_TOP = st.sampled_from(["name", "preset", "method", "variant", "title"])
-STUDY_RUN = st.sampled_from(["t_end", "dt", "x0", "flags0", "rtol", "atol", "steady",
-                             "period_tol", "mode", "fallback", "bogus"])
-AXIS_KEY = st.sampled_from(["name", "values", "start", "stop", "num", "log"])
+STUDY_TOP = st.sampled_from(["name", "title", "bogus"])
+STUDY_SCENE = st.sampled_from(["preset", "variant", "x0", "flags0", "bogus"])
+STUDY_RUN = st.sampled_from(["steady", "period_tol", "mode", "fallback", "t_end", "bogus"])
+STUDY_STOP = st.sampled_from(["t_end", "max_speed", "on_failure"])
+STUDY_INTEGRATOR = st.sampled_from(["method", "dt", "rtol", "atol"])
+AXIS_KEY = st.sampled_from(["values", "start", "stop", "num", "log"])
 
 
 def _study(parts):
     text = (_toml(parts["top"]) + "\n[[axes]]\nname = \"k_n\"\n" + _toml(parts["axis"])
-            + "\n[run]\n" + _toml(parts["run"]) + "\n")
+            + "\n[run]\n" + _toml(parts["run"]) + "\n[scene]\n" + _toml(parts["scene"])
+            + "\n[scene.stop]\n" + _toml(parts["stop"])
+            + "\n[scene.integrator]\n" + _toml(parts["integrator"]) + "\n")
     try:
         s = parse_study(text)
     except pdw.InvalidInputError:
         return
     assert "/" not in s.name and not s.name.startswith(".")
     assert 1 <= len(s.points()) <= 10 ** 6
-    r = s.run
-    assert 0 < r["dt"] <= r["t_end"] and math.isfinite(r["rtol"]) and r["flags0"] in ([0, 1], [1, 1],
-                                                                                         [1, 0], [0, 0])
+    sc = s.scene
+    assert 0 < sc.integrator.dt <= sc.stop.t_end and math.isfinite(sc.integrator.rtol)
+    assert tuple(sc.flags0) in ((0, 1), (1, 1), (1, 0), (0, 0))
+    assert np.isfinite(sc.x0).all() and len(sc.x0) == 8
+    assert s.run["steady"] >= 1 and math.isfinite(s.run["period_tol"])
+
+
+def _pairs(keys):
+    return st.lists(st.tuples(keys, TOML_VALUE), max_size=3, unique_by=lambda t: t[0])
 
 
 test_fuzz_study, test_fuzz_study_study = _twin("study", _study, st.fixed_dictionaries({
-    "top": st.lists(st.tuples(STUDY_TOP, TOML_VALUE), max_size=3, unique_by=lambda t: t[0]),
-    "axis": st.lists(st.tuples(AXIS_KEY.filter(lambda k: k != "name"), TOML_VALUE), min_size=1,
-                     max_size=3, unique_by=lambda t: t[0]),
-    "run": st.lists(st.tuples(STUDY_RUN, TOML_VALUE), max_size=3, unique_by=lambda t: t[0]),
+    "top": _pairs(STUDY_TOP), "run": _pairs(STUDY_RUN), "scene": _pairs(STUDY_SCENE),
+    "stop": _pairs(STUDY_STOP), "integrator": _pairs(STUDY_INTEGRATOR),
+    "axis": st.lists(st.tuples(AXIS_KEY, TOML_VALUE), min_size=1, max_size=3,
+                     unique_by=lambda t: t[0]),
 }))
 
 

@@ -74,26 +74,32 @@ name = "s"
 name = "k_n"
 values = [1e5]
 [run]
+%(run)s
+[scene]
+%(scene)s
+[scene.stop]
 t_end = 1.0
-%s
+[scene.integrator]
+%(integrator)s
 """
 
 
-@pytest.mark.parametrize("run,field", [
-    ('x0 = ["0", "0.5", "0", "0", "0", "0", "0", "0"]', "x0"),
-    ("x0 = [0, 0.5, 0, 0]", "x0"),
-    ("flags0 = [5, 7]", "flags0"),
-    ("flags0 = [0.5, 1]", "flags0"),
-    ("dt = 2.0", "dt"),
-    ("rtol = nan", "rtol"),
-    ("atol = -1.0", "atol"),
-    ("period_tol = inf", "period_tol"),
-    ("steady = 0", "steady"),
+@pytest.mark.parametrize("table,line,field", [
+    ("scene", 'x0 = ["0", "0.5", "0", "0", "0", "0", "0", "0"]', "x0"),
+    ("scene", "x0 = [0, 0.5, 0, 0]", "x0"),
+    ("scene", "flags0 = [5, 7]", "flags0"),
+    ("scene", "flags0 = [0.5, 1]", "flags0"),
+    ("integrator", "dt = 2.0", "dt"),
+    ("integrator", "rtol = nan", "rtol"),
+    ("integrator", "atol = -1.0", "atol"),
+    ("run", "period_tol = inf", "period_tol"),
+    ("run", "steady = 0", "steady"),
 ])
-def test_study_run_table_is_checked_as_simulate_checks(run, field):
+def test_study_values_are_checked_as_simulate_checks(table, line, field):
     """Such [run] values loaded, and the sweep exited 0 with every row "error"."""
+    parts = {"run": "", "scene": "", "integrator": "", table: line}
     with pytest.raises(pdw.InvalidInputError, match=field):
-        parse_study(_STUDY % run)
+        parse_study(_STUDY % parts)
 
 
 # --- finding 9: the error's type and field ------------------------------------------------------

@@ -23,15 +23,17 @@ from pdw.studies.study import parse_study
 
 BASE = """
 name = "safe"
+[scene]
 preset = "%(preset)s"
+params = { k_hip = %(k_hip)r }
+[scene.integrator]
 method = "%(method)s"
-[params]
-k_hip = %(k_hip)r
+[scene.stop]
+t_end = %(t_end)r
 [[axes]]
 name = "k_n"
 values = [0.9e5, 1.1e5]
 [run]
-t_end = %(t_end)r
 steady = 2
 fallback = false
 """
@@ -140,12 +142,12 @@ def test_process_workers_die_with_a_sigkilled_parent(tmp_path):
     f = tmp_path / "slow.toml"
     f.write_text(textwrap.dedent("""
         name = "slow"
-        method = "rodas4"
+        [scene.stop]
+        t_end = 200.0
         [[axes]]
         name = "k_n"
         values = [0.9e5, 1.0e5, 1.1e5, 1.2e5]
         [run]
-        t_end = 200.0
         fallback = false
         """))
     parent = subprocess.Popen([sys.executable, "-m", "pdw", "sweep", str(f), "--out",
