@@ -84,7 +84,7 @@ SAN_TESTS ?= tests/test_hardening_boundary.py tests/test_hardening_status.py \
              tests/test_hybrid.py tests/test_integrators.py tests/test_features.py
 sanitize: $(STAMP)
 	rm -rf $(SAN_DIR) && mkdir -p $(SAN_DIR)
-	PDW_CFLAGS="$(SAN_FLAGS)" LDFLAGS="-fsanitize=address,undefined" \
+	PDW_DEBUG=1 PDW_CFLAGS="$(SAN_FLAGS)" LDFLAGS="-fsanitize=address,undefined" \
 	  $(PY) setup.py -q build_ext --build-lib $(SAN_DIR) --build-temp $(SAN_DIR)/tmp
 	tar --exclude='*.so' --exclude='*.c' --exclude='__pycache__' -cf - pdw tests derive docs \
 	  generated pyproject.toml | tar -xf - -C $(SAN_DIR)

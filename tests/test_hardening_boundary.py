@@ -60,6 +60,14 @@ CASES = [
     ("_hybrid.impact(P, np.zeros(2))", "y_minus"),
     ("_hybrid.walk(P, np.zeros(2), 0.0, 3, {}, 10)", "y0"),
     ("_hybrid.solve(np.eye(3), np.zeros(2))", "b"),
+    ("_hybrid.rhs_jac(P, np.zeros(3))", "y"),
+    ("_hybrid.swing_foot_grad(P[:4].copy(), np.zeros(4))", "p"),
+    ("_hybrid.impact_jac(P, np.zeros(1))", "y_minus"),
+    ("_hybrid.step_jac(P, np.zeros(2), {})", "y0"),
+    ("_hybrid.step_jac_batch(P, np.zeros((3, 4)), {}, np.empty((3, 4)), np.empty((1, 4, 4)), "
+     "np.empty(3, np.intc))", "DP"),
+    ("_hybrid.step_jac_batch(P, np.zeros((3, 4)), {}, np.empty((3, 4)), np.empty((3, 4, 4)), "
+     "np.empty(1, np.intc))", "status"),
     ("_hybrid.solve(np.zeros((9, 9)), np.zeros(9))", "A"),
 ]
 
@@ -82,7 +90,8 @@ else:
     print("RETURNED")
 """ % call
     # the entry points that had only an assert are also run under -O (where asserts vanish)
-    had_assert = any(n in call for n in ("precompute", "solve", "full_state_batch", "step_batch"))
+    had_assert = any(n in call for n in ("precompute", "solve", "full_state_batch", "step_batch",
+                                         "step_jac_batch"))
     for flags in ((), ("-O",)) if had_assert else ((),):
         out = _run(code, *flags)
         assert out.returncode == 0, (call, flags, out.returncode, out.stderr[-2000:])

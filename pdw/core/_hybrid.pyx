@@ -298,6 +298,7 @@ def walk(const double[::1] p, const double[::1] y0, double s0, long n_steps, dic
 
 def rhs_jac(const double[::1] p, const double[::1] y):
     """(ydot (4,), A = d ydot / d y (4, 4)) of the stance phase (symbolic Jacobian)."""
+    _py(p, y)
     yd = np.empty(PDW_NHY)
     A = np.empty((PDW_NHY, PDW_NHY))
     cdef double[::1] vy = yd
@@ -309,6 +310,7 @@ def rhs_jac(const double[::1] p, const double[::1] y):
 
 def swing_foot_grad(const double[::1] p, const double[::1] y):
     """d y_sw / d y (4,)."""
+    _py(p, y)
     g = np.empty(PDW_NHY)
     cdef double[::1] v = g
     pdw_hybrid_swing_foot_grad(&y[0], &p[0], &v[0])
@@ -317,6 +319,7 @@ def swing_foot_grad(const double[::1] p, const double[::1] y):
 
 def impact_jac(const double[::1] p, const double[::1] y_minus):
     """d y+ / d y- (4, 4) of the impact-and-relabel map."""
+    _py(p, y_minus, "y_minus")
     D = np.empty((PDW_NHY, PDW_NHY))
     cdef double[:, ::1] v = D
     if pdw_hybrid_impact_jac(&p[0], &y_minus[0], &v[0, 0]):
@@ -330,8 +333,14 @@ def step_jac_batch(const double[::1] p, const double[:, ::1] y0, dict opts,
     cdef pdw_hybrid_opts o
     cdef pdw_hybrid_result r
     cdef Py_ssize_t i, j, n = y0.shape[0]
+    _len("p", p.shape[0], PDW_NP)
+    _rows("y0", n, y0.shape[1], n, PDW_NHY)
+    _rows("y_plus", y_plus.shape[0], y_plus.shape[1], n, PDW_NHY)
+    _len("status", status.shape[0], n)
+    if DP.shape[0] != n or DP.shape[1] != PDW_NHY or DP.shape[2] != PDW_NHY:
+        raise ValueError("DP must have shape (%d, %d, %d), got (%d, %d, %d)"
+                         % (n, PDW_NHY, PDW_NHY, DP.shape[0], DP.shape[1], DP.shape[2]))
     _fill_opts(&o, opts)
-    assert y_plus.shape[0] == n and status.shape[0] == n and DP.shape[0] == n
     with nogil:
         for i in range(n):
             status[i] = pdw_hybrid_step_jac(&p[0], &y0[i, 0], &o, &r, &DP[i, 0, 0])
@@ -344,6 +353,7 @@ def step_jac(const double[::1] p, const double[::1] y0, dict opts):
     cdef pdw_hybrid_opts o
     cdef pdw_hybrid_result r
     cdef int st
+    _py(p, y0, "y0")
     _fill_opts(&o, opts)
     DP = np.full((PDW_NHY, PDW_NHY), np.nan)
     cdef double[:, ::1] v = DP
