@@ -146,7 +146,7 @@ def test_ctrl_c_stops_a_long_compiled_run_within_a_second_with_the_partial_resul
     assert words[0] == "INTERRUPTED", out
     assert words[1] == "interrupted" and int(words[2]) > 0 and int(words[3]) > 0
     assert 0 < float(words[4]) < 1.0
-    assert took < 1.0 + 0.5, took                 # the poll is every 2000 loop iterations
+    assert took < 2.0, took         # the poll is every 2000 iterations (~0.1 s); + the exit
 
 
 # --- finding 9 (statuses and memory) ---------------------------------------------------------
