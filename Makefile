@@ -54,6 +54,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_simulate.py
 	$(PY) benchmarks/bench_integrators.py
 	$(PY) benchmarks/bench_scenes.py
+	$(PY) benchmarks/bench_batch.py
 	$(PY) benchmarks/work_precision.py
 
 ## study: slow studies (marked slow in tests/)
