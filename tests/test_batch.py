@@ -130,3 +130,28 @@ def test_dataframe():
 def test_empty_batch():
     b = simulate_batch(np.zeros((0, 8)), t_end=T_END)
     assert len(b) == 0 and b.x_final.shape == (0, 8)
+
+
+def test_basin_points_are_scalar_walks():
+    """A 3 x 2 basin slice: each point's class follows from its scalar simulate run."""
+    from pdw.analysis import basin as B
+    from pdw.analysis import cell_mapping as cmap
+    from pdw.analysis import limit_cycle as lc
+    b = B.basin(phi=(0.6, 0.9, 3), thetad2=(-3.5, -1.0, 2), t_end=6.0, threads=1)
+    p = pdw.Params.paper_steady()
+    rest = cmap.rest_of(b.reference, p)
+    seen = set()
+    for j, th in enumerate(b.thetad2):
+        for i, ph in enumerate(b.phi):
+            x = lc.embed(cmap.cell_state(ph, th, rest, p), p)
+            r = pdw.simulate(x, t_end=6.0, params=p, flags0=(1, 1), record_every=0,
+                             periodic_steps=4, on_failure="return")
+            assert b.n_steps[j, i] == r.n_gait_steps
+            expect = {"fell": B.FELL, "diverged": B.FELL, "walked": B.UNDECIDED}.get(r.status)
+            if r.status == "periodic":
+                same = (abs(r.gait["L"][-1] - b.gait_L) <= 0.02 * b.gait_L
+                        and abs(r.gait["P"][-1] - b.gait_P) <= 0.02 * b.gait_P)
+                expect = B.GAIT if same else B.OTHER
+            assert b.outcome[j, i] == expect, (ph, th, r.status)
+            seen.add(int(b.outcome[j, i]))
+    assert B.GAIT in seen and B.FELL in seen
