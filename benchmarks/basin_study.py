@@ -2,12 +2,11 @@
 touch-down section, with the ensemble engine (pdw.analysis.basin), and the scalar path's time
 for the same grid extrapolated from a sample of scalar `pdw.simulate` runs.
 
-Run: `.venv/bin/python benchmarks/basin_study.py [N] [SAMPLE]` (N x N grid, default 100; SAMPLE
-scalar runs, default 40). Writes docs/figures/basin_paper_steady.png and
-benchmarks/results/basin.txt.
+Run: `.venv/bin/python benchmarks/basin_study.py [N] [SAMPLE] [--update-docs]` (N x N grid,
+default 100; SAMPLE scalar runs, default 40). Writes basin_paper_steady.png, basin.txt and
+basin.npz under out/benchmarks/ (with --update-docs: docs/figures/, benchmarks/results/).
 """
 import os
-import pathlib
 import sys
 import time
 
@@ -16,7 +15,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from _results import publish  # noqa: E402
+from _results import FIGURES, RESULTS, publish  # noqa: E402
 
 import pdw  # noqa: E402
 from pdw.analysis import basin as B  # noqa: E402
@@ -26,7 +25,7 @@ from pdw.analysis import limit_cycle as lc  # noqa: E402
 N = int(sys.argv[1]) if len(sys.argv) > 1 else 100
 SAMPLE = int(sys.argv[2]) if len(sys.argv) > 2 else 40
 PHI, THD2, T_END = (0.55, 0.95), (-4.0, 0.0), 8.0
-FIG = pathlib.Path(__file__).resolve().parent.parent / "docs" / "figures" / "basin_paper_steady.png"
+FIG = FIGURES / "basin_paper_steady.png"
 
 
 def main():
@@ -50,7 +49,7 @@ def main():
     B.plot(b, ax=ax, title="paper_steady basin, %d x %d touch-down states (cdm, dt = 1e-4)"
            % (N, N))
     fig.tight_layout()
-    FIG.parent.mkdir(exist_ok=True)
+    FIG.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(FIG, dpi=120)
     lines = ["Basin of paper_steady on phi in %s rad x thetad2 in %s rad/s, %d x %d, t_end %g s, "
              "periodic_steps 4" % (PHI, THD2, N, N, T_END),
@@ -68,9 +67,9 @@ def main():
              % (per_scalar * b.walkers, per_scalar * b.walkers / 2),
              "extrapolated for 400 x 400: batch %.0f s, scalar 1 thread %.0f s"
              % (b.wall_time / b.walkers * 160000, per_scalar * 160000),
-             "figure: docs/figures/basin_paper_steady.png"]
+             "figure: %s" % FIG.relative_to(FIG.parents[2])]
     publish("basin.txt", lines)
-    np.savez_compressed(pathlib.Path(__file__).parent / "results" / "basin.npz", phi=b.phi,
+    np.savez_compressed(RESULTS / "basin.npz", phi=b.phi,
                         thetad2=b.thetad2, outcome=b.outcome, n_steps=b.n_steps)
 
 

@@ -7,8 +7,8 @@ a few of which fall), no recording. Interleaved in one process, round by round: 
 on 1 thread, then on 2 threads. Medians of ROUNDS rounds; the load average is printed before
 and after (the machine is shared: read the ratios, taken in the same rounds, before the times).
 
-Run: `make bench` (or `.venv/bin/python benchmarks/bench_batch.py [N] [ROUNDS]`). Writes
-benchmarks/results/batch.txt.
+Run: `make bench` (or `.venv/bin/python benchmarks/bench_batch.py [N] [ROUNDS] [--update-docs]`).
+Writes batch.txt under out/benchmarks/results/ (--update-docs: benchmarks/results/).
 """
 import os
 import statistics
