@@ -155,3 +155,10 @@ def test_basin_points_are_scalar_walks():
             assert b.outcome[j, i] == expect, (ph, th, r.status)
             seen.add(int(b.outcome[j, i]))
     assert B.GAIT in seen and B.FELL in seen
+
+
+def test_threads_and_lanes_are_checked():
+    with pytest.raises(pdw.InvalidInputError, match="threads"):
+        simulate_batch(_states(2), t_end=T_END, threads=0)
+    with pytest.raises(pdw.InvalidInputError, match="lanes"):
+        simulate_batch(_states(2), t_end=T_END, lanes=65)

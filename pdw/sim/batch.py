@@ -218,7 +218,7 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
     lanes = _check_count("lanes", lanes)
     if not 1 <= lanes <= _batch.MAX_LANES:
         raise InvalidInputError("lanes must be in [1, %d], got %d" % (_batch.MAX_LANES, lanes))
-    threads = os.cpu_count() or 1 if threads is None else _check_count("threads", threads)
+    threads = (os.cpu_count() or 1) if threads is None else _check_count("threads", threads)
     if threads < 1:
         raise InvalidInputError("threads must be >= 1, got %d" % threads)
     k = kernel_index(variant, None)
