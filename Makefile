@@ -66,6 +66,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_simulate.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_integrators.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_scenes.py $(UPDATE_DOCS)
+	$(PY) benchmarks/bench_batch.py $(UPDATE_DOCS)
 	$(PY) benchmarks/work_precision.py $(UPDATE_DOCS)
 
 ## study: slow studies (marked slow in tests/), written to out/ (UPDATE_DOCS as for bench)

@@ -151,6 +151,10 @@ void pdw_discrete_init(const pdw_kernel *k, const double *p, const double *x,
  * final sample with pdw_record_final and returns s->status). */
 int pdw_update_flags(pdw_sim *s, double t);
 
+/* pdw_update_flags with the trig of s->x already in s->work (PDW_WORK_TRIG): the ensemble
+ * engine (pdw_batch.c) computes the sin/cos of all its lanes in one vector loop first. */
+int pdw_update_flags_trig(pdw_sim *s, double t);
+
 /* Room for `n` more events (always, when events are not stored)? */
 static inline int pdw_events_room(const pdw_sim *s, long n)
 {
