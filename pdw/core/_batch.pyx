@@ -97,6 +97,24 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     if (status.shape[0] != n or x_final.shape[0] != n or gait.shape[0] != n
             or gait.shape[1] != PDW_STEP_RING or gait.shape[2] != PDW_NSTEP):
         raise ValueError("output arrays do not match N = %d" % n)
+    # every other array, checked before a pointer is taken (issue 16: the compiled boundary)
+    for name, got, want in (
+            ("flags0", (flags0.shape[0], flags0.shape[1]), (n, 2)),
+            ("hip", (hip.shape[0],), (n,)), ("depth", (depth.shape[0],), (n,)),
+            ("out['stop_reason']", (stop_reason.shape[0],), (n,)),
+            ("out['flags_final']", (flags_final.shape[0], flags_final.shape[1]), (n, 2)),
+            ("out['x_final']", (x_final.shape[0], x_final.shape[1]), (n, PDW_NX)),
+            ("out['t_final']", (t_final.shape[0],), (n,)),
+            ("out['n_steps']", (n_taken.shape[0],), (n,)),
+            ("out['n_gait_steps']", (n_gait.shape[0],), (n,)),
+            ("out['n_touch_down']", (n_td.shape[0],), (n,)),
+            ("out['n_lift_off']", (n_lo.shape[0],), (n,)),
+            ("out['fail_reason']", (fail_reason.shape[0],), (n,)),
+            ("out['fail_leg']", (fail_leg.shape[0],), (n,)),
+            ("out['fail_t']", (fail_t.shape[0],), (n,)),
+            ("out['fail_x']", (fail_x.shape[0], fail_x.shape[1]), (n, PDW_NX))):
+        if got != want:
+            raise ValueError("%s must have shape %s, got %s" % (name, want, got))
     if n == 0 or i0 == i1:
         return 0
     cdef pdw_batch_job job
