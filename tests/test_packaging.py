@@ -111,7 +111,11 @@ def test_sdist_tests_pass_against_the_installed_wheel(venv, dists, tmp_path):
     py = venv / "bin" / "python"
     _run([py, "-m", "pip", "install", "--quiet", "--disable-pip-version-check", *reqs])
     env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
-    # the `pytest` script, not `python -m pytest`: the unpacked sources must not shadow the wheel
-    r = _run([venv / "bin" / "pytest", "-q", "-p", "no:cacheprovider", "tests"], cwd=src,
-             timeout=1800, env=env)
+    # run from a neutral folder with the `pytest` script (not `python -m pytest`), so that
+    # neither pytest nor a test's `python -c` subprocess imports the unpacked, uncompiled sources
+    # instead of the installed wheel
+    cwd = tmp_path / "elsewhere"
+    cwd.mkdir()
+    r = _run([venv / "bin" / "pytest", "-q", "-p", "no:cacheprovider", "-c", src / "pyproject.toml",
+              "--rootdir", src, src / "tests"], cwd=cwd, timeout=1800, env=env)
     assert " passed" in r.stdout and " failed" not in r.stdout
