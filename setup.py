@@ -17,7 +17,8 @@ DEBUG = os.environ.get("PDW_DEBUG", "") not in ("", "0")
 extra = ["-O3", "-std=c99", "-fno-math-errno"] + ([] if DEBUG else ["-g0"]) \
     + os.environ.get("PDW_CFLAGS", "").split()
 link = [] if DEBUG or not sys.platform.startswith("linux") else ["-s"]
-hybrid = ["pdw/core/_hybrid.pyx", "generated/pdw_hybrid.c", CSRC + "/pdw_hybrid_sim.c"]
+hybrid = ["pdw/core/_hybrid.pyx", "generated/pdw_hybrid.c", CSRC + "/pdw_hybrid_sim.c",
+          CSRC + "/pdw_hybrid_var.c"]
 sources = (["pdw/core/_core.pyx", "generated/pdw_model.c"]
            + sorted(set(glob.glob(CSRC + "/*.c")) - set(hybrid)))
 

@@ -33,6 +33,7 @@ from ..core.errors import PdwError
 from ..core.integrators import METHODS
 from ..sim.gait import steps
 from ..sim.scene import PRESETS, Scene
+from .cli_continue import add_cli as add_continue_cli
 from .cli_sweep import add_cli as add_sweep_cli
 from .report import walk_report
 
@@ -206,6 +207,7 @@ def _parser():
                    help="list the example scenes and studies shipped with pdw")
     r.add_argument("--out", help="also write steps.csv, run.json and scene.toml to this folder")
     add_sweep_cli(sub)                          # ``pdw sweep STUDY.toml`` (cli_sweep.py)
+    add_continue_cli(sub)                       # ``pdw continue SPEC.toml`` (cli_continue.py)
     return ap
 
 

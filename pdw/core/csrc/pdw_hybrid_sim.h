@@ -98,4 +98,14 @@ long pdw_hybrid_walk(const double *p, const double *y0, double s0, long n_steps,
  * pivoting; returns 0, or -1 when singular. n <= 8. */
 int pdw_hybrid_solve(int n, double *A, double *b, double *x);
 
+/* Exact derivatives (pdw_hybrid_var.c): ydot and A = d ydot / d y (4x4 row-major) of the
+ * stance phase (-1 on a singular M_r); the impact-and-relabel map's derivative D (4x4) at a
+ * pre-impact state; and one step of the map (as pdw_hybrid_step from t0 = s0 = 0, filling r)
+ * with its Jacobian DP = D S Phi(T) (4x4 row-major): the variational equations integrated to
+ * the strike time with the saltation matrix S of the heel-strike event. Return PDW_HYBRID_*. */
+int pdw_hybrid_rhs_jac(const double *y, const double *p, double *ydot, double *A);
+int pdw_hybrid_impact_jac(const double *p, const double *ym, double *D);
+int pdw_hybrid_step_jac(const double *p, const double *y0, const pdw_hybrid_opts *o,
+                        pdw_hybrid_result *r, double *DP);
+
 #endif /* PDW_HYBRID_SIM_H */
