@@ -10,7 +10,7 @@ SOURCES := $(wildcard generated/*.c generated/*.h pdw/core/*.pyx pdw/core/csrc/*
 # an extra's requirements, read from pyproject.toml (installed without rebuilding pdw)
 EXTRA_REQS = $(PY) -c "import sys, tomllib; print('\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies'][sys.argv[1]]))"
 
-.PHONY: all run test lint test-all derive check-generated bench study clean distclean
+.PHONY: all run test lint test-all derive check-generated bench study sanitize clean distclean
 
 all: $(STAMP)
 
@@ -66,6 +66,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_simulate.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_integrators.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_scenes.py $(UPDATE_DOCS)
+	$(PY) benchmarks/bench_batch.py $(UPDATE_DOCS)
 	$(PY) benchmarks/work_precision.py $(UPDATE_DOCS)
 
 ## study: slow studies (marked slow in tests/), written to out/ (UPDATE_DOCS as for bench)
@@ -73,6 +74,28 @@ study: $(STAMP)
 	PDW_UPDATE_DOCS=$(if $(UPDATE_DOCS),1,0) $(PY) -m pytest -q -m slow
 	$(PY) benchmarks/stability_maps.py $(UPDATE_DOCS)
 	$(PY) benchmarks/step_edge_grid.py $(UPDATE_DOCS)
+
+## sanitize: the compiled core built with AddressSanitizer + UndefinedBehaviorSanitizer (in
+## build/sanitize, the normal build untouched), and the tests of the compiled boundary, the loops
+## and the hybrid map run on it (docs/stability.md); any ASan/UBSan report fails the run
+SAN_DIR   := build/sanitize
+SAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined -g
+SAN_TESTS ?= tests/test_hardening_boundary.py tests/test_hardening_status.py \
+             tests/test_hardening_input.py tests/test_hardening_fuzz.py tests/test_simulation.py \
+             tests/test_hybrid.py tests/test_integrators.py tests/test_features.py
+sanitize: $(STAMP)
+	rm -rf $(SAN_DIR) && mkdir -p $(SAN_DIR)
+	PDW_DEBUG=1 PDW_CFLAGS="$(SAN_FLAGS)" LDFLAGS="-fsanitize=address,undefined" \
+	  $(PY) setup.py -q build_ext --build-lib $(SAN_DIR) --build-temp $(SAN_DIR)/tmp
+	tar --exclude='*.so' --exclude='*.c' --exclude='__pycache__' -cf - pdw tests derive docs \
+	  generated pyproject.toml | tar -xf - -C $(SAN_DIR)
+	cd $(SAN_DIR) && ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 \
+	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+	  LD_PRELOAD="$$(gcc -print-file-name=libasan.so) $$(gcc -print-file-name=libubsan.so)" \
+	  $(abspath $(PY)) -c "import pdw.core._core as c; assert '$(SAN_DIR)' in c.__file__, c.__file__" && \
+	  ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+	  LD_PRELOAD="$$(gcc -print-file-name=libasan.so) $$(gcc -print-file-name=libubsan.so)" \
+	  $(abspath $(PY)) -m pytest -q -p no:cacheprovider $(SAN_TESTS)
 
 clean:
 	rm -rf build out

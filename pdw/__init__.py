@@ -13,6 +13,7 @@ mass_matrix             M(q) of Eq. 2
 contact_forces          contact kinematics and forces of both feet (Eqs. 3-11)
 energies                kinetic and potential energies
 simulate, Result        one compiled simulation (support flags, events, status)
+simulate_batch          N walkers in one call, W lanes in lockstep (docs/ensemble.md): BatchResult
 Scene, run              everything a simulation needs, as one object or TOML file (docs/scenes.md)
 steps                   per-step gait descriptors (docs/model.md section 8)
 hybrid                  the rigid-ground impact-momentum model (docs/model.md section 9): find_gait, ...
@@ -60,6 +61,7 @@ from .core.model import (
 )
 from .core.params import X0_DISTURBED, X0_PAPER, Params
 from .sim import scene
+from .sim.batch import BatchResult, simulate_batch
 from .sim.gait import Steps, steps
 from .sim.scene import Scene, run
 from .sim.simulation import Event, Result, simulate
@@ -74,7 +76,7 @@ del _name, _module
 
 __all__ = [
     "Params", "rhs", "jacobian", "mass_matrix", "contact_forces", "ContactState", "energies",
-    "STATE", "VARIANTS", "INPUT_HASH", "simulate", "Result", "Event", "METHODS", "X0_PAPER",
+    "STATE", "VARIANTS", "INPUT_HASH", "simulate", "Result", "simulate_batch", "BatchResult", "Event", "METHODS", "X0_PAPER",
     "X0_DISTURBED", "steps", "Steps", "PdwError", "SimulationError", "DivergedError",
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait", "Scene", "run",
     "limit_cycle", "cell_mapping", "find_gait", "sweep",

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core import _hybrid
+from ..core import _hybrid, checks
 from ..core.errors import (
     FellError,
     InvalidInputError,
@@ -59,13 +59,15 @@ def _p(params):
 
 
 def _state(y, name="state"):
-    arr = np.array(y, dtype=float).reshape(-1)
-    if arr.shape != (4,):
-        raise InvalidInputError("%s must have shape (4,) = %s, got %s"
-                                % (name, list(STATE), np.shape(y)))
-    if not np.isfinite(arr).all():
-        raise InvalidInputError("%s must be finite, got %r" % (name, arr))
-    return np.ascontiguousarray(arr)
+    return np.ascontiguousarray(checks.real_array(name, y, [(4,)], labels=STATE))
+
+
+#: Allowed ranges of the step map's options (lo, hi; both closed unless noted in _OPEN).
+_OPTION_RANGES = {"rtol": (0.0, 1.0), "atol": (0.0, None), "h0": (0.0, None),
+                  "h_max": (0.0, None), "t_max": (0.0, None), "event_tol": (0.0, None),
+                  "min_step_angle": (0.0, np.pi), "fall_angle": (0.0, np.pi),
+                  "dt_out": (0.0, None)}
+_OPEN = {"rtol", "atol", "h0", "h_max", "t_max", "event_tol", "fall_angle"}
 
 
 def _options(options):
@@ -73,7 +75,14 @@ def _options(options):
     if unknown:
         raise InvalidInputError("unknown hybrid option(s) %s; allowed: %s"
                                 % (", ".join(sorted(unknown)), ", ".join(DEFAULT_OPTIONS)))
-    return {k: (int(v) if k == "max_steps" else float(v)) for k, v in options.items()}
+    out = {}
+    for k, v in options.items():
+        if k == "max_steps":
+            out[k] = checks.count("max_steps", v, lo=1, hi=10 ** 9)
+        else:
+            lo, hi = _OPTION_RANGES[k]
+            out[k] = checks.number(k, v, lo=lo, hi=hi, lo_open=k in _OPEN)
+    return out
 
 
 # --- the reduced model, pointwise ------------------------------------------------------------
@@ -111,7 +120,7 @@ def full_state(y, params=None, s0=0.0, stance_leg=1) -> np.ndarray:
     """Full-model state(s) [x_o, y_o, theta1, theta2, ...] (docs/model.md section 2) of reduced
     state(s) y, shape (4,) or (N, 4); ``s0`` the stance foot's rolling coordinate, and
     ``stance_leg`` (1 or 2, scalar or per row) which leg is in stance."""
-    Y = np.ascontiguousarray(np.atleast_2d(np.asarray(y, dtype=float)))
+    Y = np.ascontiguousarray(np.atleast_2d(checks.real_array("y", y, [(4,), (-1, 4)])))
     X = np.empty((len(Y), 8))
     _hybrid.full_state_batch(_p(params), Y, X)
     X[:, 0] += np.broadcast_to(np.asarray(s0, dtype=float), (len(Y),))
@@ -374,6 +383,10 @@ class HybridTrajectory:
         return np.array([s["x_touch"] for s in self.steps if s["status"] == "ok"])
 
 
+#: Largest record `simulate_hybrid` allocates [bytes] (48 bytes a sample).
+MAX_RECORD_BYTES = 4e9
+
+
 def simulate_hybrid(params=None, state0=None, n_steps=10, *, dt_out=0.002, stance_leg=2,
                     s0=0.0, **options) -> HybridTrajectory:
     """Walk ``n_steps`` steps of the hybrid model from ``state0`` (reduced, `STATE`).
@@ -387,15 +400,32 @@ def simulate_hybrid(params=None, state0=None, n_steps=10, *, dt_out=0.002, stanc
     params = Params.paper_steady() if params is None else params
     if stance_leg not in (1, 2):
         raise InvalidInputError("stance_leg must be 1 or 2, got %r" % (stance_leg,))
-    if int(n_steps) < 1:
-        raise InvalidInputError("n_steps must be >= 1, got %r" % (n_steps,))
+    n_steps = checks.count("n_steps", n_steps, lo=1, hi=10 ** 7)
+    s0 = checks.number("s0", s0)
     opts = _options({**options, "dt_out": dt_out})
+    dt_out = opts["dt_out"]
     p = _p(params)
     y0 = find_gait(params).state if state0 is None else _state(state0, "state0")
     t_max = opts.get("t_max", DEFAULT_OPTIONS["t_max"])
     per_step = int(t_max / dt_out) + 4 if dt_out > 0 else int(opts.get("max_steps", 10000)) + 4
     cap = int(n_steps) * min(per_step, 20000)
+    if cap > 10 ** 6:       # a large record: walk unrecorded first (cheap) to size it
+        cap = 0
     res, t, y, k = _hybrid.walk(p, y0, float(s0), int(n_steps), opts, cap)
+    if cap == 0 or any(r["rec_full"] for r in res):
+        # size the record from the steps the walk took and walk again (the steps are
+        # deterministic: the second walk is the first one, recorded whole)
+        need = sum((int(r["t_strike"] / dt_out) + 4) if dt_out > 0 else r["n_steps"] + 4
+                   for r in res) + 16
+        if need * 48 > MAX_RECORD_BYTES:
+            raise InvalidInputError(
+                "simulate_hybrid: recording %d steps at dt_out = %g needs %d samples (%.3g GB, "
+                "more than %.3g GB): use a larger dt_out" % (n_steps, dt_out, need,
+                                                             need * 48 / 1e9, MAX_RECORD_BYTES / 1e9))
+        res, t, y, k = _hybrid.walk(p, y0, float(s0), int(n_steps), opts, need)
+        if any(r["rec_full"] for r in res):      # cannot happen; never report it as ok
+            raise SimulationError("simulate_hybrid: the record of %d samples was still too small"
+                                  % need)
     legs = np.where(k % 2 == 0, stance_leg, 3 - stance_leg)
     s0s = np.array([r["s0"] for r in res])
     x = full_state(y, params, s0=s0s[k], stance_leg=legs) if len(y) else np.empty((0, 8))

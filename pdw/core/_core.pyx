@@ -7,6 +7,7 @@ C headers). Time loops release the GIL and are entered once per simulation.
 """
 import numpy as np
 
+from cpython.exc cimport PyErr_CheckSignals
 from libc.string cimport memset, memcpy
 
 
@@ -59,6 +60,8 @@ cdef extern from "pdw_sim.h":
         long n_touch_down, n_lift_off
         double ring[1][1]
     ctypedef struct pdw_sim:
+        long poll_every
+        long max_steps
         const pdw_kernel *kernel
         double p[32]
         double dt
@@ -107,7 +110,7 @@ cdef extern from "pdw_sim.h":
                            const int *flags0, pdw_discrete *d, double *work) noexcept nogil
     void pdw_gait_init(pdw_gait *g) noexcept nogil
     enum:
-        PDW_STATUS_RECORDS_FULL
+        PDW_STATUS_RECORDS_FULL, PDW_STATUS_POLL
 
 
 cdef extern from "pdw_tableaus.h":
@@ -159,16 +162,57 @@ cdef const pdw_kernel *_kernel(int k) except NULL:
     return &pdw_kernels[k]
 
 
+# --- the boundary: every shape is checked once per call, before a pointer is taken -----------
+
+cdef int _len(str name, Py_ssize_t got, Py_ssize_t want) except -1:
+    if got != want:
+        raise ValueError("%s must have shape (%d,), got (%d,)" % (name, want, got))
+    return 0
+
+
+cdef int _rows(str name, Py_ssize_t r, Py_ssize_t c, Py_ssize_t want_r, Py_ssize_t want_c) except -1:
+    if r != want_r or c != want_c:
+        raise ValueError("%s must have shape (%d, %d), got (%d, %d)" % (name, want_r, want_c, r, c))
+    return 0
+
+
+cdef int _flags_ok(const int[:, ::1] flags) except -1:
+    cdef Py_ssize_t i, j
+    for i in range(flags.shape[0]):
+        for j in range(2):
+            if flags[i, j] != 0 and flags[i, j] != 1:
+                raise ValueError("flags[%d, %d] must be 0 or 1, got %d" % (i, j, flags[i, j]))
+    return 0
+
+
+cdef int _batch(const double[:, ::1] x, const double[::1] p, const int[:, ::1] flags,
+                const double[:, ::1] anchors, str out_name, Py_ssize_t out_r, Py_ssize_t out_c,
+                Py_ssize_t want_out_c, const double[:, ::1] work) except -1:
+    cdef Py_ssize_t n = x.shape[0]
+    _rows("x", n, x.shape[1], n, PDW_NX)
+    _len("p", p.shape[0], PDW_NP)
+    _rows("flags", flags.shape[0], flags.shape[1], n, 2)
+    _rows("anchors", anchors.shape[0], anchors.shape[1], n, 2)
+    _rows(out_name, out_r, out_c, n, want_out_c)
+    _rows("work", work.shape[0], work.shape[1], n, PDW_NWORK)
+    _flags_ok(flags)
+    return 0
+
+
 def precompute(const double[::1] params, double[::1] p):
     """Fill the kernel parameter vector p (NP,) from the physical parameters (NPARAM,)."""
-    assert params.shape[0] == PDW_NPARAM and p.shape[0] == PDW_NP
+    _len("params", params.shape[0], PDW_NPARAM)
+    _len("p", p.shape[0], PDW_NP)
     pdw_precompute(&params[0], &p[0])
 
 
 def rhs_batch(int k, const double[:, ::1] x, const double[::1] p, const int[:, ::1] flags,
               const double[:, ::1] anchors, double[:, ::1] xdot, double[:, ::1] work):
-    """f(x) (Eq. A.4) for each row; work (N, NWORK) receives every stage's output."""
+    """f(x) (Eq. A.4) for each row; work (N, NWORK) receives every stage's output.
+
+    Shapes (checked): x, xdot (N, NX); p (NP,); flags (N, 2) of 0/1; anchors (N, 2)."""
     cdef const pdw_kernel *kern = _kernel(k)
+    _batch(x, p, flags, anchors, "xdot", xdot.shape[0], xdot.shape[1], PDW_NX, work)
     cdef Py_ssize_t i, n = x.shape[0]
     with nogil:
         for i in range(n):
@@ -179,6 +223,7 @@ def jacobian_batch(int k, const double[:, ::1] x, const double[::1] p, const int
                    const double[:, ::1] anchors, double[:, ::1] J, double[:, ::1] work):
     """df/dx (8x8 row-major per row of J, shape (N, 64)); work as in rhs_batch, with partials."""
     cdef const pdw_kernel *kern = _kernel(k)
+    _batch(x, p, flags, anchors, "J", J.shape[0], J.shape[1], PDW_NX * PDW_NX, work)
     cdef Py_ssize_t i, n = x.shape[0]
     with nogil:
         for i in range(n):
@@ -186,9 +231,12 @@ def jacobian_batch(int k, const double[:, ::1] x, const double[::1] p, const int
 
 
 def energies_batch(int k, const double[:, ::1] x, const double[::1] p, double[:, ::1] e):
-    """T, V_gravity, V_hip for each row of x."""
+    """T, V_gravity, V_hip for each row of x (N, NX) into e (N, NENERGY)."""
     cdef const pdw_kernel *kern = _kernel(k)
     cdef Py_ssize_t i, n = x.shape[0]
+    _rows("x", n, x.shape[1], n, PDW_NX)
+    _len("p", p.shape[0], PDW_NP)
+    _rows("e", e.shape[0], e.shape[1], n, PDW_NENERGY)
     cdef double trig[4]
     with nogil:
         for i in range(n):
@@ -198,8 +246,16 @@ def energies_batch(int k, const double[:, ::1] x, const double[::1] p, double[:,
 
 def cdm_terms(int k, const double[::1] x, const double[::1] p, const double[::1] contact,
               double[::1] M, double[::1] C, double[::1] QmG):
-    """M, the appendix C matrix and Q_f - G at x for given contact forces (central difference)."""
+    """M, the appendix C matrix and Q_f - G at x for given contact forces (central difference).
+
+    Shapes (checked): x (NX,), p (NP,), contact (2 NCONTACT,), M, C (NQ*NQ,), QmG (NQ,)."""
     cdef const pdw_kernel *kern = _kernel(k)
+    _len("x", x.shape[0], PDW_NX)
+    _len("p", p.shape[0], PDW_NP)
+    _len("contact", contact.shape[0], 2 * PDW_NCONTACT)
+    _len("M", M.shape[0], PDW_NQ * PDW_NQ)
+    _len("C", C.shape[0], PDW_NQ * PDW_NQ)
+    _len("QmG", QmG.shape[0], PDW_NQ)
     cdef double trig[4]
     pdw_trig(&x[0], trig)
     kern.cdm_terms(&x[0], trig, &p[0], &contact[0], &M[0], &C[0], &QmG[0])
@@ -213,6 +269,12 @@ def bench(int k, str what, const double[::1] x, const double[::1] p, int f1, int
     cdef double anchors[2]
     cdef double work[PDW_NWORK]
     cdef double sink = 0.0, ns
+    _len("x", x.shape[0], PDW_NX)
+    _len("p", p.shape[0], PDW_NP)
+    if n < 0:
+        raise ValueError("n must be >= 0, got %d" % n)
+    if (f1 != 0 and f1 != 1) or (f2 != 0 and f2 != 1):
+        raise ValueError("flags must be 0 or 1, got (%d, %d)" % (f1, f2))
     flags[0] = f1; flags[1] = f2; anchors[0] = a1; anchors[1] = a2
     if what == "rhs":
         with nogil:
@@ -267,12 +329,32 @@ def ros_tableau(str name="rodas4"):
             "e": np.array([T.e[i] for i in range(n)])}
 
 
+#: Loop iterations between two polls for signals (Ctrl-C) and the step budget.
+POLL_EVERY = 2000
+#: First size of the record buffers [samples]; they double as a run needs more.
+RECORD_CHUNK = 1 << 16
+_SAMPLE_BYTES = 8 * (1 + PDW_NX + 1 + PDW_NREC)
+
+
+cdef object _grown(object a, long n):
+    """a (rows, ...) copied into n rows (zeros after), or pdw's MemoryError."""
+    try:
+        out = np.zeros((n,) + a.shape[1:], dtype=a.dtype)
+    except MemoryError:
+        raise MemoryError("recording needs more than %.3g GB (%d samples of %d bytes): record "
+                          "fewer samples (record_every) or none (record_every=0)"
+                          % (n * _SAMPLE_BYTES / 1e9, n, _SAMPLE_BYTES)) from None
+    out[:a.shape[0]] = a
+    return out
+
+
 def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, int f2,
         double dt, long n_steps, long record_every, bint record_contact,
         double fall_hip_height, double fall_depth, double max_speed,
         double rtol=1e-6, double atol=1e-8, double h_max=0.0, long max_records=0,
         long event_capacity=256, double event_tol=1e-9, bint record_events=True,
-        long stop_steps=0, int periodic_k=0, double periodic_tol=0.0, double t_end=0.0):
+        long stop_steps=0, int periodic_k=0, double periodic_tol=0.0, double t_end=0.0,
+        long max_steps=0, long poll_every=POLL_EVERY):
     """Run one simulation in compiled code (GIL released). Returns a dict of arrays and status.
 
     The online gait analysis runs for every method: the result's "gait" holds the last
@@ -282,23 +364,39 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     periodic_tol (relative); "stop_reason" says which (layout STOP).
 
     Fixed-step methods take n_steps steps of dt; adaptive ones integrate to t_end (default
-    n_steps*dt) with
-    first step dt, locating flag switches to within event_tol [s]. The record buffer first holds
-    max_records samples (default: n_steps/record_every+2, exact for fixed-step methods; for
-    adaptive ones at most 4096 to start with). When a loop fills the event or the record buffer
-    it returns PDW_STATUS_EVENTS_FULL / PDW_STATUS_RECORDS_FULL; this function then doubles that
-    buffer and calls the loop again, which resumes where it stopped: no sample is dropped.
+    n_steps*dt) with first step dt, locating flag switches to within event_tol [s], and fail
+    (reason PDW_REASON_BUDGET) once max_steps (> 0) steps were tried. The record buffer first
+    holds min(n_steps/record_every + 2, RECORD_CHUNK) samples (or max_records); when a loop
+    fills the event or the record buffer it returns PDW_STATUS_EVENTS_FULL /
+    PDW_STATUS_RECORDS_FULL; this function then doubles that buffer and calls the loop again,
+    which resumes where it stopped: no sample is dropped. Every poll_every loop iterations the
+    loop returns PDW_STATUS_POLL: signals are checked here (GIL held); on Ctrl-C the run stops
+    and the result (so far) is returned with "interrupted" set to the KeyboardInterrupt.
+
+    Shapes (checked): x0 (NX,), p (NP,).
     """
     cdef pdw_sim s
     cdef int flags0[2]
-    cdef long n_rec_cap = (n_steps // record_every + 2) if record_every > 0 else 0
-    if max_records > 0 and record_every > 0:
-        n_rec_cap = max_records
+    _len("x0", x0.shape[0], PDW_NX)
+    _len("p", p.shape[0], PDW_NP)
+    if (f1 != 0 and f1 != 1) or (f2 != 0 and f2 != 1):
+        raise ValueError("flags must be 0 or 1, got (%d, %d)" % (f1, f2))
+    if n_steps < 0 or record_every < 0 or max_records < 0 or event_capacity < 0 \
+            or stop_steps < 0 or max_steps < 0 or poll_every < 0:
+        raise ValueError("n_steps, record_every, max_records, event_capacity, stop_steps, "
+                         "max_steps and poll_every must be >= 0")
+    if not (dt > 0):
+        raise ValueError("dt must be > 0, got %r" % dt)
     if method < 0 or method >= pdw_nmethods:
         raise ValueError("method id %d out of range [0, %d)" % (method, pdw_nmethods))
+    if periodic_k < 0 or periodic_k == 1 or periodic_k > PDW_STEP_RING:
+        raise ValueError("periodic_k must be 0 (off) or in [2, %d], got %d" % (PDW_STEP_RING, periodic_k))
+    cdef long n_rec_cap = 0
+    if record_every > 0:
+        n_rec_cap = max_records if max_records > 0 else min(n_steps // record_every + 2,
+                                                            <long>RECORD_CHUNK)
+        n_rec_cap = max(n_rec_cap, 3)
     cdef pdw_advance_fn advance = pdw_methods[method].advance
-    if pdw_methods[method].adaptive and max_records <= 0 and n_rec_cap > 4096:
-        n_rec_cap = 4096        # adaptive: the number of steps is unknown; grown on demand
     memset(&s, 0, sizeof(pdw_sim))
     s.kernel = _kernel(k)
     s.t_end = t_end if t_end > 0 else n_steps * dt   # adaptive methods end exactly at t_end
@@ -314,6 +412,8 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     s.fall_hip_height = fall_hip_height
     s.fall_depth = fall_depth
     s.max_speed = max_speed
+    s.max_steps = max_steps if pdw_methods[method].adaptive else 0
+    s.poll_every = poll_every
     rec_t = np.zeros(n_rec_cap)
     rec_x = np.zeros((n_rec_cap, PDW_NX))
     rec_flags = np.zeros((n_rec_cap, 2), dtype=np.intc)
@@ -335,8 +435,6 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     s.events = &v_e[0, 0] if record_events else NULL
     s.ev_capacity = events.shape[0] if record_events else 0
     s.stop_steps = stop_steps
-    if periodic_k < 0 or periodic_k == 1 or periodic_k > PDW_STEP_RING:
-        raise ValueError("periodic_k must be 0 (off) or in [2, %d], got %d" % (PDW_STEP_RING, periodic_k))
     s.periodic_k = periodic_k
     s.periodic_tol = periodic_tol
     pdw_gait_init(&s.gait)
@@ -344,26 +442,29 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     flags0[0] = f1; flags0[1] = f2
     pdw_discrete_init(s.kernel, s.p, s.x, flags0, &s.disc, s.work)
     cdef int status
+    interrupted = None
     while True:
         with nogil:
             status = advance(&s)
-        if status == PDW_STATUS_EVENTS_FULL:
-            grown = np.zeros((2 * events.shape[0], PDW_NEVENT))
-            grown[:events.shape[0]] = events
-            events = grown
+        if status == PDW_STATUS_POLL:
+            try:
+                PyErr_CheckSignals()
+            except KeyboardInterrupt as e:
+                interrupted = e
+                break
+        elif status == PDW_STATUS_EVENTS_FULL:
+            events = _grown(events, 2 * events.shape[0])
             v_e = events
             s.events = &v_e[0, 0]
             s.ev_capacity = events.shape[0]
         elif status == PDW_STATUS_RECORDS_FULL:
-            # adaptive methods only: double the record arrays (copying what is there) and resume
-            n_rec_cap = 2 * max(n_rec_cap, 1)
-            rec_t = np.concatenate([rec_t, np.zeros(n_rec_cap - rec_t.shape[0])])
-            rec_x = np.concatenate([rec_x, np.zeros((n_rec_cap - rec_x.shape[0], PDW_NX))])
-            rec_flags = np.concatenate([rec_flags,
-                                        np.zeros((n_rec_cap - rec_flags.shape[0], 2), dtype=np.intc)])
+            # double the record arrays (copying what is there) and resume
+            n_rec_cap = 2 * max(n_rec_cap, 2)
+            rec_t = _grown(rec_t, n_rec_cap)
+            rec_x = _grown(rec_x, n_rec_cap)
+            rec_flags = _grown(rec_flags, n_rec_cap)
             if record_contact:
-                rec_contact = np.concatenate(
-                    [rec_contact, np.zeros((n_rec_cap - rec_contact.shape[0], PDW_NREC))])
+                rec_contact = _grown(rec_contact, n_rec_cap)
             v_t = rec_t
             v_x = rec_x
             v_f = rec_flags
@@ -394,6 +495,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         "event_counts": {"touch_down": s.gait.n_touch_down, "lift_off": s.gait.n_lift_off},
         "stop_reason": s.stop_reason,
         "status": status,
+        "interrupted": interrupted,
         "t": rec_t[:n_rec], "x": rec_x[:n_rec], "flags": rec_flags[:n_rec],
         "contact": rec_contact[:n_rec] if record_contact else None,
         "events": events[:s.n_events].copy() if record_events else np.zeros((0, PDW_NEVENT)),

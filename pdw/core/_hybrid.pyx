@@ -64,6 +64,26 @@ cdef extern from "pdw_hybrid_sim.h":
 NY = PDW_NHY
 NFOOT = PDW_NHYFOOT
 STATUS = ("ok", "no_strike", "fell", "singular", "nonfinite", "max_steps", "step_tiny")
+
+
+cdef int _len(str name, Py_ssize_t got, Py_ssize_t want) except -1:
+    if got != want:
+        raise ValueError("%s must have shape (%d,), got (%d,)" % (name, want, got))
+    return 0
+
+
+cdef int _rows(str name, Py_ssize_t r, Py_ssize_t c, Py_ssize_t want_r, Py_ssize_t want_c) except -1:
+    if r != want_r or c != want_c:
+        raise ValueError("%s must have shape (%d, %d), got (%d, %d)" % (name, want_r, want_c, r, c))
+    return 0
+
+
+cdef int _py(const double[::1] p, const double[::1] y, str yname="y") except -1:
+    _len("p", p.shape[0], PDW_NP)
+    _len(yname, y.shape[0], PDW_NHY)
+    return 0
+
+
 OPTION_NAMES = ("rtol", "atol", "h0", "h_max", "t_max", "event_tol", "min_step_angle",
                 "fall_angle", "max_steps", "dt_out")
 
@@ -117,6 +137,7 @@ cdef dict _result_dict(pdw_hybrid_result *r):
 
 def rhs(const double[::1] p, const double[::1] y):
     """dy/dt of the stance phase; raises on a singular reduced mass matrix."""
+    _py(p, y)
     out = np.empty(PDW_NHY)
     cdef double[::1] v = out
     if pdw_hybrid_rhs(&y[0], &p[0], &v[0]):
@@ -126,6 +147,7 @@ def rhs(const double[::1] p, const double[::1] y):
 
 def stance_terms(const double[::1] p, const double[::1] y):
     """(M_r (2, 2), f_r (2,)) of M_r phidd = f_r."""
+    _py(p, y)
     Mr = np.empty(4)
     fr = np.empty(2)
     cdef double[::1] vm = Mr, vf = fr
@@ -135,6 +157,8 @@ def stance_terms(const double[::1] p, const double[::1] y):
 
 def ground_force(const double[::1] p, const double[::1] y, const double[::1] ydd):
     """Ground reaction (F_x, F_y) on the stance foot for accelerations ydd (2,)."""
+    _py(p, y)
+    _len("ydd", ydd.shape[0], 2)
     F = np.empty(2)
     cdef double[::1] v = F
     pdw_hybrid_ground_force(&y[0], &ydd[0], &p[0], &v[0])
@@ -143,6 +167,7 @@ def ground_force(const double[::1] p, const double[::1] y, const double[::1] ydd
 
 def swing_foot(const double[::1] p, const double[::1] y):
     """[y_sw, vy_sw, x_sw, x_st] (stance rolling coordinate 0)."""
+    _py(p, y)
     out = np.empty(PDW_NHYFOOT)
     cdef double[::1] v = out
     pdw_hybrid_swing_foot(&y[0], &p[0], &v[0])
@@ -151,6 +176,7 @@ def swing_foot(const double[::1] p, const double[::1] y):
 
 def energies(const double[::1] p, const double[::1] y):
     """[T, V_gravity, V_hip] of the stance phase (stance rolling coordinate 0)."""
+    _py(p, y)
     out = np.empty(PDW_NENERGY)
     cdef double[::1] v = out
     pdw_hybrid_energies(&y[0], &p[0], &v[0])
@@ -160,7 +186,9 @@ def energies(const double[::1] p, const double[::1] y):
 def full_state_batch(const double[::1] p, const double[:, ::1] y, double[:, ::1] x):
     """Full-model states x (N, 8) of reduced states y (N, 4): stance leg = leg 1, s0 = 0."""
     cdef Py_ssize_t i, n = y.shape[0]
-    assert x.shape[0] == n and x.shape[1] == PDW_NX
+    _len("p", p.shape[0], PDW_NP)
+    _rows("y", n, y.shape[1], n, PDW_NHY)
+    _rows("x", x.shape[0], x.shape[1], n, PDW_NX)
     with nogil:
         for i in range(n):
             pdw_hybrid_full_state(&y[i, 0], &p[0], &x[i, 0])
@@ -168,6 +196,9 @@ def full_state_batch(const double[::1] p, const double[:, ::1] y, double[:, ::1]
 
 def impact_terms(const double[::1] p, const double[::1] q):
     """M(q) (4, 4) and the material-point Jacobians J (2 feet, 2, 4)."""
+    _len("p", p.shape[0], PDW_NP)
+    if q.shape[0] != 4 and q.shape[0] != PDW_NX:
+        raise ValueError("q must have shape (4,) or (%d,), got (%d,)" % (PDW_NX, q.shape[0]))
     out = np.empty(32)
     cdef double[::1] v = out
     pdw_hybrid_impact_terms(&q[0], &p[0], &v[0])
@@ -176,6 +207,7 @@ def impact_terms(const double[::1] p, const double[::1] q):
 
 def impact(const double[::1] p, const double[::1] y_minus):
     """The impact map at a pre-impact state; a dict (see pdw_hybrid_result)."""
+    _py(p, y_minus, "y_minus")
     cdef pdw_hybrid_result r
     memset(&r, 0, sizeof(r))
     r.status = pdw_hybrid_impact(&p[0], &y_minus[0], &r)
@@ -184,8 +216,11 @@ def impact(const double[::1] p, const double[::1] y_minus):
 
 def solve(double[:, ::1] A, double[::1] b):
     """x of A x = b by the C Gaussian elimination (A, b overwritten); for tests."""
+    if not 1 <= A.shape[0] <= 8:
+        raise ValueError("A must have 1 to 8 rows, got %d" % A.shape[0])
     cdef int n = A.shape[0]
-    assert A.shape[1] == n and b.shape[0] == n and n <= 8
+    _rows("A", A.shape[0], A.shape[1], n, n)
+    _len("b", b.shape[0], n)
     x = np.empty(n)
     cdef double[::1] vx = x
     if pdw_hybrid_solve(n, &A[0, 0], &b[0], &vx[0]):
@@ -198,6 +233,9 @@ def step(const double[::1] p, const double[::1] y0, dict opts, double t0=0.0, do
     """One step of the hybrid map. Returns (result dict, rec_t, rec_y)."""
     cdef pdw_hybrid_opts o
     cdef pdw_hybrid_result r
+    _py(p, y0, "y0")
+    if rec_cap < 0:
+        raise ValueError("rec_cap must be >= 0, got %d" % rec_cap)
     _fill_opts(&o, opts)
     rec_t = np.zeros(max(rec_cap, 1))
     rec_y = np.zeros((max(rec_cap, 1), PDW_NHY))
@@ -215,8 +253,11 @@ def step_batch(const double[::1] p, const double[:, ::1] y0, dict opts, double[:
     cdef pdw_hybrid_opts o
     cdef pdw_hybrid_result r
     cdef Py_ssize_t i, j, n = y0.shape[0]
+    _len("p", p.shape[0], PDW_NP)
+    _rows("y0", n, y0.shape[1], n, PDW_NHY)
+    _rows("y_plus", y_plus.shape[0], y_plus.shape[1], n, PDW_NHY)
+    _len("status", status.shape[0], n)
     _fill_opts(&o, opts)
-    assert y_plus.shape[0] == n and status.shape[0] == n
     with nogil:
         for i in range(n):
             pdw_hybrid_step(&p[0], &y0[i, 0], 0.0, 0.0, &o, &r, NULL, NULL, 0)
@@ -229,6 +270,9 @@ def walk(const double[::1] p, const double[::1] y0, double s0, long n_steps, dic
          long rec_cap):
     """n_steps steps; returns (list of result dicts, rec_t, rec_y, rec_step)."""
     cdef pdw_hybrid_opts o
+    _py(p, y0, "y0")
+    if rec_cap < 0:
+        raise ValueError("rec_cap must be >= 0, got %d" % rec_cap)
     _fill_opts(&o, opts)
     if n_steps < 1:
         raise ValueError("n_steps must be >= 1, got %d" % n_steps)
@@ -254,6 +298,7 @@ def walk(const double[::1] p, const double[::1] y0, double s0, long n_steps, dic
 
 def rhs_jac(const double[::1] p, const double[::1] y):
     """(ydot (4,), A = d ydot / d y (4, 4)) of the stance phase (symbolic Jacobian)."""
+    _py(p, y)
     yd = np.empty(PDW_NHY)
     A = np.empty((PDW_NHY, PDW_NHY))
     cdef double[::1] vy = yd
@@ -265,6 +310,7 @@ def rhs_jac(const double[::1] p, const double[::1] y):
 
 def swing_foot_grad(const double[::1] p, const double[::1] y):
     """d y_sw / d y (4,)."""
+    _py(p, y)
     g = np.empty(PDW_NHY)
     cdef double[::1] v = g
     pdw_hybrid_swing_foot_grad(&y[0], &p[0], &v[0])
@@ -273,6 +319,7 @@ def swing_foot_grad(const double[::1] p, const double[::1] y):
 
 def impact_jac(const double[::1] p, const double[::1] y_minus):
     """d y+ / d y- (4, 4) of the impact-and-relabel map."""
+    _py(p, y_minus, "y_minus")
     D = np.empty((PDW_NHY, PDW_NHY))
     cdef double[:, ::1] v = D
     if pdw_hybrid_impact_jac(&p[0], &y_minus[0], &v[0, 0]):
@@ -286,8 +333,14 @@ def step_jac_batch(const double[::1] p, const double[:, ::1] y0, dict opts,
     cdef pdw_hybrid_opts o
     cdef pdw_hybrid_result r
     cdef Py_ssize_t i, j, n = y0.shape[0]
+    _len("p", p.shape[0], PDW_NP)
+    _rows("y0", n, y0.shape[1], n, PDW_NHY)
+    _rows("y_plus", y_plus.shape[0], y_plus.shape[1], n, PDW_NHY)
+    _len("status", status.shape[0], n)
+    if DP.shape[0] != n or DP.shape[1] != PDW_NHY or DP.shape[2] != PDW_NHY:
+        raise ValueError("DP must have shape (%d, %d, %d), got (%d, %d, %d)"
+                         % (n, PDW_NHY, PDW_NHY, DP.shape[0], DP.shape[1], DP.shape[2]))
     _fill_opts(&o, opts)
-    assert y_plus.shape[0] == n and status.shape[0] == n and DP.shape[0] == n
     with nogil:
         for i in range(n):
             status[i] = pdw_hybrid_step_jac(&p[0], &y0[i, 0], &o, &r, &DP[i, 0, 0])
@@ -300,6 +353,7 @@ def step_jac(const double[::1] p, const double[::1] y0, dict opts):
     cdef pdw_hybrid_opts o
     cdef pdw_hybrid_result r
     cdef int st
+    _py(p, y0, "y0")
     _fill_opts(&o, opts)
     DP = np.full((PDW_NHY, PDW_NHY), np.nan)
     cdef double[:, ::1] v = DP

@@ -10,7 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _core, _layout
+from . import _core, _layout, checks
+from .errors import InvalidInputError
 from .params import Params
 
 STATE = _layout.STATE
@@ -29,49 +30,38 @@ def kernel_index(variant: str = "paper", features=None) -> int:
     feats = _layout.FEATURES if features is None else tuple(features)
     unknown = set(feats) - set(_layout.FEATURES)
     if unknown:
-        raise ValueError("unknown feature(s) %s; allowed: %s"
-                         % (", ".join(sorted(unknown)), ", ".join(_layout.FEATURES)))
+        raise InvalidInputError("unknown feature(s) %s; allowed: %s"
+                                % (", ".join(sorted(unknown)), ", ".join(_layout.FEATURES)))
     name = variant + "".join("_no_" + f for f in _layout.FEATURES if f not in feats)
     return _KERNELS.get(name, _KERNELS[variant])
 
 
 def check_variant(variant):
-    if variant not in VARIANTS:
-        raise ValueError("variant must be one of %s, got %r" % (", ".join(map(repr, VARIANTS)), variant))
+    if not isinstance(variant, str) or variant not in VARIANTS:
+        raise InvalidInputError("variant must be one of %s, got %r" % (", ".join(map(repr, VARIANTS)), variant))
 
 
 def parameter_vector(params: Params | None) -> np.ndarray:
     """Kernel parameter vector: `Params.as_array` plus derived constants, shape (NP,)."""
     params = Params.paper() if params is None else params
     if not isinstance(params, Params):
-        raise TypeError("params must be a pdw.Params, got %s" % type(params).__name__)
+        raise InvalidInputError("params must be a pdw.Params, got %s" % type(params).__name__)
     p = np.zeros(_core.NP)
     _core.precompute(params.as_array(), p)
     return p
 
 
 def _states(x, name="x", width=_core.NX):
-    arr = np.array(x, dtype=float, order="C", copy=True)
-    single = arr.ndim == 1
-    arr = np.atleast_2d(arr)
-    if arr.ndim != 2 or arr.shape[1] != width:
-        raise ValueError("%s must have shape (%d,) or (N, %d), got %s" % (name, width, width, np.shape(x)))
-    bad = ~np.isfinite(arr)
-    if bad.any():
-        row, col = np.argwhere(bad)[0]
-        field = STATE[col] if width == _core.NX else _layout.STATE[col]
-        raise ValueError("%s[%s] is not finite (%r)" % (name, field, arr[row, col]))
-    return np.ascontiguousarray(arr), single
+    arr = checks.real_array(name, x, [(width,), (-1, width)],
+                            labels=STATE if width == _core.NX else None)
+    return np.ascontiguousarray(np.atleast_2d(arr)), arr.ndim == 1
 
 
 def _discrete(flags, anchors, n):
-    f = np.broadcast_to(np.asarray(flags, dtype=np.intc), (n, 2)).copy()
-    if not np.isin(f, (0, 1)).all():
-        raise ValueError("flags must be 0 (swing) or 1 (support), got %r" % (flags,))
-    a = np.broadcast_to(np.asarray(anchors, dtype=float), (n, 2)).copy()
-    if not np.isfinite(a).all():
-        raise ValueError("anchors must be finite, got %r" % (anchors,))
-    return np.ascontiguousarray(f), np.ascontiguousarray(a)
+    f = checks.flags("flags", flags, n)
+    f = np.ascontiguousarray(np.broadcast_to(np.asarray(f, dtype=np.intc), (n, 2)))
+    a = checks.real_array("anchors", anchors, [(2,), (n, 2)])
+    return f, np.ascontiguousarray(np.broadcast_to(a, (n, 2)))
 
 
 def _folded(params, features):
@@ -138,7 +128,7 @@ def mass_matrix(q, params=None):
 
     ``q`` may be a configuration (4,) / (N, 4) or a full state (8,) / (N, 8).
     """
-    Q = np.asarray(q, dtype=float)
+    Q = checks.real_array("q", q, [(_core.NQ,), (-1, _core.NQ), (_core.NX,), (-1, _core.NX)])
     if Q.shape[-1] == _core.NQ:
         Q = np.concatenate([Q, np.zeros_like(Q)], axis=-1)
     *_, work = _evaluate(Q, params, (0, 0), (0.0, 0.0), "paper")

@@ -8,6 +8,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import _layout
+from .checks import _real
+from .errors import InvalidInputError
 
 #: The paper's initial state of the typical gait (Sec. 3.2), flags (swing, support) = (0, 1).
 X0_PAPER = (0.0, 0.4969, -0.0582, 0.0582, 0.5092, 0.0186, 3.3338, -1.0093)
@@ -26,7 +28,7 @@ class Params:
 
     The defaults are `Params.paper()` (docs/model.md section 1). Every field is checked on
     construction: a NaN, a non-positive mass or length, ``r >= l``, or ``v_s >= v_d``
-    raises `ValueError` naming the field and its allowed range.
+    raises `pdw.InvalidInputError` (a `ValueError`) naming the field and its allowed range.
 
     Use `dataclasses.replace` (or `Params.replace`) to change fields.
     """
@@ -58,28 +60,25 @@ class Params:
     def __post_init__(self):
         for f in dataclasses.fields(self):
             v = getattr(self, f.name)
-            try:
-                v = float(v)
-            except (TypeError, ValueError):
-                raise ValueError("Params.%s must be a real number, got %r" % (f.name, v)) from None
+            v = _real("Params." + f.name, v)
             object.__setattr__(self, f.name, v)
             if not math.isfinite(v):
-                raise ValueError("Params.%s must be finite, got %r (allowed: %s)"
+                raise InvalidInputError("Params.%s must be finite, got %r (allowed: %s)"
                                  % (f.name, v, _range_text(f)))
             md = f.metadata
             bad_lo = md["lo"] is not None and (v <= md["lo"] if md["lo_open"] else v < md["lo"])
             bad_hi = md["hi"] is not None and (v >= md["hi"] if md["hi_open"] else v > md["hi"])
             if bad_lo or bad_hi:
-                raise ValueError("Params.%s = %r is out of range; allowed: %s [%s]"
+                raise InvalidInputError("Params.%s = %r is out of range; allowed: %s [%s]"
                                  % (f.name, v, _range_text(f), md["unit"]))
         if self.r >= self.l:
-            raise ValueError("Params.r = %r must be smaller than Params.l = %r (0 <= r < l)"
+            raise InvalidInputError("Params.r = %r must be smaller than Params.l = %r (0 <= r < l)"
                              % (self.r, self.l))
         if self.J_l == 0.0 and self.c == 0.0 and self.w == 0.0:
-            raise ValueError("Params.J_l = 0 with c = w = 0 gives a leg without inertia about the "
+            raise InvalidInputError("Params.J_l = 0 with c = w = 0 gives a leg without inertia about the "
                              "hip (singular mass matrix): need J_l > 0 or c**2 + w**2 > 0")
         if self.v_s >= self.v_d:
-            raise ValueError("Params.v_s = %r must be smaller than Params.v_d = %r "
+            raise InvalidInputError("Params.v_s = %r must be smaller than Params.v_d = %r "
                              "(0 < v_s < v_d, Eq. 10)" % (self.v_s, self.v_d))
 
     # --- presets ---------------------------------------------------------------------------
@@ -98,7 +97,7 @@ class Params:
         """A preset by name: ``"paper"`` or ``"paper_steady"``."""
         presets = {"paper": cls.paper, "paper_steady": cls.paper_steady}
         if name not in presets:
-            raise ValueError("unknown preset %r; allowed: %s" % (name, ", ".join(presets)))
+            raise InvalidInputError("unknown preset %r; allowed: %s" % (name, ", ".join(presets)))
         return presets[name](**overrides)
 
     def without(self, features) -> "Params":
@@ -110,7 +109,7 @@ class Params:
                 "tangential": ("k_t", "d_t"), "friction": ("mu_s", "mu_d")}
         unknown = set(features) - set(zero)
         if unknown:
-            raise ValueError("unknown feature(s) %s; allowed: %s"
+            raise InvalidInputError("unknown feature(s) %s; allowed: %s"
                              % (", ".join(sorted(unknown)), ", ".join(zero)))
         return self.replace(**{n: 0.0 for f, names in zero.items() if f not in features
                                for n in names})
@@ -119,7 +118,7 @@ class Params:
         """A copy with some fields changed (validated)."""
         unknown = set(changes) - {f.name for f in dataclasses.fields(self)}
         if unknown:
-            raise ValueError("unknown Params field(s): %s; allowed: %s"
+            raise InvalidInputError("unknown Params field(s): %s; allowed: %s"
                              % (", ".join(sorted(unknown)), ", ".join(_layout.PARAMS)))
         return dataclasses.replace(self, **changes)
 

@@ -2,6 +2,9 @@
 first axis, one line per value of the second (docs/studies.md)."""
 from __future__ import annotations
 
+import os
+import pathlib
+
 import numpy as np
 
 _PANELS = (("L", "step length L [m]", 1.0), ("P", "step period P [s]", 1.0),
@@ -52,6 +55,9 @@ def plot_study(study, rows, path):
         axs.flat[0].legend(handles, labels, fontsize=7)
     fig.suptitle("%s\n(%s, variant %s, %s, %s)" % (study.title, study.preset, study.variant,
                                                    study.method, study.run["mode"]), fontsize=9)
-    fig.savefig(path, dpi=110)
+    path = pathlib.Path(path)
+    tmp = path.with_name("." + path.stem + ".%d.tmp%s" % (os.getpid(), path.suffix))
+    fig.savefig(tmp, dpi=110)         # atomic: a reader sees the old figure or the new one
     plt.close(fig)
+    os.replace(tmp, path)
     return path

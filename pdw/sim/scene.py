@@ -417,6 +417,8 @@ class Scene(_Section):
             data = _toml.loads(text)
         except _toml.TOMLDecodeError as e:
             raise InvalidInputError("%s: not valid TOML: %s" % (source, e)) from None
+        except RecursionError:
+            raise InvalidInputError("%s: TOML nested too deeply" % source) from None
         try:
             return cls.from_dict(data)
         except InvalidInputError as e:

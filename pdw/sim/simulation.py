@@ -8,13 +8,20 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
 import numpy as np
 
-from ..core import _core, _layout
-from ..core.errors import DivergedError, InvalidInputError, SingularSystemError
+from ..core import _core, _layout, checks
+from ..core.errors import (
+    DivergedError,
+    InvalidInputError,
+    SingularSystemError,
+    StepSizeError,
+    StepSizeWarning,
+)
 from ..core.integrators import METHODS
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
 from ..core.params import X0_PAPER, Params
@@ -30,7 +37,18 @@ _REASONS = {
     4: "a foot sank deeper than fall_depth below the ground",
     5: "the step's linear system was singular",
     6: "the adaptive step size underflowed (the error test never passed)",
+    7: "the step budget (max_steps) was used up before t_end",
 }
+#: Smallest step [s] (a smaller one makes the step matrices singular in double precision).
+DT_MIN = 1e-12
+#: Runaway bounds checked on every recorded and the final state of a run that reached its end:
+#: the hip more than RUNAWAY_HIP leg lengths above its start, or a leg turned by more than
+#: RUNAWAY_ANGLE [rad] (a full turn).
+RUNAWAY_HIP = 2.0
+RUNAWAY_ANGLE = 2 * math.pi
+#: A run that reached t_end without a single touch-down in at least NO_STEP_PERIODS pendulum
+#: periods 2 pi sqrt(l/g) did not walk: status "no_steps".
+NO_STEP_PERIODS = 2.0
 
 
 class Event(NamedTuple):
@@ -61,8 +79,12 @@ class Result:
         Every touch-down and lift-off (empty when ``record_events=False``; `event_counts`
         counts them either way).
     status : str
-        ``"walked"`` (reached t_end, or the requested number of gait steps), ``"periodic"``
-        (stopped because the last steps agreed), ``"fell"`` (see `failure`) or ``"diverged"``.
+        ``"walked"`` (reached t_end, or the requested number of gait steps, having stepped),
+        ``"periodic"`` (stopped because the last steps agreed), ``"fell"`` (see `failure`),
+        ``"diverged"`` (non-finite, runaway or airborne state, non-finite energies, step
+        budget), ``"no_steps"`` (reached t_end without a touch-down in `NO_STEP_PERIODS`
+        pendulum periods or more) or ``"interrupted"`` (Ctrl-C: the partial result rides on
+        the ``KeyboardInterrupt`` as ``.result``).
     failure : dict or None
         For a fall or divergence: ``t`` and ``x`` of the last good state, ``reason`` and ``leg``.
     params : Params
@@ -148,31 +170,18 @@ class Result:
 
 
 def _check_positive(name, value):
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InvalidInputError("%s must be a number, got %r" % (name, value)) from None
-    if not math.isfinite(v) or v <= 0:
-        raise InvalidInputError("%s must be finite and > 0, got %r" % (name, value))
-    return v
+    return checks.positive(name, value)
 
 
 def check_state(x0, name="x0"):
-    x = np.array(x0, dtype=float).ravel() if np.ndim(x0) else None
-    if x is None or x.shape != (_core.NX,):
-        raise InvalidInputError("%s must have 8 components %s, got shape %s"
-                                % (name, STATE, np.shape(x0)))
-    for i, v in enumerate(x):
-        if not math.isfinite(v):
-            raise InvalidInputError("%s[%d] (%s) must be finite, got %r" % (name, i, STATE[i], v))
-    return x
+    return checks.real_array(name, x0, [(_core.NX,)], labels=STATE)
 
 
 _DEFAULTS = dict(t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm", flags0=(0, 1),
                  record_every=1, record_forces=True, on_failure="raise", fall_hip_height=None,
                  fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8, h_max=None, event_tol=1e-9,
                  features=None, record_events=True, record_energies=False, stop_steps=0,
-                 periodic_steps=0, periodic_tol=1e-3, check_step="warn")
+                 periodic_steps=0, periodic_tol=1e-3, check_step="warn", max_steps=None)
 
 
 def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
@@ -180,7 +189,7 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
              fall_hip_height=None, fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8,
              h_max=None, event_tol=1e-9, *, features=None, record_events=True,
              record_energies=False, stop_steps=0, periodic_steps=0, periodic_tol=1e-3,
-             check_step="warn"):
+             check_step="warn", max_steps=None):
     """Simulate the walker from ``x0`` for ``t_end`` seconds (or run a `pdw.Scene`).
 
     ``simulate(scene)`` runs the scene (as `pdw.run`); no other argument may be given then.
@@ -266,26 +275,31 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
         raise InvalidInputError("params must be a pdw.Params, got %s" % type(params).__name__)
     x = check_state(x0)
     t_end = _check_positive("t_end", t_end)
-    dt = _check_positive("dt", dt)
+    dt = checks.number("dt", dt, lo=DT_MIN)
     if dt > t_end:
         raise InvalidInputError("dt = %g must not exceed t_end = %g" % (dt, t_end))
     try:
         check_variant(variant)
     except ValueError as e:
         raise InvalidInputError(str(e)) from None
-    if method not in METHODS:
-        raise InvalidInputError("method must be one of %s, got %r" % (", ".join(METHODS), method))
-    if on_failure not in ("raise", "return"):
-        raise InvalidInputError("on_failure must be 'raise' or 'return', got %r" % (on_failure,))
-    f0 = tuple(int(f) for f in flags0)
-    if len(f0) != 2 or any(f not in (0, 1) for f in f0):
-        raise InvalidInputError("flags0 must be two values in {0, 1}, got %r" % (flags0,))
-    if int(record_every) != record_every or record_every < 0:
-        raise InvalidInputError("record_every must be an integer >= 0, got %r" % (record_every,))
+    checks.choice("method", method, METHODS)
+    checks.choice("on_failure", on_failure, ("raise", "return"))
+    f0 = checks.flags("flags0", flags0)
+    record_every = checks.count("record_every", record_every)
     n_steps = int(round(t_end / dt))
-    if n_steps > 2**40:
-        raise InvalidInputError("t_end/dt = %g steps is too many" % (t_end / dt))
-    hip = 0.5 * params.l if fall_hip_height is None else float(fall_hip_height)
+    if n_steps > checks.MAX_COUNT:
+        raise InvalidInputError("t_end/dt = %g steps is too many (at most %d)"
+                                % (t_end / dt, checks.MAX_COUNT))
+    adaptive = _core.method_table()[METHODS.index(method)][2]
+    if max_steps is None:
+        budget = 10 ** 6 + int(2e6 * t_end) if adaptive else 0
+    else:
+        budget = checks.count("max_steps", max_steps, lo=1)
+        if not adaptive and n_steps > budget:
+            raise InvalidInputError("t_end/dt = %d steps exceeds max_steps = %d: raise max_steps "
+                                    "or take a larger dt" % (n_steps, budget))
+    hip = 0.5 * params.l if fall_hip_height is None else checks.number("fall_hip_height",
+                                                                        fall_hip_height)
     depth = 0.25 * params.l if fall_depth is None else _check_positive("fall_depth", fall_depth)
     max_speed = _check_positive("max_speed", max_speed)
     rtol = _check_positive("rtol", rtol)
@@ -293,6 +307,10 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     h_max = 0.0 if h_max is None else _check_positive("h_max", h_max)
     event_tol = _check_positive("event_tol", event_tol)
     feats = _check_features(features)
+    for name, flag in (("record_forces", record_forces), ("record_events", record_events),
+                       ("record_energies", record_energies)):
+        if not isinstance(flag, (bool, np.bool_)):
+            raise InvalidInputError("%s must be True or False, got %r" % (name, flag))
     if record_energies and not record_every:
         raise InvalidInputError("record_energies needs recorded states (record_every > 0)")
     stop_steps = _check_count("stop_steps", stop_steps)
@@ -305,23 +323,38 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     k = kernel_index(variant, feats)
     if feats != _layout.FEATURES:
         params = params.without(feats)
-    _stepsize.check_step(dt, params, method, variant, check_step)
+    try:
+        _stepsize.check_step(dt, params, method, variant, check_step)
+    except (np.linalg.LinAlgError, FloatingPointError, OverflowError) as e:
+        _step_unknown(dt, method, check_step, e)
     p = parameter_vector(params)
     start = time.perf_counter()
     raw = _core.run(k, METHODS.index(method), x, p, f0[0], f0[1], dt, n_steps, int(record_every),
                     bool(record_forces), hip, depth, max_speed, rtol, atol, h_max,
                     event_tol=event_tol, record_events=bool(record_events), stop_steps=stop_steps,
-                    periodic_k=periodic_steps, periodic_tol=periodic_tol, t_end=t_end)
+                    periodic_k=periodic_steps, periodic_tol=periodic_tol, t_end=t_end,
+                    max_steps=budget)
     wall = time.perf_counter() - start
     energies = None
-    if record_energies:
+    if record_energies and raw["interrupted"] is None:
         e = np.empty((len(raw["x"]), len(_layout.ENERGY)))
         if len(e):
             _core.energies_batch(k, np.ascontiguousarray(raw["x"]), p, e)
         energies = {name: e[:, i] for i, name in enumerate(_layout.ENERGY)}
         energies["E"] = e.sum(axis=1)
     return _result(raw, params, variant, method, dt, t_end, wall, on_failure, feats,
-                   bool(record_events), energies)
+                   bool(record_events), energies, x)
+
+
+def _step_unknown(dt, method, mode, e):
+    """`pdw.stability.check_step` could not estimate the limit (a force law so stiff that the
+    linearisation is not finite, e.g. v_s <= 1e-150): say so (warning or error)."""
+    msg = ("the stability limit of %s at these parameters could not be estimated (%s): a force "
+           "law is too stiff to linearise in double precision; dt = %g is probably far too large "
+           "(use an adaptive method, or check_step='off')" % (method, e, dt))
+    if mode == "error":
+        raise StepSizeError(msg, dt=dt, limit=0.0, force="unknown") from None
+    warnings.warn(StepSizeWarning(msg, dt=dt, limit=0.0, force="unknown"), stacklevel=3)
 
 
 def _same(a, b):
@@ -335,13 +368,7 @@ def _same(a, b):
 
 
 def _check_count(name, value):
-    try:
-        ok = not isinstance(value, bool) and int(value) == value and value >= 0
-    except (TypeError, ValueError):
-        ok = False
-    if not ok:
-        raise InvalidInputError("%s must be an integer >= 0, got %r" % (name, value))
-    return int(value)
+    return checks.count(name, value)
 
 
 def _check_features(features):
@@ -358,9 +385,48 @@ def _check_features(features):
     return tuple(f for f in _layout.FEATURES if f in feats)
 
 
+def _honest(raw, status, params, x0, energies):
+    """The status of a run that reached its end, checked: a runaway or airborne state, or
+    non-finite energies, make it "diverged" (raw["failure"] filled in: the first offending
+    sample); no touch-down at all in a long enough run makes it "no_steps"."""
+    if status != "done":
+        return status
+    X = raw["x"] if len(raw["x"]) else np.empty((0, _core.NX))
+    T = raw["t"]
+    X = np.vstack([X, raw["x_final"][None, :]])
+    T = np.append(T, raw["t_final"])
+    hip_max = x0[1] + RUNAWAY_HIP * params.l
+    bad = (X[:, 1] > hip_max) | (np.abs(X[:, 2:4]) > RUNAWAY_ANGLE).any(axis=1)
+    reason = None
+    if bad.any():
+        i = int(np.argmax(bad))
+        if X[i, 1] > hip_max:
+            reason = ("runaway: the hip rose to y_o = %.4g m, more than %g l above its start "
+                      "(airborne): not walking" % (X[i, 1], RUNAWAY_HIP))
+        else:
+            reason = ("runaway: a leg turned past %.3g rad (theta1, theta2 = %.4g, %.4g): not "
+                      "walking" % (RUNAWAY_ANGLE, X[i, 2], X[i, 3]))
+    elif energies is not None and not all(np.isfinite(v).all() for v in energies.values()):
+        i = int(np.argmax(~np.isfinite(energies["E"])))
+        reason = "the energies are not finite at a finite state (overflow)"
+    if reason is not None:
+        i = max(i - 1, 0)                  # the last good sample before the offending one
+        raw["failure"] = {"t": float(T[i]), "x": X[i].copy(), "leg": -1, "reason": reason}
+        return "diverged"
+    period = 2 * math.pi * math.sqrt(params.l / params.g) if params.g > 0 else math.inf
+    if raw["event_counts"]["touch_down"] == 0 and raw["t_final"] >= NO_STEP_PERIODS * period:
+        return "no_steps"
+    return status
+
+
 def _result(raw, params, variant, method, dt, t_end, wall, on_failure,
-            features=_layout.FEATURES, events_recorded=True, energies=None):
-    status = _STATUS[raw["status"]]
+            features=_layout.FEATURES, events_recorded=True, energies=None, x0=None):
+    if raw.get("interrupted") is not None:
+        status = "interrupted"
+    else:
+        status = _STATUS[raw["status"]]
+        if x0 is not None:
+            status = _honest(raw, status, params, x0, energies)
     rc = raw["contact"]
     ic = {n: i for i, n in enumerate(_layout.RECORD_CONTACT)}
     if rc is not None:
@@ -374,7 +440,7 @@ def _result(raw, params, variant, method, dt, t_end, wall, on_failure,
     failure = None
     if status in ("fell", "diverged", "singular"):
         f = raw["failure"]
-        failure = {"t": f["t"], "x": f["x"], "reason": _REASONS[f["reason"]],
+        failure = {"t": f["t"], "x": f["x"], "reason": _REASONS.get(f["reason"], f["reason"]),
                    "leg": None if f["leg"] < 0 else f["leg"] + 1}
     public = {"done": "walked", "singular": "diverged"}.get(status, status)
     stop = _layout.STOP[raw["stop_reason"]]
@@ -387,11 +453,18 @@ def _result(raw, params, variant, method, dt, t_end, wall, on_failure,
                  events_recorded=events_recorded,
                  stop_reason=stop if stop != "none" else ("t_end" if public == "walked" else public),
                  energies=energies, features=tuple(features))
+    if status == "interrupted":
+        exc = raw["interrupted"]
+        exc.result = res
+        raise exc
     if res.status == "diverged" and on_failure == "raise":
         cls = SingularSystemError if status == "singular" else DivergedError
+        advice = ("Check the masses and inertias (Params) and dt." if status == "singular" else
+                  "Raise max_steps, or loosen rtol/atol." if raw["failure"]["reason"] == 7 else
+                  "Try a smaller dt or a stiff method.")
         raise cls("simulation diverged at t = %.6g s (step %d, dt = %g, method %s): %s; "
-                  "last good state %s. Try a smaller dt or a stiff method."
+                  "last good state %s. %s"
                   % (failure["t"], raw["n_steps"], dt, method, failure["reason"],
-                     np.array2string(failure["x"], precision=5)),
+                     np.array2string(failure["x"], precision=5), advice),
                   t=failure["t"], x=failure["x"], reason=failure["reason"], result=res)
     return res

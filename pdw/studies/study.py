@@ -13,11 +13,13 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import itertools
+import json
 import pathlib
+import re
 
 import numpy as np
 
-from ..core import _layout, _toml
+from ..core import _layout, _toml, checks
 from ..core.errors import InvalidInputError
 from ..core.params import Params
 from ..sim.scene import Scene
@@ -41,7 +43,12 @@ MOVED = {"preset": "scene.preset", "variant": "scene.variant", "method": "scene.
          "run.x0": "scene.x0", "run.flags0": "scene.flags0"}
 #: Result columns of a point (after the index and the axis values).
 COLUMNS = ("status", "gait", "source", "L", "P", "v", "cycle", "double_support", "ds_fraction", "travel",
-           "spread_L", "spread_cycle", "n_steps", "max_multiplier", "t_final", "wall_s", "error")
+           "spread_L", "spread_cycle", "n_steps", "max_multiplier", "t_final", "wall_s", "error",
+           "settings")
+#: A study name is a plain file name: letters, digits, "_", "-", "+", "." (not first).
+NAME_RE = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.+-]{0,99}")
+#: Most points one study may have (also the most values of one axis).
+MAX_POINTS = 10 ** 6
 
 
 # --- the study --------------------------------------------------------------------------------
@@ -97,11 +104,33 @@ class Study:
         dict and the point's full parameter set."""
         p = self.base_params().as_dict()
         p.update(values)
-        return {"index": index, "values": dict(values), "params": p,
+        task = {"index": index, "values": dict(values), "params": p,
                 "scene": self.scene.to_dict(), "run": dict(self.run)}
+        task["settings"] = settings_hash(task)
+        return task
 
     def digest(self) -> str:
         return hashlib.sha256(self.source.encode()).hexdigest()
+
+
+def settings_hash(task) -> str:
+    """16 hex digits of the SHA-256 of everything that decides a point's row: its full
+    parameter set, the scene (variant, start, integrator, duration...), the [run] settings and
+    the model's input hash (`pdw.INPUT_HASH`). A resumed sweep recomputes every row whose hash
+    differs."""
+    key = {"params": task["params"], "scene": task["scene"], "run": task["run"],
+           "model": _layout.INPUT_HASH}
+    text = json.dumps(key, sort_keys=True, default=repr)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def check_name(name, where="study"):
+    """A study name must be a plain file name (no folder, no "..", no absolute path)."""
+    if not isinstance(name, str) or not NAME_RE.fullmatch(name) or name in (".", ".."):
+        raise InvalidInputError("%s: name must be a plain file name (letters, digits, '_', '-', "
+                                "'+', '.'; not starting with '.'; at most 100 characters), got %r"
+                                % (where, name))
+    return name
 
 
 def _typecheck(where, key, value, typ):
@@ -133,6 +162,8 @@ def parse_study(text, name="study", path="") -> Study:
         data = _toml.loads(text)
     except _toml.TOMLDecodeError as e:
         raise InvalidInputError("%s: not valid TOML: %s" % (where, e)) from None
+    except RecursionError:
+        raise InvalidInputError("%s: TOML nested too deeply" % where) from None
     for k, v in data.items():
         if k in MOVED:
             _moved(where, k)
@@ -177,8 +208,9 @@ def parse_study(text, name="study", path="") -> Study:
             missing = [k for k in ("start", "stop", "num") if k not in ax]
             if missing:
                 raise InvalidInputError("%s: missing %s (or give values)" % (w, ", ".join(missing)))
-            if ax["num"] < 1:
-                raise InvalidInputError("%s: num must be >= 1" % w)
+            checks.count(w + ": num", ax["num"], lo=1, hi=MAX_POINTS)
+            checks.number(w + ": start", ax["start"])
+            checks.number(w + ": stop", ax["stop"])
             if ax.get("log", False):
                 if ax["start"] <= 0 or ax["stop"] <= 0:
                     raise InvalidInputError("%s: a log axis needs start, stop > 0" % w)
@@ -198,8 +230,12 @@ def parse_study(text, name="study", path="") -> Study:
     if run["mode"] not in ("simulate", "newton"):
         raise InvalidInputError("%s [run]: mode must be 'simulate' or 'newton', got %r"
                                 % (where, run["mode"]))
-    if run["steady"] < 1:
-        raise InvalidInputError("%s [run]: steady must be >= 1, got %r" % (where, run["steady"]))
+    checks.count(where + " [run] steady", run["steady"], lo=1, hi=10 ** 6)
+    checks.positive(where + " [run] period_tol", run["period_tol"])
+    n_points = int(np.prod([float(len(v)) for _, v in axes]))
+    if n_points > MAX_POINTS:
+        raise InvalidInputError("%s: %d points; at most %d" % (where, n_points, MAX_POINTS))
+    check_name(data.get("name", name), where)
     study = Study(name=data.get("name", name), title=data.get("title", data.get("name", name)),
                   scene=scene, axes=axes, run=run, paper=dict(data.get("paper", {})),
                   source=text, path=str(path))

@@ -33,21 +33,25 @@ import concurrent.futures as cf
 import csv
 import dataclasses
 import datetime
+import fcntl
 import io
 import json
 import math
 import os
 import pathlib
 import platform
+import signal
 import subprocess
 import sys
+import tempfile
+import threading
 import time
 
 import numpy as np
 
 from ..core.errors import InvalidInputError, PdwError
 from ..core.params import Params
-from .study import COLUMNS, Study, load_study, parse_study  # noqa: F401 (pdw.sweep.parse_study)
+from .study import COLUMNS, Study, check_name, load_study, parse_study, settings_hash  # noqa: F401 (pdw.sweep.parse_study)
 
 # --- the worker -------------------------------------------------------------------------------
 
@@ -75,6 +79,7 @@ def run_point(task) -> dict:
     t0 = time.perf_counter()
     row = {"index": int(task["index"]), **task["values"]}
     row.update({c: "" for c in COLUMNS})
+    row["settings"] = task.get("settings", "")
     run = task["run"]
     try:
         params = Params(**task["params"])
@@ -141,7 +146,9 @@ def _parse(v):
 
 def read_rows(path, study) -> dict:
     """Rows already in a study's CSV, by index; checks that they belong to ``study`` (same
-    columns, same axis values). Malformed lines (a write cut by a kill) are dropped."""
+    columns, same axis values). Malformed lines (a write cut by a kill), rows computed under
+    other settings (their ``settings`` hash differs: another preset, method, [run], fixed
+    parameter or model) and ``error`` rows are dropped: they are computed again."""
     path = pathlib.Path(path)
     if not path.exists():
         return {}
@@ -168,7 +175,7 @@ def read_rows(path, study) -> dict:
                                for a in study.axis_names):
             raise PdwError("%s: row %s does not match this study's point %s; use a fresh output "
                            "folder or resume=False (--fresh)" % (path, row["index"], pts.get(k)))
-        if row["status"] == "":
+        if row["status"] in ("", "error") or row["settings"] != study.task(k, pts[k])["settings"]:
             continue
         rows[k] = {c: (int(row[c]) if c == "index" else _parse(row[c])) for c in header}
     return rows
@@ -277,12 +284,84 @@ class StudyResult:
             if name not in ("status", "gait", "error") else [r[name] for r in self.rows]
 
 
+#: The lock file that keeps a second sweep out of an output folder.
+LOCK_NAME = ".pdw-sweep.lock"
+
+
+def _die_with_parent(ppid):
+    """Process-pool worker initializer: the worker ends when its parent does (even SIGKILLed).
+    Linux: prctl(PR_SET_PDEATHSIG, SIGKILL); everywhere: a thread watching the parent id."""
+    try:
+        import ctypes
+        ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGKILL))   # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+    if os.getppid() != ppid:
+        os._exit(1)
+
+    def watch():
+        while os.getppid() == ppid:
+            time.sleep(1.0)
+        os._exit(1)
+    threading.Thread(target=watch, daemon=True, name="pdw-parent-watch").start()
+
+
+class _FolderLock:
+    """An exclusive lock (fcntl.flock) on ``<out>/.pdw-sweep.lock``: one sweep per folder."""
+
+    def __init__(self, folder):
+        self.path = pathlib.Path(folder) / LOCK_NAME
+        self.f = None
+
+    def __enter__(self):
+        f = open(self.path, "a+")
+        try:
+            fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            f.seek(0)
+            holder = f.read().strip() or "?"
+            f.close()
+            raise PdwError("%s is in use by another sweep (process %s holds %s): wait for it to "
+                           "finish, or write to another folder (--out)"
+                           % (self.path.parent, holder, self.path.name)) from None
+        f.seek(0)
+        f.truncate()
+        f.write("%d\n" % os.getpid())
+        f.flush()
+        self.f = f
+        return self
+
+    def __exit__(self, *exc):
+        fcntl.flock(self.f, fcntl.LOCK_UN)
+        self.f.close()
+        return False
+
+
+def _write_atomic(path, text):
+    """Write ``text`` to ``path`` through a temporary file in the same folder (fsync, rename):
+    readers see the old file or the new one, never a part."""
+    path = pathlib.Path(path)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix="." + path.name + ".", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", newline="") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
 def _make_executor(backend, workers):
     n = max(1, int(workers or os.cpu_count() or 1))
     if backend == "thread":
         return cf.ThreadPoolExecutor(n), n
     if backend == "process":
-        return cf.ProcessPoolExecutor(n), n
+        return cf.ProcessPoolExecutor(n, initializer=_die_with_parent, initargs=(os.getpid(),)), n
     raise InvalidInputError("backend must be 'thread', 'process' or 'serial', got %r" % (backend,))
 
 
@@ -321,8 +400,14 @@ def run_study(study, out=None, *, executor=None, workers=None, backend="thread",
                                 "pdw.present.study_plots.plot_study, or None; got %r" % (figures,))
     if not isinstance(study, Study):
         study = load_study(study)
+    check_name(study.name)
     out = pathlib.Path(out or pathlib.Path("out") / "studies" / study.name)
     out.mkdir(parents=True, exist_ok=True)
+    with _FolderLock(out):
+        return _run_locked(study, out, executor, workers, backend, resume, progress, figures)
+
+
+def _run_locked(study, out, executor, workers, backend, resume, progress, figures):
     csv_path, json_path = out / (study.name + ".csv"), out / (study.name + ".json")
     header = _header(study)
     t_start = time.perf_counter()
@@ -330,13 +415,10 @@ def run_study(study, out=None, *, executor=None, workers=None, backend="thread",
     done = read_rows(csv_path, study) if resume else {}
     points = study.points()
     todo = [(k, v) for k, v in points if k not in done]
-    # rewrite the CSV with what is kept (drops torn lines), then append as points finish
-    tmp = csv_path.with_suffix(".csv.tmp")
-    with open(tmp, "w", newline="") as f:
-        f.write(",".join(header) + "\n")
-        for k in sorted(done):
-            f.write(_csv_line(done[k], header))
-    os.replace(tmp, csv_path)
+    # rewrite the CSV with what is kept (drops torn lines and stale rows), then append as
+    # points finish
+    _write_atomic(csv_path, ",".join(header) + "\n"
+                  + "".join(_csv_line(done[k], header) for k in sorted(done)))
 
     own = None
     if executor is None and backend != "serial" and todo:
@@ -385,11 +467,7 @@ def run_study(study, out=None, *, executor=None, workers=None, backend="thread",
         raise error
     rows = [done[k] for k, _ in points]
     # final CSV in index order (atomic)
-    with open(tmp, "w", newline="") as f:
-        f.write(",".join(header) + "\n")
-        for r in rows:
-            f.write(_csv_line(r, header))
-    os.replace(tmp, csv_path)
+    _write_atomic(csv_path, ",".join(header) + "\n" + "".join(_csv_line(r, header) for r in rows))
     wall = time.perf_counter() - t_start
     statuses = {}
     for r in rows:
@@ -407,7 +485,7 @@ def run_study(study, out=None, *, executor=None, workers=None, backend="thread",
             paths["png"] = figures(study, rows, out / (study.name + ".png"))
         except ImportError:
             meta["figure"] = "not written: matplotlib is not installed"
-    json_path.write_text(json.dumps(meta, indent=2, default=_jsonable) + "\n")
+    _write_atomic(json_path, json.dumps(meta, indent=2, default=_jsonable) + "\n")
     return StudyResult(study=study, rows=rows, paths=paths, computed=sorted(computed),
                        resumed=sorted(set(done) - set(computed)), wall_s=wall)
 

@@ -34,6 +34,9 @@ int pdw_cdm_advance(pdw_sim *s)
         pdw_record(s, 0.0);
     }
     while (s->n < s->n_steps) {
+        /* a return here resumes exactly: at n > 0 the top of the loop recomputes work */
+        if (s->n > 0 && !pdw_records_room(s)) { s->status = PDW_STATUS_RECORDS_FULL; return s->status; }
+        if (s->n > 0 && pdw_poll_due(s)) return s->status;
         const double t = s->n * dt;
         /* flags from (U_n, U'_n); this also leaves trig and kin of x_n in work (at n = 0 the
          * start-up's update and right-hand side did) */

@@ -130,11 +130,18 @@ static int push_event(pdw_sim *s, double t, int leg, int kind, const double *ki)
 
 int pdw_update_flags(pdw_sim *s, double t)
 {
+    if (!pdw_events_room(s, 2)) return -1;
+    pdw_trig(s->x, s->work + PDW_WORK_TRIG);
+    return pdw_update_flags_trig(s, t);
+}
+
+int pdw_update_flags_trig(pdw_sim *s, double t)
+{
     pdw_discrete *d = &s->disc;
     double *kin = s->work + PDW_WORK_KIN;
     int changed = 0, stop = PDW_STOP_NONE;
     if (!pdw_events_room(s, 2)) return -1;
-    kinematics(s->kernel, s->p, s->x, d->anchors, s->work);
+    s->kernel->kinematics(s->x, s->work + PDW_WORK_TRIG, s->p, d->anchors, kin);
     for (int i = 0; i < 2; ++i) {
         const double *ki = kin + i*PDW_NKIN, *kj = kin + (1 - i)*PDW_NKIN;
         const double y = ki[PDW_KIN_Y_D], vy = ki[PDW_KIN_V_Y];

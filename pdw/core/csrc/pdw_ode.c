@@ -76,6 +76,8 @@ int pdw_fixed_advance(pdw_sim *s, pdw_fixed_step_fn step)
         if (r > 0) return s->status;                        /* a stop condition */
     }
     while (s->n < s->n_steps) {
+        if (!pdw_records_room(s)) { s->status = PDW_STATUS_RECORDS_FULL; return s->status; }
+        if (pdw_poll_due(s)) return s->status;
         if (s->n > 0) {
             /* flags from (U_n, U'_n) before step n, as the paper's loop (Fig. 3) */
             const pdw_discrete before = s->disc;
@@ -177,6 +179,14 @@ int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx)
         if (!pdw_events_room(s, 6)) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
         if (s->record_every > 0 && s->n_rec + 1 > s->rec_capacity) {
             s->status = PDW_STATUS_RECORDS_FULL;
+            return s->status;
+        }
+        /* poll only where a resumed call continues exactly (new_point and last_rejected are
+         * what a fresh call starts with: right after an accepted step) */
+        if (new_point && !last_rejected && pdw_poll_due(s)) return s->status;
+        if (s->max_steps > 0 && s->n + s->n_rejected >= s->max_steps) {
+            fail_step_size(s);
+            s->failure.reason = PDW_REASON_BUDGET;
             return s->status;
         }
         if (!s->cache_valid) { pdw_ode_f(s, s->x, s->cache); s->cache_valid = 1; }

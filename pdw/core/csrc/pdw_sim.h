@@ -56,6 +56,14 @@ typedef struct pdw_gait {
  * number of samples is not known in advance) return it. */
 enum { PDW_STATUS_RECORDS_FULL = 64 };
 
+/* A loop status beyond the generated ones: poll_every loop iterations have passed. The loop
+ * returns it at a point where it resumes exactly (like PDW_STATUS_EVENTS_FULL); _core.run takes
+ * the GIL, checks for signals (Ctrl-C) and the step budget, and calls advance again. */
+enum { PDW_STATUS_POLL = 65 };
+
+/* Why an adaptive loop stopped beyond pdw_failure's PDW_REASON_*: the step budget. */
+enum { PDW_REASON_BUDGET = 7 };
+
 typedef struct pdw_sim {
     /* --- model and settings (inputs) --- */
     const pdw_kernel *kernel;
@@ -107,7 +115,28 @@ typedef struct pdw_sim {
     int status;                 /* PDW_STATUS_* */
     int stop_reason;            /* PDW_STOP_*: which stop condition ended the run (NONE: t_end or a failure) */
     pdw_failure failure;
+    /* --- interruptibility (see PDW_STATUS_POLL) --- */
+    long poll_every;            /* return PDW_STATUS_POLL every this many loop iterations; 0: never */
+    long since_poll;            /* iterations since the last poll */
+    long max_steps;             /* adaptive methods: fail (PDW_REASON_BUDGET) once accepted +
+                                 * rejected steps reach this; 0: no budget */
 } pdw_sim;
+
+/* Is a poll due (counts one loop iteration)? Sets s->status = PDW_STATUS_POLL when it is. */
+static inline int pdw_poll_due(pdw_sim *s)
+{
+    if (s->poll_every <= 0 || ++s->since_poll < s->poll_every) return 0;
+    s->since_poll = 0;
+    s->status = PDW_STATUS_POLL;
+    return 1;
+}
+
+/* Room for one more sample and a final one? (checked at the top of a loop iteration, where a
+ * return resumes exactly) */
+static inline int pdw_records_room(const pdw_sim *s)
+{
+    return s->record_every <= 0 || s->n_rec + 2 <= s->rec_capacity;
+}
 
 /* Initialise the discrete state for x0 and initial flags: anchors of support legs at x0. */
 void pdw_discrete_init(const pdw_kernel *k, const double *p, const double *x,
@@ -121,6 +150,10 @@ void pdw_discrete_init(const pdw_kernel *k, const double *p, const double *x,
  * 1 when a stop condition was met (s->status and s->stop_reason are set: the caller stores the
  * final sample with pdw_record_final and returns s->status). */
 int pdw_update_flags(pdw_sim *s, double t);
+
+/* pdw_update_flags with the trig of s->x already in s->work (PDW_WORK_TRIG): the ensemble
+ * engine (pdw_batch.c) computes the sin/cos of all its lanes in one vector loop first. */
+int pdw_update_flags_trig(pdw_sim *s, double t);
 
 /* Room for `n` more events (always, when events are not stored)? */
 static inline int pdw_events_room(const pdw_sim *s, long n)

@@ -1,0 +1,158 @@
+# cython: language_level=3
+"""Thin Cython layer over the ensemble engine (csrc/pdw_batch.c): many walkers, W lanes in
+lockstep, threads over disjoint ranges of walkers.
+
+Private: the public API is `pdw.sim.batch.simulate_batch`. Every array is caller-allocated,
+C-contiguous (typed memoryviews). `run_range` releases the GIL for the whole range.
+"""
+from libc.stdlib cimport malloc, free
+
+
+cdef extern from "pdw_model.h":
+    enum:
+        PDW_NX, PDW_NP, PDW_NKERNELS, PDW_NSTEP, PDW_STEP_RING
+    ctypedef struct pdw_kernel:
+        int variant
+    const pdw_kernel pdw_kernels[]
+
+
+cdef extern from "pdw_sim.h":
+    ctypedef struct pdw_sim:
+        int status
+
+
+cdef extern from "pdw_batch.h":
+    enum:
+        PDW_BATCH_MAXW
+    ctypedef struct pdw_batch_job:
+        const pdw_kernel *kernel
+        long n
+        const double *x0
+        const double *p
+        long p_stride
+        const int *flags0
+        const double *fall_hip_height
+        const double *fall_depth
+        double dt
+        long n_steps
+        double max_speed
+        long stop_steps
+        int periodic_k
+        double periodic_tol
+        int *status
+        int *stop_reason
+        int *flags_final
+        double *x_final
+        double *t_final
+        long *n_taken
+        long *n_gait
+        long *n_touch_down
+        long *n_lift_off
+        double *gait
+        int *fail_reason
+        int *fail_leg
+        double *fail_t
+        double *fail_x
+    long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
+                       int vector) noexcept nogil
+
+
+MAX_LANES = PDW_BATCH_MAXW
+
+
+def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[:, ::1] flags0,
+              const double[::1] hip, const double[::1] depth, double dt, long n_steps,
+              double max_speed, long stop_steps, int periodic_k, double periodic_tol,
+              dict out, long i0, long i1, int lanes, bint vector):
+    """Advance walkers [i0, i1) with `lanes` lanes (GIL released), writing rows of `out`.
+
+    x0 (N, 8); p (N, NP) or (1, NP) (one vector for all); flags0 (N, 2) intc; hip, depth (N,).
+    out: the dict of output arrays made by pdw.sim.batch (status, stop_reason, flags_final,
+    x_final, t_final, n_steps, n_gait_steps, n_touch_down, n_lift_off, gait, fail_reason,
+    fail_leg, fail_t, fail_x). Threads may call this at once on disjoint ranges of one `out`.
+    """
+    if k < 0 or k >= PDW_NKERNELS:
+        raise ValueError("kernel id %d out of range [0, %d)" % (k, PDW_NKERNELS))
+    if lanes < 1 or lanes > PDW_BATCH_MAXW:
+        raise ValueError("lanes must be in [1, %d], got %d" % (PDW_BATCH_MAXW, lanes))
+    cdef long n = x0.shape[0]
+    if x0.shape[1] != PDW_NX or p.shape[1] != PDW_NP or (p.shape[0] != n and p.shape[0] != 1):
+        raise ValueError("x0 must be (N, %d) and p (N or 1, %d)" % (PDW_NX, PDW_NP))
+    if not (0 <= i0 <= i1 <= n):
+        raise ValueError("range [%d, %d) not within [0, %d]" % (i0, i1, n))
+    cdef int[::1] status = out["status"]
+    cdef int[::1] stop_reason = out["stop_reason"]
+    cdef int[:, ::1] flags_final = out["flags_final"]
+    cdef double[:, ::1] x_final = out["x_final"]
+    cdef double[::1] t_final = out["t_final"]
+    cdef long[::1] n_taken = out["n_steps"]
+    cdef long[::1] n_gait = out["n_gait_steps"]
+    cdef long[::1] n_td = out["n_touch_down"]
+    cdef long[::1] n_lo = out["n_lift_off"]
+    cdef double[:, :, ::1] gait = out["gait"]
+    cdef int[::1] fail_reason = out["fail_reason"]
+    cdef int[::1] fail_leg = out["fail_leg"]
+    cdef double[::1] fail_t = out["fail_t"]
+    cdef double[:, ::1] fail_x = out["fail_x"]
+    if (status.shape[0] != n or x_final.shape[0] != n or gait.shape[0] != n
+            or gait.shape[1] != PDW_STEP_RING or gait.shape[2] != PDW_NSTEP):
+        raise ValueError("output arrays do not match N = %d" % n)
+    # every other array, checked before a pointer is taken (issue 16: the compiled boundary)
+    for name, got, want in (
+            ("flags0", (flags0.shape[0], flags0.shape[1]), (n, 2)),
+            ("hip", (hip.shape[0],), (n,)), ("depth", (depth.shape[0],), (n,)),
+            ("out['stop_reason']", (stop_reason.shape[0],), (n,)),
+            ("out['flags_final']", (flags_final.shape[0], flags_final.shape[1]), (n, 2)),
+            ("out['x_final']", (x_final.shape[0], x_final.shape[1]), (n, PDW_NX)),
+            ("out['t_final']", (t_final.shape[0],), (n,)),
+            ("out['n_steps']", (n_taken.shape[0],), (n,)),
+            ("out['n_gait_steps']", (n_gait.shape[0],), (n,)),
+            ("out['n_touch_down']", (n_td.shape[0],), (n,)),
+            ("out['n_lift_off']", (n_lo.shape[0],), (n,)),
+            ("out['fail_reason']", (fail_reason.shape[0],), (n,)),
+            ("out['fail_leg']", (fail_leg.shape[0],), (n,)),
+            ("out['fail_t']", (fail_t.shape[0],), (n,)),
+            ("out['fail_x']", (fail_x.shape[0], fail_x.shape[1]), (n, PDW_NX))):
+        if got != want:
+            raise ValueError("%s must have shape %s, got %s" % (name, want, got))
+    if n == 0 or i0 == i1:
+        return 0
+    cdef pdw_batch_job job
+    job.kernel = &pdw_kernels[k]
+    job.n = n
+    job.x0 = &x0[0, 0]
+    job.p = &p[0, 0]
+    job.p_stride = PDW_NP if p.shape[0] == n and n > 1 else 0
+    job.flags0 = &flags0[0, 0]
+    job.fall_hip_height = &hip[0]
+    job.fall_depth = &depth[0]
+    job.dt = dt
+    job.n_steps = n_steps
+    job.max_speed = max_speed
+    job.stop_steps = stop_steps
+    job.periodic_k = periodic_k
+    job.periodic_tol = periodic_tol
+    job.status = &status[0]
+    job.stop_reason = &stop_reason[0]
+    job.flags_final = &flags_final[0, 0]
+    job.x_final = &x_final[0, 0]
+    job.t_final = &t_final[0]
+    job.n_taken = &n_taken[0]
+    job.n_gait = &n_gait[0]
+    job.n_touch_down = &n_td[0]
+    job.n_lift_off = &n_lo[0]
+    job.gait = &gait[0, 0, 0]
+    job.fail_reason = &fail_reason[0]
+    job.fail_leg = &fail_leg[0]
+    job.fail_t = &fail_t[0]
+    job.fail_x = &fail_x[0, 0]
+    cdef pdw_sim *sims = <pdw_sim *> malloc(lanes * sizeof(pdw_sim))
+    if sims == NULL:
+        raise MemoryError()
+    cdef long done
+    try:
+        with nogil:
+            done = pdw_batch_cdm(&job, i0, i1, lanes, sims, vector)
+    finally:
+        free(sims)
+    return done

@@ -1,0 +1,282 @@
+"""`simulate_batch`: N walkers in one call, W lanes of a block in lockstep (docs/ensemble.md).
+
+The compiled engine (pdw/core/csrc/pdw_batch.c) advances a block of W walkers with the paper's
+central difference method (MODEL.md section 7), one walker per lane: the sin/cos of all lanes in
+one vector loop (glibc's libmvec), the generated stages and the discrete logic (flags, arming,
+anchors, events, online gait descriptors) per lane, exactly as `pdw.simulate`; a lane whose
+walker finishes takes the next one. Threads (GIL released) take disjoint ranges of walkers.
+"""
+from __future__ import annotations
+
+import math
+import os
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core import _batch, _layout
+from ..core.errors import InvalidInputError
+from ..core.model import STATE, check_variant, kernel_index, parameter_vector
+from ..core.params import Params
+from . import stepsize as _stepsize
+from .gait import Steps, steps_from_rows
+from .simulation import _REASONS, _check_count, _check_positive
+
+_STATUS = {0: "running", 1: "walked", 2: "fell", 3: "diverged", 5: "diverged", 6: "periodic"}
+_STOP = {0: "t_end", 1: "steps", 2: "periodic"}
+LANES = 8
+"""Default lanes per block (walkers advanced in lockstep by one thread)."""
+
+
+@dataclass
+class BatchResult:
+    """Outcome of `simulate_batch`: one row per walker, in the order of ``x0``.
+
+    Attributes
+    ----------
+    status : ndarray of str (N,)
+        ``"walked"``, ``"periodic"``, ``"fell"`` or ``"diverged"``, as `Result.status`.
+    stop_reason : ndarray of str (N,)
+        ``"t_end"``, ``"steps"``, ``"periodic"``, or the failure status.
+    x_final : ndarray (N, 8)
+        State at ``t_final`` (layout `pdw.STATE`); for a failure the last state reached.
+    t_final : ndarray (N,)
+        Time of ``x_final`` [s].
+    n_steps : ndarray of int (N,)
+        Integration steps taken.
+    flags_final : ndarray of int (N, 2)
+        Support flags of legs 1, 2 at the end.
+    failure_reason : ndarray of str (N,)
+        Why a walker fell or diverged (``"none"`` otherwise); ``failure_t`` [s] (N,),
+        ``failure_x`` (N, 8) the last good state (NaN if none), ``failure_leg`` (N,) 1, 2 or 0.
+    n_touch_down, n_lift_off, n_gait_steps : ndarray of int (N,)
+        Event counts and complete gait steps (MODEL.md section 8) of each walker.
+    gait_rows : ndarray (N, STEP_RING, len(STEP))
+        The last ``min(n_gait_steps, STEP_RING)`` steps of each walker, oldest first (layout
+        `pdw.core._layout.STEP`, legs 0/1), NaN beyond; `steps(i)` gives them as `Steps`.
+    dt, t_end : float
+        Step and end time [s]; ``method``, ``variant``: as given.
+    """
+
+    status: np.ndarray
+    stop_reason: np.ndarray
+    x_final: np.ndarray
+    t_final: np.ndarray
+    n_steps: np.ndarray
+    flags_final: np.ndarray
+    failure_reason: np.ndarray
+    failure_t: np.ndarray
+    failure_x: np.ndarray
+    failure_leg: np.ndarray
+    n_touch_down: np.ndarray
+    n_lift_off: np.ndarray
+    n_gait_steps: np.ndarray
+    gait_rows: np.ndarray
+    dt: float
+    t_end: float
+    method: str
+    variant: str
+
+    def __len__(self) -> int:
+        return len(self.status)
+
+    @property
+    def walked(self) -> np.ndarray:
+        """(N,) bool: did each walker keep walking to the end (t_end or a stop condition)?"""
+        return np.isin(self.status, ("walked", "periodic"))
+
+    def steps(self, i: int) -> Steps:
+        """The last gait steps of walker i (at most STEP_RING), as `pdw.steps` gives them."""
+        n = min(int(self.n_gait_steps[i]), _layout.STEP_RING)
+        return steps_from_rows(self.gait_rows[i, :n])
+
+    def to_dataframe(self):
+        """One row per walker: status, stop_reason, t_final, the final state (columns
+        ``x_<name>``), event counts, failure reason and time, and the last step's descriptors
+        (columns ``last_<field>``). Needs pandas."""
+        import pandas as pd
+        cols = {"status": self.status, "stop_reason": self.stop_reason, "t_final": self.t_final,
+                "n_steps": self.n_steps}
+        for j, name in enumerate(STATE):
+            cols["x_" + name] = self.x_final[:, j]
+        cols.update(n_touch_down=self.n_touch_down, n_lift_off=self.n_lift_off,
+                    n_gait_steps=self.n_gait_steps, failure_reason=self.failure_reason,
+                    failure_t=self.failure_t)
+        last = np.full((len(self), len(_layout.STEP)), np.nan)
+        has = self.n_gait_steps > 0
+        idx = np.minimum(self.n_gait_steps, _layout.STEP_RING) - 1
+        last[has] = self.gait_rows[np.nonzero(has)[0], idx[has]]
+        for j, name in enumerate(_layout.STEP):
+            cols["last_" + name] = last[:, j]
+        return pd.DataFrame(cols)
+
+
+def _rows(x0):
+    try:
+        x = np.array(x0, dtype=float, order="C")
+    except (TypeError, ValueError):
+        raise InvalidInputError("x0 must be an (N, 8) array of numbers") from None
+    if x.ndim != 2 or x.shape[1] != len(STATE):
+        raise InvalidInputError("x0 must have shape (N, 8) (columns %s), got %s"
+                                % (STATE, np.shape(x0)))
+    bad = ~np.isfinite(x)
+    if bad.any():
+        r, c = np.argwhere(bad)[0]
+        raise InvalidInputError("x0 row %d, column %d (%s) must be finite, got %r"
+                                % (r, c, STATE[c], x[r, c]))
+    return x
+
+
+def _flags(flags0, n):
+    f = np.array(flags0, dtype=np.intc)
+    if f.shape == (2,):
+        f = np.tile(f, (n, 1))
+    if f.shape != (n, 2):
+        raise InvalidInputError("flags0 must be (2,) or (N, 2) = (%d, 2), got %s"
+                                % (n, np.shape(flags0)))
+    bad = (f != 0) & (f != 1)
+    if bad.any():
+        r = np.argwhere(bad)[0][0]
+        raise InvalidInputError("flags0 row %d must be two values in {0, 1}, got %r"
+                                % (r, tuple(f[r])))
+    return np.ascontiguousarray(f)
+
+
+def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
+                   flags0=(0, 1), threads=None, lanes=LANES, vector=False, stop_steps=0,
+                   periodic_steps=0, periodic_tol=1e-3, fall_hip_height=None, fall_depth=None,
+                   max_speed=1e3, check_step="warn") -> BatchResult:
+    """Simulate N walkers at once: the result of `pdw.simulate` for each, without recording.
+
+    Parameters
+    ----------
+    x0 : array (N, 8)
+        Initial states, layout `pdw.STATE` [m, rad, m/s, rad/s].
+    t_end, dt : float
+        End time and step [s], as `simulate` (n_steps = round(t_end/dt)).
+    params : Params or sequence of N Params, optional
+        One parameter set for all walkers (default: the paper's) or one per walker.
+    variant : {"paper", "consistent"}
+    method : {"cdm"}
+        Only the paper's central difference method (MODEL.md section 7) has a batched loop;
+        adaptive rodas4 with per-lane step control is not implemented (docs/ensemble.md).
+    flags0 : (2,) or (N, 2) ints in {0, 1}
+        Initial support flags of legs 1, 2.
+    threads : int, optional
+        Threads taking ranges of walkers (GIL released); default: os.cpu_count().
+    lanes : int
+        Walkers per block advanced in lockstep (1 ... 64).
+    vector : bool
+        False (default): the scalar libm sin/cos, so that every walker is bitwise its
+        `simulate` run. True: the sin/cos of a block through glibc's vector routines (libmvec,
+        within 4 ulp of libm's); flag switches on the step grid turn those last bits into
+        step-sized shifts of events, so final states then agree with `simulate` in outcome,
+        not to 1e-12 (docs/ensemble.md).
+    stop_steps, periodic_steps, periodic_tol, fall_hip_height, fall_depth, max_speed, check_step
+        As `simulate`; fall_hip_height and fall_depth default to 0.5 l and 0.25 l of each
+        walker's parameters. A divergence is a status here (``"diverged"``), never an error.
+
+    Returns
+    -------
+    BatchResult
+        Per-walker arrays (status, x_final, t_final, failure, event counts, last gait steps).
+    """
+    x = _rows(x0)
+    n = len(x)
+    t_end = _check_positive("t_end", t_end)
+    dt = _check_positive("dt", dt)
+    if dt > t_end:
+        raise InvalidInputError("dt = %g must not exceed t_end = %g" % (dt, t_end))
+    try:
+        check_variant(variant)
+    except ValueError as e:
+        raise InvalidInputError(str(e)) from None
+    if method != "cdm":
+        raise InvalidInputError("simulate_batch supports method 'cdm' only, got %r (use "
+                                "pdw.simulate on a thread pool for the others)" % (method,))
+    if params is None or isinstance(params, Params):
+        plist = [Params.paper() if params is None else params]
+    else:
+        plist = list(params)
+        if len(plist) != n:
+            raise InvalidInputError("params must be one Params or a sequence of N = %d, got %d"
+                                    % (n, len(plist)))
+    for i, p in enumerate(plist):
+        if not isinstance(p, Params):
+            raise InvalidInputError("params row %d must be a pdw.Params, got %s"
+                                    % (i, type(p).__name__))
+    f0 = _flags(flags0, n)
+    n_steps = int(round(t_end / dt))
+    stop_steps = _check_count("stop_steps", stop_steps)
+    periodic_steps = _check_count("periodic_steps", periodic_steps)
+    if periodic_steps == 1 or periodic_steps > _layout.STEP_RING:
+        raise InvalidInputError("periodic_steps must be 0 (off) or in [2, %d], got %d"
+                                % (_layout.STEP_RING, periodic_steps))
+    periodic_tol = _check_positive("periodic_tol", periodic_tol)
+    max_speed = _check_positive("max_speed", max_speed)
+    lanes = _check_count("lanes", lanes)
+    if not 1 <= lanes <= _batch.MAX_LANES:
+        raise InvalidInputError("lanes must be in [1, %d], got %d" % (_batch.MAX_LANES, lanes))
+    threads = (os.cpu_count() or 1) if threads is None else _check_count("threads", threads)
+    if threads < 1:
+        raise InvalidInputError("threads must be >= 1, got %d" % threads)
+    k = kernel_index(variant, None)
+    distinct = {}
+    for p in plist:
+        if id(p) not in distinct:
+            distinct[id(p)] = p
+            _stepsize.check_step(dt, p, method, variant, check_step)
+    pvec = np.ascontiguousarray([parameter_vector(p) for p in plist])
+    ls = np.array([p.l for p in plist], dtype=float)
+    hip = np.broadcast_to(0.5 * ls if fall_hip_height is None else float(fall_hip_height), (n,))
+    depth = np.broadcast_to(0.25 * ls if fall_depth is None
+                            else _check_positive("fall_depth", fall_depth), (n,))
+    hip = np.ascontiguousarray(hip, dtype=float)
+    depth = np.ascontiguousarray(depth, dtype=float)
+    out = _outputs(n)
+    if n:
+        chunks = _chunks(n, threads, lanes)
+        args = (k, x, pvec, f0, hip, depth, dt, n_steps, max_speed, stop_steps, periodic_steps,
+                periodic_tol, out)
+        if len(chunks) == 1:
+            _batch.run_range(*args, chunks[0][0], chunks[0][1], lanes, bool(vector))
+        else:
+            with ThreadPoolExecutor(min(threads, len(chunks))) as ex:
+                list(ex.map(lambda c: _batch.run_range(*args, c[0], c[1], lanes, bool(vector)),
+                            chunks))
+    return _result(out, dt, n_steps * dt, method, variant)
+
+
+def _chunks(n, threads, lanes):
+    """Ranges of walkers for the threads: several per thread (refilling balances them)."""
+    if threads == 1:
+        return [(0, n)]
+    size = max(lanes, math.ceil(n / (4 * threads)))
+    return [(i, min(n, i + size)) for i in range(0, n, size)]
+
+
+def _outputs(n):
+    ring, nstep = _layout.STEP_RING, len(_layout.STEP)
+    return {"status": np.zeros(n, np.intc), "stop_reason": np.zeros(n, np.intc),
+            "flags_final": np.zeros((n, 2), np.intc), "x_final": np.zeros((n, len(STATE))),
+            "t_final": np.zeros(n), "n_steps": np.zeros(n, np.int_),
+            "n_gait_steps": np.zeros(n, np.int_), "n_touch_down": np.zeros(n, np.int_),
+            "n_lift_off": np.zeros(n, np.int_), "gait": np.zeros((n, ring, nstep)),
+            "fail_reason": np.zeros(n, np.intc), "fail_leg": np.zeros(n, np.intc),
+            "fail_t": np.zeros(n), "fail_x": np.zeros((n, len(STATE)))}
+
+
+def _result(out, dt, t_end, method, variant):
+    status = np.array([_STATUS[s] for s in out["status"]], dtype=object)
+    stop = np.array([_STOP[r] if r else (s if s in ("fell", "diverged") else "t_end")
+                     for r, s in zip(out["stop_reason"], status)], dtype=object)
+    return BatchResult(
+        status=status, stop_reason=stop, x_final=out["x_final"], t_final=out["t_final"],
+        n_steps=out["n_steps"], flags_final=out["flags_final"],
+        failure_reason=np.array([_REASONS[r] if r else "none" for r in out["fail_reason"]],
+                                dtype=object),
+        failure_t=out["fail_t"], failure_x=out["fail_x"], failure_leg=out["fail_leg"] + 1,
+        n_touch_down=out["n_touch_down"], n_lift_off=out["n_lift_off"],
+        n_gait_steps=out["n_gait_steps"], gait_rows=out["gait"], dt=dt, t_end=t_end,
+        method=method, variant=variant)

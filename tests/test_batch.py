@@ -1,0 +1,164 @@
+"""The ensemble engine (pdw.simulate_batch) against the scalar pdw.simulate, walker by walker."""
+import numpy as np
+import pytest
+
+import pdw
+from pdw.core import _layout
+from pdw.sim.batch import simulate_batch
+
+T_END = 1.2      # long enough for touch-downs, lift-offs, gait steps and falls
+
+
+def _states(n, seed=0):
+    """n initial states around the paper's: a mix of walks and falls."""
+    rng = np.random.default_rng(seed)
+    x = np.tile(np.asarray(pdw.X0_PAPER, float), (n, 1))
+    x[:, 6] += rng.uniform(-2.5, 0.5, n)      # thetad1: strongly negative ones fall
+    x[:, 7] += rng.uniform(-0.5, 0.5, n)
+    return x
+
+
+def _scalar(x, params, **kw):
+    return pdw.simulate(x, t_end=T_END, params=params, record_every=1, record_forces=False,
+                        on_failure="return", check_step="off", **kw)
+
+
+def _assert_same(b, i, r, rtol=1e-12):
+    assert b.status[i] == r.status, i
+    assert b.stop_reason[i] == r.stop_reason, i
+    assert b.n_steps[i] == r.n_steps
+    assert b.t_final[i] == pytest.approx(r.t_final, rel=1e-15, abs=0)
+    assert tuple(b.flags_final[i]) == tuple(r.flags[-1])      # the last sample's flags
+    assert b.n_touch_down[i] == r.event_counts["touch_down"]
+    assert b.n_lift_off[i] == r.event_counts["lift_off"]
+    assert b.n_gait_steps[i] == r.n_gait_steps
+    scale = np.maximum(np.abs(r.x_final), 1e-300)
+    assert np.all(np.abs(b.x_final[i] - r.x_final) <= rtol * scale), (i, b.x_final[i], r.x_final)
+    g_b, g_r = b.steps(i), r.gait
+    assert len(g_b) == len(g_r)
+    for name in ("L", "P", "cycle", "double_support"):
+        np.testing.assert_array_equal(g_b[name], g_r[name])
+    if r.failure:
+        assert b.failure_reason[i] == r.failure["reason"]
+        assert b.failure_t[i] == r.failure["t"]
+        np.testing.assert_array_equal(b.failure_x[i], r.failure["x"])
+        assert b.failure_leg[i] == (r.failure["leg"] or 0)
+    else:
+        assert b.failure_reason[i] == "none"
+
+
+@pytest.mark.parametrize("n, lanes, threads", [(1, 8, 1), (11, 4, 1), (13, 8, 2)])
+def test_every_walker_is_the_scalar_run(n, lanes, threads):
+    """Batch of 1, non-full last blocks (11 = 2*4 + 3, 13 = 8 + 5), threads over ranges."""
+    x = _states(n)
+    b = simulate_batch(x, t_end=T_END, lanes=lanes, threads=threads, vector=False,
+                       check_step="off")
+    statuses = set()
+    for i in range(n):
+        r = _scalar(x[i], pdw.Params.paper())
+        _assert_same(b, i, r)
+        statuses.add(r.status)
+    if n > 1:
+        assert statuses >= {"walked", "fell"}, statuses     # the mix this test is about
+
+
+def test_per_walker_params_and_stop_steps():
+    x = _states(6, seed=1)
+    x[:, 6] = pdw.X0_PAPER[6]                         # all start as the paper's walker...
+    params = [pdw.Params.paper(d_hip=d) for d in np.linspace(0.005, 0.03, 6)]   # ...not alike
+    b = simulate_batch(x, t_end=T_END, params=params, lanes=4, threads=1, vector=False,
+                       stop_steps=2, check_step="off")
+    for i in range(6):
+        _assert_same(b, i, _scalar(x[i], params[i], stop_steps=2))
+    assert len(set(np.round(b.x_final[:, 6], 9))) > 1      # the parameters did act
+
+
+def test_lanes_and_threads_do_not_change_results():
+    """Each lane is independent: the vector path gives the same per-walker answer in any lane."""
+    x = _states(20, seed=2)
+    ref = simulate_batch(x, t_end=T_END, lanes=1, threads=1, vector=True, check_step="off")
+    for lanes, threads in ((8, 1), (5, 2), (16, 2)):
+        b = simulate_batch(x, t_end=T_END, lanes=lanes, threads=threads, vector=True,
+                           check_step="off")
+        np.testing.assert_array_equal(b.x_final, ref.x_final)
+        np.testing.assert_array_equal(b.status, ref.status)
+        np.testing.assert_array_equal(b.n_touch_down, ref.n_touch_down)
+
+
+def test_vector_path_agrees_in_outcome():
+    """libmvec's sin/cos differ from libm's in the last bits; flag switches on the step grid
+    turn that into step-sized shifts of events, so the states are not 1e-12 close (see
+    docs/ensemble.md), but each walker's outcome and event counts are the scalar run's."""
+    x = _states(12, seed=3)
+    b = simulate_batch(x, t_end=T_END, lanes=8, threads=1, vector=True, check_step="off")
+    for i in range(12):
+        r = _scalar(x[i], pdw.Params.paper())
+        assert b.status[i] == r.status
+        if r.status == "walked":
+            assert b.n_touch_down[i] == r.event_counts["touch_down"]
+            np.testing.assert_allclose(b.x_final[i], r.x_final, rtol=0.05, atol=0.05)
+
+
+def test_bad_row_is_named():
+    x = _states(5)
+    x[3, 2] = np.nan
+    with pytest.raises(pdw.InvalidInputError, match="row 3"):
+        simulate_batch(x, t_end=T_END)
+    with pytest.raises(pdw.InvalidInputError, match="row 2"):
+        simulate_batch(_states(4), t_end=T_END, flags0=[(0, 1), (0, 1), (2, 1), (0, 1)])
+    with pytest.raises(pdw.InvalidInputError, match="row 1"):
+        simulate_batch(_states(2), t_end=T_END, params=[pdw.Params.paper(), "paper"])
+    with pytest.raises(pdw.InvalidInputError, match=r"\(N, 8\)"):
+        simulate_batch(np.zeros((3, 7)), t_end=T_END)
+    with pytest.raises(pdw.InvalidInputError, match="cdm"):
+        simulate_batch(_states(2), t_end=T_END, method="rodas4")
+
+
+def test_dataframe():
+    pd = pytest.importorskip("pandas")
+    x = _states(3)
+    b = simulate_batch(x, t_end=T_END, check_step="off")
+    df = b.to_dataframe()
+    assert isinstance(df, pd.DataFrame) and len(df) == 3
+    np.testing.assert_array_equal(df["x_thetad1"].to_numpy(), b.x_final[:, 6])
+    walked = b.n_gait_steps > 0
+    last = np.minimum(b.n_gait_steps, _layout.STEP_RING) - 1
+    for i in np.nonzero(walked)[0]:
+        assert df["last_L"][i] == b.gait_rows[i, last[i], _layout.STEP.index("L")]
+
+
+def test_empty_batch():
+    b = simulate_batch(np.zeros((0, 8)), t_end=T_END)
+    assert len(b) == 0 and b.x_final.shape == (0, 8)
+
+
+def test_basin_points_are_scalar_walks():
+    """A 3 x 2 basin slice: each point's class follows from its scalar simulate run."""
+    from pdw.analysis import basin as B
+    from pdw.analysis import cell_mapping as cmap
+    from pdw.analysis import limit_cycle as lc
+    b = B.basin(phi=(0.6, 0.9, 3), thetad2=(-3.5, -1.0, 2), t_end=6.0, threads=1)
+    p = pdw.Params.paper_steady()
+    rest = cmap.rest_of(b.reference, p)
+    seen = set()
+    for j, th in enumerate(b.thetad2):
+        for i, ph in enumerate(b.phi):
+            x = lc.embed(cmap.cell_state(ph, th, rest, p), p)
+            r = pdw.simulate(x, t_end=6.0, params=p, flags0=(1, 1), record_every=0,
+                             periodic_steps=4, on_failure="return")
+            assert b.n_steps[j, i] == r.n_gait_steps
+            expect = {"fell": B.FELL, "diverged": B.FELL, "walked": B.UNDECIDED}.get(r.status)
+            if r.status == "periodic":
+                same = (abs(r.gait["L"][-1] - b.gait_L) <= 0.02 * b.gait_L
+                        and abs(r.gait["P"][-1] - b.gait_P) <= 0.02 * b.gait_P)
+                expect = B.GAIT if same else B.OTHER
+            assert b.outcome[j, i] == expect, (ph, th, r.status)
+            seen.add(int(b.outcome[j, i]))
+    assert B.GAIT in seen and B.FELL in seen
+
+
+def test_threads_and_lanes_are_checked():
+    with pytest.raises(pdw.InvalidInputError, match="threads"):
+        simulate_batch(_states(2), t_end=T_END, threads=0)
+    with pytest.raises(pdw.InvalidInputError, match="lanes"):
+        simulate_batch(_states(2), t_end=T_END, lanes=65)

@@ -1,0 +1,277 @@
+"""Issue 16: hypothesis fuzzing of the compiled entry points (shapes, dtypes, strides, values),
+of `Params`, `simulate`, scenes and studies (malformed input), and of long random runs.
+
+Every case either succeeds (with an honest result) or raises the documented error -- never a
+crash, a raw Python error, or a status that lies. A small budget runs in ``make test``; the
+``slow`` twins (``make study``) run about 10^5 cases in all (counts in docs/stability.md).
+``PDW_FUZZ_EXAMPLES`` overrides the small budget per test.
+"""
+import math
+import os
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import pdw
+from pdw.core import _core, _hybrid
+from pdw.core.model import parameter_vector
+from pdw.studies.study import parse_study
+
+SMALL = int(os.environ.get("PDW_FUZZ_EXAMPLES", "25"))
+#: the slow twins' examples per test (their sum is the study's count: 1.0e5)
+LARGE = {"compiled": 40000, "hybrid": 15000, "params": 20000, "simulate": 5000,
+         "scene": 10000, "study": 9900, "long": 100}
+_HC = [HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much]
+P = parameter_vector(pdw.Params.paper())
+X0 = np.array(pdw.X0_PAPER)
+
+
+def _twin(kind, fn, strategy=None, small=None):
+    """A small-budget test and its slow twin with LARGE[kind] examples: fn(data) draws its case
+    from hypothesis' data, or fn(case) gets one case of ``strategy``."""
+    def case(data):
+        fn(data if strategy is None else data.draw(strategy))
+
+    def fast(data):
+        case(data)
+
+    def slow(data):
+        case(data)
+    fast = settings(max_examples=small or SMALL, deadline=None,
+                    suppress_health_check=_HC)(given(st.data())(fast))
+    slow = settings(max_examples=LARGE[kind], deadline=None,
+                    suppress_health_check=_HC)(given(st.data())(slow))
+    return fast, pytest.mark.slow(slow)
+
+
+# --- strategies ---------------------------------------------------------------------------------
+
+ANY_FLOAT = st.floats(allow_nan=True, allow_infinity=True)
+NICE_FLOAT = st.floats(-1e3, 1e3)
+DTYPES = st.sampled_from([np.float64, np.float64, np.float64, np.float32, np.int64, np.intc])
+
+
+@st.composite
+def arrays(draw, shape_hint, dtype=None):
+    """An array whose shape is shape_hint mostly, else a random 1-2 d shape; any dtype; C
+    order or a strided view."""
+    if draw(st.booleans()):
+        shape = shape_hint
+    else:
+        shape = tuple(draw(st.integers(0, 70)) for _ in range(draw(st.integers(1, 2))))
+    dt = draw(DTYPES) if dtype is None else dtype
+    if not draw(st.integers(0, 5)):
+        dt = draw(DTYPES)                       # the wrong dtype now and then
+    strided = draw(st.integers(0, 7)) == 0
+    full = shape[:-1] + (shape[-1] * (2 if strided else 1),)
+    n = int(np.prod(full))
+    vals = draw(st.lists(NICE_FLOAT | ANY_FLOAT, min_size=min(n, 4), max_size=min(n, 4)))
+    a = np.resize(np.array(vals or [0.0], dtype=float), n).reshape(full) if n else np.zeros(full)
+    with np.errstate(invalid="ignore", over="ignore"):
+        a = a.astype(dt) if dt != np.float64 else a
+    return a[..., ::2] if strided else a
+
+
+# --- the compiled entry points ------------------------------------------------------------
+
+def _compiled(data):
+    n = data.draw(st.integers(0, 4))
+    which = data.draw(st.sampled_from(["rhs", "jac", "energies", "cdm", "precompute", "run"]))
+    k = data.draw(st.integers(-1, len(_core.kernel_table())))
+    x = data.draw(arrays((n, _core.NX)))
+    p = data.draw(arrays((_core.NP,)))
+    flags = data.draw(arrays((n, 2), np.intc))
+    anchors = data.draw(arrays((n, 2)))
+    work = data.draw(arrays((n, _core.NWORK)))
+    try:
+        if which == "rhs":
+            _core.rhs_batch(k, x, p, flags, anchors, data.draw(arrays((n, _core.NX))), work)
+        elif which == "jac":
+            _core.jacobian_batch(k, x, p, flags, anchors, data.draw(arrays((n, 64))), work)
+        elif which == "energies":
+            _core.energies_batch(k, x, p, data.draw(arrays((n, 3))))
+        elif which == "cdm":
+            _core.cdm_terms(k, data.draw(arrays((_core.NX,))), p, data.draw(arrays((14,))),
+                            data.draw(arrays((16,))), data.draw(arrays((16,))),
+                            data.draw(arrays((4,))))
+        elif which == "precompute":
+            _core.precompute(data.draw(arrays((19,))), data.draw(arrays((_core.NP,))))
+        else:
+            _core.run(max(k, 0), data.draw(st.integers(-1, 5)), data.draw(arrays((_core.NX,))),
+                      P, data.draw(st.integers(-1, 2)), 1, data.draw(st.sampled_from([1e-4, 0.0])),
+                      data.draw(st.integers(-2, 50)), data.draw(st.integers(-1, 3)), True,
+                      0.25, 0.125, 1e3, t_end=0.005)
+    except (ValueError, IndexError, TypeError, BufferError):
+        pass                                      # a refusal; a crash would end the test run
+
+
+def _hybrid_entry(data):
+    n = data.draw(st.integers(0, 4))
+    which = data.draw(st.sampled_from(["rhs", "energies", "full", "batch", "solve", "impact"]))
+    y = data.draw(arrays((_hybrid.NY,)))
+    try:
+        if which == "rhs":
+            _hybrid.rhs(data.draw(arrays((_core.NP,))), y)
+        elif which == "energies":
+            _hybrid.energies(data.draw(arrays((_core.NP,))), y)
+        elif which == "full":
+            _hybrid.full_state_batch(P, data.draw(arrays((n, 4))), data.draw(arrays((n, 8))))
+        elif which == "batch":
+            _hybrid.step_batch(P, data.draw(arrays((n, 4))), {"max_steps": 50},
+                               data.draw(arrays((n, 4))), data.draw(arrays((n,), np.intc)))
+        elif which == "solve":
+            m = data.draw(st.integers(0, 10))
+            _hybrid.solve(data.draw(arrays((m, m))), data.draw(arrays((m,))))
+        else:
+            _hybrid.impact(P, y)
+    except (ValueError, TypeError, ArithmeticError, BufferError):
+        pass
+
+
+test_fuzz_compiled_entry_points, test_fuzz_compiled_entry_points_study = _twin("compiled", _compiled)
+test_fuzz_hybrid_entry_points, test_fuzz_hybrid_entry_points_study = _twin("hybrid", _hybrid_entry)
+
+
+# --- Params, simulate, scenes, studies ------------------------------------------------------
+
+JUNK = (ANY_FLOAT | st.integers(-10 ** 30, 10 ** 30) | st.text(max_size=4) | st.none()
+        | st.booleans() | st.complex_numbers(max_magnitude=10) | st.lists(NICE_FLOAT, max_size=3))
+FIELDS = pdw.Params.__dataclass_fields__
+
+
+def _params(kw):
+    try:
+        p = pdw.Params(**kw)
+    except pdw.InvalidInputError as e:
+        assert any("Params." + f in str(e) for f in kw) or "Params." in str(e), e
+        return
+    for f in FIELDS:
+        v = getattr(p, f)
+        assert type(v) is float and math.isfinite(v)
+
+
+test_fuzz_params, test_fuzz_params_study = _twin("params", _params, st.dictionaries(
+    st.sampled_from(sorted(FIELDS)), NICE_FLOAT | JUNK, max_size=4))
+
+SIM_ARGS = {
+    "t_end": st.sampled_from([0.02, 0.05]) | JUNK,
+    "dt": st.sampled_from([1e-4, 1e-3, 1e-5]) | JUNK,
+    "method": st.sampled_from(pdw.METHODS) | JUNK,
+    "flags0": st.sampled_from([(0, 1), (1, 1), (1, 0), (0, 0)]) | JUNK,
+    "record_every": st.integers(0, 5) | JUNK,
+    "fall_hip_height": st.floats(0.0, 0.4) | JUNK,
+    "max_speed": st.sampled_from([1e3, 10.0]) | JUNK,
+    "rtol": st.sampled_from([1e-6, 1e-3]) | JUNK,
+    "x0": st.lists(st.floats(-0.5, 0.5), min_size=8, max_size=8).map(
+        lambda v: (X0 + 0.2 * np.array(v)).tolist()) | JUNK,
+}
+
+
+def _simulate(kw):
+    kw = {**kw, "check_step": "off", "on_failure": "return"}
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            r = pdw.simulate(**kw)
+    except pdw.InvalidInputError:
+        return
+    assert r.status in ("walked", "periodic", "fell", "diverged", "no_steps")
+    assert np.isfinite(r.x).all() and np.isfinite(r.x_final).all()
+    if r.status == "walked":
+        assert r.failure is None and abs(r.t_final - r.t_end) < 1e-9 * max(1.0, r.t_end)
+    else:
+        assert r.status == "no_steps" or r.failure is not None
+
+
+test_fuzz_simulate, test_fuzz_simulate_study = _twin(
+    "simulate", _simulate, st.fixed_dictionaries({}, optional=SIM_ARGS))
+
+TOML_VALUE = (st.integers(-5, 10 ** 7) | st.floats(allow_nan=False, allow_infinity=False)
+              | st.text("abc/._-", max_size=6).map(lambda s: '"%s"' % s)
+              | st.sampled_from(["nan", "inf", "true", "[]", "[1, 2]", '["0"]', "{}", '"../x"',
+                                 '"paper"', '"rodas4"', "[0, 1]", "[5, 7]", "1e400"]))
+
+
+def _toml(lines):
+    return "\n".join("%s = %s" % (k, v) for k, v in lines)
+
+
+def _scene(lines):
+    text = "[walker]\n" + _toml(lines["walker"]) + "\n[run]\n" + _toml(lines["run"]) + "\n"
+    try:
+        s = pdw.Scene.from_toml(text)
+    except pdw.InvalidInputError:
+        return
+    assert isinstance(s, pdw.Scene)
+
+
+SCENE_KEYS = st.sampled_from(["t_end", "dt", "method", "variant", "flags0", "record_every", "x0",
+                              "k_n", "l", "preset", "foo", "rtol", "stop_steps"])
+test_fuzz_scene, test_fuzz_scene_study = _twin("scene", _scene, st.fixed_dictionaries({
+    "walker": st.lists(st.tuples(SCENE_KEYS, TOML_VALUE), max_size=3, unique_by=lambda t: t[0]),
+    "run": st.lists(st.tuples(SCENE_KEYS, TOML_VALUE), max_size=3, unique_by=lambda t: t[0]),
+}))
+
+STUDY_TOP = st.sampled_from(["name", "title", "bogus"])
+STUDY_SCENE = st.sampled_from(["preset", "variant", "x0", "flags0", "bogus"])
+STUDY_RUN = st.sampled_from(["steady", "period_tol", "mode", "fallback", "t_end", "bogus"])
+STUDY_STOP = st.sampled_from(["t_end", "max_speed", "on_failure"])
+STUDY_INTEGRATOR = st.sampled_from(["method", "dt", "rtol", "atol"])
+AXIS_KEY = st.sampled_from(["values", "start", "stop", "num", "log"])
+
+
+def _study(parts):
+    text = (_toml(parts["top"]) + "\n[[axes]]\nname = \"k_n\"\n" + _toml(parts["axis"])
+            + "\n[run]\n" + _toml(parts["run"]) + "\n[scene]\n" + _toml(parts["scene"])
+            + "\n[scene.stop]\n" + _toml(parts["stop"])
+            + "\n[scene.integrator]\n" + _toml(parts["integrator"]) + "\n")
+    try:
+        s = parse_study(text)
+    except pdw.InvalidInputError:
+        return
+    assert "/" not in s.name and not s.name.startswith(".")
+    assert 1 <= len(s.points()) <= 10 ** 6
+    sc = s.scene
+    assert 0 < sc.integrator.dt <= sc.stop.t_end and math.isfinite(sc.integrator.rtol)
+    assert tuple(sc.flags0) in ((0, 1), (1, 1), (1, 0), (0, 0))
+    assert np.isfinite(sc.x0).all() and len(sc.x0) == 8
+    assert s.run["steady"] >= 1 and math.isfinite(s.run["period_tol"])
+
+
+def _pairs(keys):
+    return st.lists(st.tuples(keys, TOML_VALUE), max_size=3, unique_by=lambda t: t[0])
+
+
+test_fuzz_study, test_fuzz_study_study = _twin("study", _study, st.fixed_dictionaries({
+    "top": _pairs(STUDY_TOP), "run": _pairs(STUDY_RUN), "scene": _pairs(STUDY_SCENE),
+    "stop": _pairs(STUDY_STOP), "integrator": _pairs(STUDY_INTEGRATOR),
+    "axis": st.lists(st.tuples(AXIS_KEY, TOML_VALUE), min_size=1, max_size=3,
+                     unique_by=lambda t: t[0]),
+}))
+
+
+# --- long random runs ---------------------------------------------------------------------
+
+def _long(case):
+    """Long runs (20 s, about 30 steps) of random walkers near the paper's: the status is honest (walked means stepping, with
+    finite energies; a fall or a divergence says when)."""
+    k_n, gamma, method = case
+    p = pdw.Params.paper_steady(k_n=k_n, gamma=gamma)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = pdw.simulate(t_end=20.0, params=p, method=method, on_failure="return",
+                         record_every=50, record_energies=True, check_step="off", dt=1e-4)
+    if r.status == "walked":
+        assert r.n_gait_steps >= 3
+        assert all(np.isfinite(v).all() for v in r.energies.values())
+        assert np.abs(r.x[:, 2:4]).max() < 2 * np.pi
+    else:
+        assert r.status in ("fell", "diverged", "no_steps", "periodic")
+
+
+test_fuzz_long_runs, test_fuzz_long_runs_study = _twin(
+    "long", _long, st.tuples(st.floats(5e4, 2e5), st.floats(0.015, 0.025),
+                             st.sampled_from(["cdm", "rodas4"])), small=max(1, SMALL // 10))
