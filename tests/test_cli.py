@@ -168,3 +168,12 @@ def test_closed_pipe_ends_quietly(tmp_path):
     p.stderr.close()
     assert "Traceback" not in err and "BrokenPipe" not in err
     assert rc == 141
+
+
+def test_unreadable_files_are_one_line_errors(tmp_path, capsys):
+    for argv in (["run", str(tmp_path / "missing.toml")],
+                 ["sweep", str(tmp_path / "missing.toml")],
+                 ["continue", str(tmp_path / "missing.toml")]):
+        assert cli.main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("pdw: ") and "missing.toml" in err and "Traceback" not in err

@@ -7,9 +7,10 @@ What a block's info string (its language) means:
   output (for a ``print(...)`` call) or the ``str`` of its value must match EXPECTED -- the same
   words in the same order, and the same numbers to the precision written (``# -> walked 12``,
   ``# -> [0, 39.7]``). Other comments are prose.
-* ``sh`` / ``bash`` / ``shell`` / ``console``: run as one bash script (``set -e``) in a scratch
-  folder, with the test's Python first on PATH (``pdw`` is its console script, ``python`` the
-  test's interpreter); every command must succeed.
+* ``sh`` / ``bash`` / ``shell`` / ``console``: run as one bash script (``set -e``) from the
+  repository root (commands write to the ignored ``out/``), with the test's Python first on PATH
+  (``pdw`` is its console script, ``python`` the test's interpreter); every command must succeed.
+  Python blocks run in a scratch folder (the files they write do not land in the checkout).
 * ``toml``: parsed; a table with ``[[axes]]`` must be a valid study (`pdw.sweep.parse_study`),
   any other a valid scene (`pdw.Scene.from_toml`).
 * any other info string (``text``, ``c``, none, ...) is not code and is not run.
@@ -122,7 +123,9 @@ def run_python(code: str, ns: dict, where: str):
 
 
 def run_sh(code: str, cwd: pathlib.Path, where: str):
-    """Run the block as one bash script (``set -e``: every command must succeed)."""
+    """Run the block as one bash script (``set -e``: every command must succeed) from the
+    repository root, as the docs say (outputs go to the ignored out/); ``cwd`` holds the
+    interpreter shim."""
     env = dict(os.environ)
     shim = cwd / "_bin"                      # `python` and `pdw` are the test's interpreter's
     shim.mkdir(exist_ok=True)
@@ -130,7 +133,7 @@ def run_sh(code: str, cwd: pathlib.Path, where: str):
     (shim / "python").symlink_to(sys.executable)
     env["PATH"] = os.pathsep.join([str(shim), str(pathlib.Path(sys.executable).parent),
                                    env.get("PATH", "")])
-    p = subprocess.run(["bash", "-e", "-o", "pipefail", "-c", code], cwd=cwd, env=env,
+    p = subprocess.run(["bash", "-e", "-o", "pipefail", "-c", code], cwd=ROOT, env=env,
                        capture_output=True, text=True, timeout=900)
     assert p.returncode == 0, "%s: the block exited %d:\n%s%s" % (
         where, p.returncode, p.stdout[-3000:], p.stderr[-3000:])

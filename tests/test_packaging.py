@@ -111,7 +111,47 @@ def test_sdist_tests_pass_against_the_installed_wheel(venv, dists, tmp_path):
     py = venv / "bin" / "python"
     _run([py, "-m", "pip", "install", "--quiet", "--disable-pip-version-check", *reqs])
     env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
-    # the `pytest` script, not `python -m pytest`: the unpacked sources must not shadow the wheel
-    r = _run([venv / "bin" / "pytest", "-q", "-p", "no:cacheprovider", "tests"], cwd=src,
-             timeout=1800, env=env)
+    # run from a neutral folder with the `pytest` script (not `python -m pytest`), so that
+    # neither pytest nor a test's `python -c` subprocess imports the unpacked, uncompiled sources
+    # instead of the installed wheel
+    cwd = tmp_path / "elsewhere"
+    cwd.mkdir()
+    r = _run([venv / "bin" / "pytest", "-q", "-p", "no:cacheprovider", "-c", src / "pyproject.toml",
+              "--rootdir", src, src / "tests"], cwd=cwd, timeout=1800, env=env)
     assert " passed" in r.stdout and " failed" not in r.stdout
+
+
+def _interpreter(version):
+    """A python of ``version`` ("3.10"): a pyenv install, or a working ``python3.10`` on PATH."""
+    import glob
+    import shutil
+    cands = sorted(glob.glob(os.path.expanduser("~/.pyenv/versions/%s.*/bin/python" % version)))
+    if cands:
+        return cands[-1]
+    found = shutil.which("python" + version)
+    if found and subprocess.run([found, "-c", ""], capture_output=True).returncode == 0:
+        return found
+    return None
+
+
+CLAIMED = [c.split(":: ")[-1] for c in _toml.loads((ROOT / "pyproject.toml").read_text())
+           ["project"]["classifiers"] if c.startswith("Programming Language :: Python :: 3.")]
+
+
+@pytest.mark.parametrize("version", CLAIMED)
+def test_sdist_installs_and_runs_on_every_claimed_python(version, dists, tmp_path):
+    """`requires-python` and the classifiers are true: pip install of the sdist (compiled
+    there) and a simulation work on each claimed Python (3.10 reads TOML through tomli)."""
+    py = _interpreter(version)
+    if py is None:
+        pytest.skip("no Python %s on this machine" % version)
+    env_dir = tmp_path / "venv"
+    _run([py, "-m", "venv", env_dir])
+    _run([env_dir / "bin" / "python", "-m", "pip", "install", "--quiet",
+          "--disable-pip-version-check", dists[0]])
+    r = _run([env_dir / "bin" / "python", "-c", "import sys, pdw; r = pdw.simulate(); "
+              "print(sys.version_info[:2], r.status, len(r.events))"], cwd=tmp_path)
+    assert r.stdout.split(")")[-1].split() == ["walked", "12"]
+    assert r.stdout.startswith("(%s, %s)" % tuple(version.split(".")))
+    r = _run([env_dir / "bin" / "pdw", "run", "--example", "typical_gait"], cwd=tmp_path)
+    assert "steady (mean of the last 4 steps): L = 0.368" in r.stdout

@@ -235,7 +235,16 @@ def main(argv=None):
                 rc = _run(args) if args.command == "run" else _walk(args)
         sys.stdout.flush()                  # a closed pipe shows here, not at exit
         return rc
+    except BrokenPipeError:
+        # the reader went away (``pdw walk | head``): stop quietly; silence the final flush
+        with contextlib.suppress(OSError):
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+        return 141
     except PdwError as e:
+        print("pdw: error: %s" % e, file=sys.stderr)
+        return 2
+    except OSError as e:                    # a file that cannot be read or written
         print("pdw: error: %s" % e, file=sys.stderr)
         return 2
     except ValueError as e:
@@ -250,12 +259,6 @@ def main(argv=None):
     except KeyboardInterrupt:
         print("pdw: interrupted", file=sys.stderr)
         return 130
-    except BrokenPipeError:
-        # the reader went away (``pdw walk | head``): stop quietly; silence the final flush
-        with contextlib.suppress(OSError):
-            devnull = os.open(os.devnull, os.O_WRONLY)
-            os.dup2(devnull, sys.stdout.fileno())
-        return 141
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
 """`simulate_batch`: N walkers in one call, W lanes of a block in lockstep (docs/ensemble.md).
 
 The compiled engine (pdw/core/csrc/pdw_batch.c) advances a block of W walkers with the paper's
-central difference method (MODEL.md section 7), one walker per lane: the sin/cos of all lanes in
+central difference method (docs/model.md section 7), one walker per lane: the sin/cos of all lanes in
 one vector loop (glibc's libmvec), the generated stages and the discrete logic (flags, arming,
 anchors, events, online gait descriptors) per lane, exactly as `pdw.simulate`; a lane whose
 walker finishes takes the next one. Threads (GIL released) take disjoint ranges of walkers.
@@ -51,7 +51,7 @@ class BatchResult:
         Why a walker fell or diverged (``"none"`` otherwise); ``failure_t`` [s] (N,),
         ``failure_x`` (N, 8) the last good state (NaN if none), ``failure_leg`` (N,) 1, 2 or 0.
     n_touch_down, n_lift_off, n_gait_steps : ndarray of int (N,)
-        Event counts and complete gait steps (MODEL.md section 8) of each walker.
+        Event counts and complete gait steps (docs/model.md section 8) of each walker.
     gait_rows : ndarray (N, STEP_RING, len(STEP))
         The last ``min(n_gait_steps, STEP_RING)`` steps of each walker, oldest first (layout
         `pdw.core._layout.STEP`, legs 0/1), NaN beyond; `steps(i)` gives them as `Steps`.
@@ -159,7 +159,7 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
         One parameter set for all walkers (default: the paper's) or one per walker.
     variant : {"paper", "consistent"}
     method : {"cdm"}
-        Only the paper's central difference method (MODEL.md section 7) has a batched loop;
+        Only the paper's central difference method (docs/model.md section 7) has a batched loop;
         adaptive rodas4 with per-lane step control is not implemented (docs/ensemble.md).
     flags0 : (2,) or (N, 2) ints in {0, 1}
         Initial support flags of legs 1, 2.

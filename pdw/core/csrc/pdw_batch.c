@@ -1,4 +1,4 @@
-/* The ensemble engine's lane loop: the paper's central difference method (pdw_cdm.c, MODEL.md
+/* The ensemble engine's lane loop: the paper's central difference method (pdw_cdm.c, docs/model.md
  * section 7, Eqs. 13-17) for a block of W walkers in lockstep; see pdw_batch.h.
  *
  * Per step: (1) the sin/cos of every running lane in one vector loop (pdw_batch_trig.c);

@@ -2,7 +2,7 @@
  *
  * A job describes N walkers (initial states, parameter vectors, fall thresholds) and the
  * caller-allocated per-walker outputs. pdw_batch_cdm advances walkers [i0, i1) of a job
- * through the paper's central difference method (pdw_cdm.c, MODEL.md section 7) in blocks of
+ * through the paper's central difference method (pdw_cdm.c, docs/model.md section 7) in blocks of
  * W lanes: each lane is a pdw_sim (its own time, flags, arming, anchors, events, online gait
  * descriptors, through pdw_discrete.c), the sin/cos of all lanes are computed in one loop the
  * compiler vectorizes (pdw_batch_trig.c), and a lane whose walker finishes is refilled with
