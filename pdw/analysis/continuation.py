@@ -1,9 +1,10 @@
 """Continuation of gaits in one parameter: branches, stability, bifurcations (docs/continuation.md).
 
 The problem: fixed points of the period-n step map, G(z, u) = P^n(z; lambda(u)) - z = 0, with z
-the section coordinates (`pdw.analysis.gait_maps`) and u the parameter coordinate, scaled so that the
-requested range is one unit: u = (mu - mu_0) / |mu_stop - mu_0|, mu = lambda (or log lambda
-with ``log=True``). A branch is a curve x(s) = (z, u)(s) of solutions.
+the section coordinates (`pdw.analysis.gait_maps`) and u the parameter coordinate, scaled so
+that the requested range is one unit: u = (mu - mu_0) / (mu_stop - mu_0), mu = lambda (or
+log lambda with ``log=True``). A branch is a curve x(s) = (z, u)(s) of solutions. The engine
+itself is `pdw.analysis.continuation_engine`.
 
 Pseudo-arclength (default): from a point x_i with unit tangent t_i (the null vector of
 DG = [M - I, dP/du], oriented by t_{i-1}), predict x_i + ds t_i and correct by Newton's method on
@@ -18,8 +19,8 @@ bifurcation there: fold: the tangent's u component (natural: det(M - I)); period
 det(M + I); Neimark-Sacker: prod_{j<k} (mu_j mu_k - 1) (a complex pair with |mu| = 1 makes a
 factor vanish; a real pair with mu_j mu_k = 1, a neutral saddle, is rejected after location);
 the end of the family: an admissibility function of the model through 0
-(`pdw.analysis.gait_maps.HybridProblem.ADMISSIBLE`, ...), or the step map failing (the walker falls, no
-heel strike, ...) where the corrector cannot go on. Each crossing is located by the Illinois
+(`pdw.analysis.gait_maps.HybridProblem.ADMISSIBLE`, ...), or the step map failing (the walker
+falls, no heel strike, ...) where the corrector cannot go on. Each crossing is located by the Illinois
 (regula falsi) method on the arclength s along the predictor from x_i, every trial point
 corrected onto the branch, until the bracket in the parameter is narrower than ``locate_tol``.
 
