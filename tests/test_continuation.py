@@ -56,6 +56,11 @@ def test_exact_step_jacobian_and_multipliers_agree_with_finite_differences(param
     b = continue_gait(params, "gamma", params.gamma * 1.01, model="hybrid", max_points=2)
     np.testing.assert_allclose(np.sort_complex(b.multipliers[0]),
                                np.sort_complex(gait.multipliers), atol=1e-6)
+    m_exact, _ = H.floquet(gait.state, params, exact=True)
+    np.testing.assert_allclose(np.sort_complex(m_exact), np.sort_complex(gait.multipliers),
+                               atol=1e-6)
+    _, DP2 = H.step_jacobian(gait.state, params)
+    np.testing.assert_array_equal(DP2, DP)
 
 
 # --- the compass gait's cascade (Goswami, Thuilot & Espiau 1998) ------------------------------------
