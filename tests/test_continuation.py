@@ -153,6 +153,16 @@ def test_natural_and_arclength_agree_and_stop_at_the_bound():
     assert "reached stop" in a.stop_reason
 
 
+def test_continuation_to_the_edge_of_a_parameter_range():
+    """k_hip -> 0 (its lower bound): one-sided parameter differences at the edge, and the
+    last point exactly at 0, equal to find_gait's gait there."""
+    params = pdw.Params.paper_steady()
+    b = continue_gait(params, "k_hip", 0.0, model="hybrid")
+    assert b.values[-1] == 0.0 and "reached stop" in b.stop_reason
+    g = H.find_gait(params.replace(k_hip=0.0), guess=b.state[-1], settle_steps=0)
+    np.testing.assert_allclose(g.state, b.state[-1], atol=1e-9)
+
+
 def test_bad_input_names_the_field():
     with pytest.raises(InvalidInputError, match="parameter"):
         continue_gait(COMPASS, "slope", 0.1, model="hybrid")

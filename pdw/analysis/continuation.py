@@ -213,6 +213,17 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
     while len(pts) < max_points:
         a = pts[-1]
         b, why, its = eng.step_from(a, ds)
+        if b is None and str(why).startswith("invalid parameter") and a.tangent[-1] > 0:
+            # the predictor left the parameter's allowed range: land on stop if it is there
+            c, evc, _ = eng.correct(a.x + (1.0 - a.x[-1]) / a.tangent[-1] * a.tangent, e)
+            if c is not None:
+                b = Point(c, evc, eng.tangent(evc, a.tangent), 0,
+                          (1.0 - a.x[-1]) / a.tangent[-1])
+                b.tests = tests(eng, b)
+                bifs += check_crossings(eng, a, b, len(pts) - 1, locate_tol, detect)
+                pts.append(b)
+                stop_reason = "reached stop = %.10g" % float(stop)
+                break
         if b is None:
             ds *= 0.5
             if ds < step_min:

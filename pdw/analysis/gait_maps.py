@@ -87,6 +87,21 @@ class _Problem:
                                     % (self.parameter, value))
         return float(math.log(value)) if self.log else float(value)
 
+    def lam_offsets(self, mu):
+        """Offsets (+, -) of the parameter difference: central, or one-sided at the edge of
+        the parameter's allowed range (e.g. k_hip -> 0)."""
+        h = self.lam_step
+        up, down = h, -h
+        for s in (h, -h):
+            try:
+                self.params_at(mu + s)
+            except InvalidInputError:
+                if s > 0:
+                    up = 0.0
+                else:
+                    down = 0.0
+        return up, down
+
     def params_at(self, mu) -> Params:
         v = self.value(mu)
         try:
@@ -150,14 +165,19 @@ class HybridProblem(_Problem):
         if jac:
             E = np.array([[1.0, 0, 0], [-1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0]])
             M = DP[list(H._SECTION)] @ E
-            h = self.lam_step
+            up, down = self.lam_offsets(mu)
+            if up == down:
+                return Evaluation(False, "invalid parameter: no room for a difference")
             vals = []
-            for s in (+h, -h):
+            for s in (up, down):
+                if s == 0.0:
+                    vals.append(y[list(H._SECTION)])
+                    continue
                 o = self._steps(parameter_vector(self.params_at(mu + s)), z, False)
                 if isinstance(o, str):
                     return Evaluation(False, "parameter derivative: " + o)
                 vals.append(o[0][list(H._SECTION)])
-            P_lam = (vals[0] - vals[1]) / (2 * h)
+            P_lam = (vals[0] - vals[1]) / (up - down)
         info = {"period": float(sum(s["t_strike"] for s in steps)),
                 "step_length": float(np.mean([s["step_length"] for s in steps])),
                 "double_support": 0.0, "state": H._y_of(z),
@@ -222,9 +242,12 @@ class ContinuousProblem(_Problem):
             return Evaluation(False, "invalid parameter: %s" % e)
         tasks = [(z, mu)]
         if jac:
-            h, hl = self.fd_step, self.lam_step
+            h = self.fd_step
+            up, down = self.lam_offsets(mu)
+            if up == down:
+                return Evaluation(False, "invalid parameter: no room for a difference")
             tasks += [(z + e, mu) for e in np.eye(6) * h] + [(z - e, mu) for e in np.eye(6) * h]
-            tasks += [(z, mu + hl), (z, mu - hl)]
+            tasks += [(z, mu + up), (z, mu + down)]
         outs = self._run(tasks)
         self.n_maps += self.period * len(tasks)
         Pz, steps = outs[0]
@@ -238,7 +261,7 @@ class ContinuousProblem(_Problem):
                 bad = next(o[1][-1]["status"] for o in outs if o[0] is None)
                 return Evaluation(False, "finite-difference neighbour: " + bad)
             M = np.column_stack([(vals[1 + k] - vals[7 + k]) / (2 * h) for k in range(6)])
-            P_lam = (vals[13] - vals[14]) / (2 * hl)
+            P_lam = (vals[13] - vals[14]) / (up - down)
         info = {"period": float(sum(s["period"] for s in steps)),
                 "step_length": float(np.mean([s["step_length"] for s in steps])),
                 "double_support": float(np.mean([s["double_support"] for s in steps])),
