@@ -1,7 +1,7 @@
-"""The hybrid (impact-momentum) walker of MODEL.md section 9, from the same Lagrangian.
+"""The hybrid (impact-momentum) walker of docs/model.md section 9, from the same Lagrangian.
 
 Rigid ground; the stance foot rolls without slip: the velocity of its material contact point is
-zero (v_x = v_y = 0, the *consistent* normal rate of MODEL.md section 6). For the stance leg i
+zero (v_x = v_y = 0, the *consistent* normal rate of docs/model.md section 6). For the stance leg i
 the constraint J_i(q) qd = 0, with J_i the 2x4 Jacobian of `model.material_velocity(i)`, is
 holonomic (for the arc foot as for the point foot r = 0)::
 
@@ -266,7 +266,7 @@ def header(h, banner):
         "#ifndef PDW_HYBRID_H\n#define PDW_HYBRID_H\n",
         '#include "pdw_model.h"\n',
         '#define PDW_HYBRID_INPUT_HASH "%s"\n' % h,
-        "/* reduced state of the stance phase (MODEL.md section 9): stance leg, swing leg */",
+        "/* reduced state of the stance phase (docs/model.md section 9): stance leg, swing leg */",
         _enum("HY", STATE), "",
         "/* swing-foot quantities (pdw_hybrid_swing_foot) */",
         _enum("HYFOOT", FOOT), "",

@@ -23,11 +23,13 @@ continue_gait, Branch   continuation of gaits in one parameter: branches, Floque
                         folds, period doublings, Neimark-Sacker, ends (pdw.analysis.continuation;
                         ``pdw continue``)
 sweep                   parameter studies from TOML files: run_study, load_study (``pdw sweep``)
+examples                the scenes and studies shipped with pdw (``pdw run --list-examples``)
 PdwError, SimulationError, DivergedError, InvalidInputError   the error hierarchy
 STATE, VARIANTS         the state layout and the contact variants (docs/model.md section 6)
 """
 import sys as _sys
 
+from . import examples  # package data: the shipped scenes and studies
 from .analysis import cell_mapping, hybrid, limit_cycle
 from .analysis.branch import Bifurcation, Branch
 from .analysis.continuation import continue_gait
@@ -76,5 +78,5 @@ __all__ = [
     "X0_DISTURBED", "steps", "Steps", "PdwError", "SimulationError", "DivergedError",
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait", "Scene", "run",
     "limit_cycle", "cell_mapping", "find_gait", "sweep",
-    "StepSizeWarning", "StepSizeError", "continue_gait", "Branch", "Bifurcation",
+    "StepSizeWarning", "StepSizeError", "examples", "continue_gait", "Branch", "Bifurcation",
 ]

@@ -1,4 +1,4 @@
-/* The hybrid (impact-momentum) walker of MODEL.md section 9: compiled step map.
+/* The hybrid (impact-momentum) walker of docs/model.md section 9: compiled step map.
  *
  * One step = the stance phase of the reduced 2-DOF system (generated/pdw_hybrid.c; state
  * y = [theta_st, theta_sw, thetad_st, thetad_sw]) integrated by Dormand-Prince 5(4) with error
@@ -6,7 +6,7 @@
  * relabelling of the legs. The caller allocates everything; nothing here allocates.
  *
  * Heel strike: the *armed* swing foot reaches the ground (y_sw = 0) moving down. As in
- * MODEL.md section 5, the swing foot is armed once it has been above the ground (y_sw > 0)
+ * docs/model.md section 5, the swing foot is armed once it has been above the ground (y_sw > 0)
  * while downhill of the stance foot (x_sw > x_st) and, here also, with the inter-leg angle
  * theta_sw - theta_st >= min_step_angle; it is disarmed whenever it is uphill again
  * (x_sw <= x_st); a strike also needs the foot downhill (x_sw > x_st) at the step's end.
