@@ -276,12 +276,11 @@ def test_engine_locates_the_neimark_sacker_of_the_delayed_logistic_map():
 def test_cli_continue_writes_csv_json_and_diagram(tmp_path, capsys):
     import csv
     import json
-    import pathlib
 
     from pdw.present.cli import main
-    spec = pathlib.Path(__file__).resolve().parent.parent / "docs/continuations/simplest_walker.toml"
-    assert main(["continue", str(spec), "--out", str(tmp_path)]) == 0
-    rows = list(csv.DictReader(open(tmp_path / "simplest_walker.csv", encoding="utf-8")))
+    assert main(["continue", "--example", "simplest_walker", "--out", str(tmp_path)]) == 0
+    with open(tmp_path / "simplest_walker.csv", encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
     assert {r["period_n"] for r in rows} == {"1", "2", "4"}
     with open(tmp_path / "simplest_walker.json", encoding="utf-8") as fh:
         js = json.load(fh)
