@@ -211,7 +211,8 @@ def test_continuous_d_hip_branch_ends_in_a_fold():
     folds = b.of_kind("fold")
     assert len(folds) == 1 and 0.014 < folds[0].value < 0.015
     assert np.min(np.abs(folds[0].multipliers - 1.0)) < 1e-2
-    with pytest.raises(pdw.gait_types.GaitNotFoundError):
+    from pdw.analysis.gait_types import GaitNotFoundError
+    with pytest.raises(GaitNotFoundError):
         LC.find_gait(params.replace(d_hip=folds[0].value + 5e-4), guess=folds[0].gait)
 
 

@@ -316,6 +316,8 @@ def switch_branch(branch, bifurcation, amplitude=0.005, max_tries=6) -> Gait:
     prob.__dict__.update(p1.__dict__)
     prob.period = 2 * p1.period
     prob.n_maps = 0
+    if hasattr(prob, "ref_events"):
+        prob.ref_events = None
     eng = Engine(prob, s["mu0"], s["scale"], s["tol"], 12, False)
     eng1 = Engine(p1, s["mu0"], s["scale"], s["tol"], 12, False)
     x_star = np.append(bifurcation.z, (bifurcation.mu - s["mu0"]) / s["scale"])

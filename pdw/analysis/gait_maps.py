@@ -205,7 +205,9 @@ class ContinuousProblem(_Problem):
     #: admissibility: the double support must last (> 0; else the feet are never both down and
     #: the section's event order changes), and the swing phase too
     ADMISSIBLE = {"double_support": "the double support vanishes (flight or swapped events)",
-                  "swing_period": "the swing phase vanishes"}
+                  "swing_period": "the swing phase vanishes",
+                  "event_sequence": "the step's sequence of support events changes (a scuff "
+                                    "of the swing foot, an extra lift-off or touch-down)"}
 
     def __init__(self, params, parameter, params_of=None, period=1, log=False, variant="paper",
                  method="rodas4", options=None, fd_step=1e-5, executor=None, workers=None, **kw):
@@ -216,6 +218,7 @@ class ContinuousProblem(_Problem):
         self.executor = executor
         self.workers = max(1, int(workers or os.cpu_count() or 1))
         self.t_hint = None
+        self.ref_events = None       # support events per cycle at the branch's first point
 
     def section(self, state):
         s = np.asarray(state, dtype=float).reshape(-1)
@@ -268,8 +271,11 @@ class ContinuousProblem(_Problem):
                 "state": LC.embed(z, self.params_at(mu)),
                 "n_events": int(sum(s["n_events"] for s in steps)),
                 "orbit": np.array([z] + [s["z"] for s in steps[:-1]])}
+        if self.ref_events is None:
+            self.ref_events = info["n_events"]
         adm = {"double_support": min(s["double_support"] for s in steps),
-               "swing_period": min(s["swing_period"] for s in steps)}
+               "swing_period": min(s["swing_period"] for s in steps),
+               "event_sequence": 0.5 - abs(info["n_events"] - self.ref_events)}
         return Evaluation(True, "ok", Pz, M, P_lam, info, adm)
 
     def gait(self, z, mu, ev, multipliers) -> Gait:
