@@ -2,6 +2,8 @@
 and docs/figures/continuation_*.png.
 
     python benchmarks/continuation.py hybrid    # compass cascade + simplest walker (seconds)
+    python benchmarks/continuation.py hybrid_paper  # paper_steady on rigid ground, 8 parameters
+    python benchmarks/continuation.py gamma     # continuous model, the slope both ways
     python benchmarks/continuation.py dhip      # continuous model, d_hip from 0.010 to the end
     python benchmarks/continuation.py rigid     # k_n 1e5 -> 1e9, consistent, d_n ~ k_n^(4/3)
     python benchmarks/continuation.py rigid_paper  # the same in the paper variant: its end
@@ -73,6 +75,29 @@ def part_hybrid():
         say("m_l/m_h = %g:" % ml)
         _branch_line(b)
         _bifs(b)
+
+
+def part_hybrid_paper():
+    say("== the paper's walker (paper_steady) on rigid ground (hybrid model): one parameter at a "
+        "time ==")
+    P = pdw.Params.paper_steady()
+    for par, stop in (("d_hip", 0.1), ("gamma", 0.2), ("gamma", 0.001), ("k_hip", 5.0),
+                      ("k_hip", 0.0), ("r", 0.45), ("c", 0.4), ("m_h", 20.0)):
+        b = continue_gait(P, par, stop, model="hybrid", max_points=150)
+        say("%s from %g towards %g:" % (par, getattr(P, par), stop))
+        _branch_line(b)
+        _bifs(b)
+
+
+def part_gamma():
+    say("== continuous model (paper_steady, paper variant): the slope gamma, both ways ==")
+    P = pdw.Params.paper_steady()
+    for stop in (0.002, 0.08):
+        b = continue_gait(P, "gamma", stop, max_points=40, workers=2)
+        _branch_line(b)
+        _bifs(b)
+        say("  gamma: %s" % " ".join("%.5f" % v for v in b.values))
+        say("  max |mu|: %s" % " ".join("%.3f" % v for v in np.abs(b.multipliers).max(1)))
 
 
 def part_dhip():
@@ -209,7 +234,8 @@ if __name__ == "__main__":
     for part in parts:
         OUT.clear()
         t0 = time.perf_counter()
-        {"hybrid": part_hybrid, "dhip": part_dhip, "rigid": part_rigid,
+        {"hybrid": part_hybrid, "hybrid_paper": part_hybrid_paper, "gamma": part_gamma,
+         "dhip": part_dhip, "rigid": part_rigid,
          "rigid_paper": part_rigid_paper, "fig11": part_fig11}[part]()
         say("(%s: %.1f s wall; python benchmarks/continuation.py %s)"
             % (part, time.perf_counter() - t0, part))

@@ -56,6 +56,11 @@ def test_exact_step_jacobian_and_multipliers_agree_with_finite_differences(param
     b = continue_gait(params, "gamma", params.gamma * 1.01, model="hybrid", max_points=2)
     np.testing.assert_allclose(np.sort_complex(b.multipliers[0]),
                                np.sort_complex(gait.multipliers), atol=1e-6)
+    m_exact, _ = H.floquet(gait.state, params, exact=True)
+    np.testing.assert_allclose(np.sort_complex(m_exact), np.sort_complex(gait.multipliers),
+                               atol=1e-6)
+    _, DP2 = H.step_jacobian(gait.state, params)
+    np.testing.assert_array_equal(DP2, DP)
 
 
 # --- the compass gait's cascade (Goswami, Thuilot & Espiau 1998) ------------------------------------
@@ -148,6 +153,16 @@ def test_natural_and_arclength_agree_and_stop_at_the_bound():
     assert "reached stop" in a.stop_reason
 
 
+def test_continuation_to_the_edge_of_a_parameter_range():
+    """k_hip -> 0 (its lower bound): one-sided parameter differences at the edge, and the
+    last point exactly at 0, equal to find_gait's gait there."""
+    params = pdw.Params.paper_steady()
+    b = continue_gait(params, "k_hip", 0.0, model="hybrid")
+    assert b.values[-1] == 0.0 and "reached stop" in b.stop_reason
+    g = H.find_gait(params.replace(k_hip=0.0), guess=b.state[-1], settle_steps=0)
+    np.testing.assert_allclose(g.state, b.state[-1], atol=1e-9)
+
+
 def test_bad_input_names_the_field():
     with pytest.raises(InvalidInputError, match="parameter"):
         continue_gait(COMPASS, "slope", 0.1, model="hybrid")
@@ -196,7 +211,8 @@ def test_continuous_d_hip_branch_ends_in_a_fold():
     folds = b.of_kind("fold")
     assert len(folds) == 1 and 0.014 < folds[0].value < 0.015
     assert np.min(np.abs(folds[0].multipliers - 1.0)) < 1e-2
-    with pytest.raises(pdw.gait_types.GaitNotFoundError):
+    from pdw.analysis.gait_types import GaitNotFoundError
+    with pytest.raises(GaitNotFoundError):
         LC.find_gait(params.replace(d_hip=folds[0].value + 5e-4), guess=folds[0].gait)
 
 
@@ -261,12 +277,11 @@ def test_engine_locates_the_neimark_sacker_of_the_delayed_logistic_map():
 def test_cli_continue_writes_csv_json_and_diagram(tmp_path, capsys):
     import csv
     import json
-    import pathlib
 
     from pdw.present.cli import main
-    spec = pathlib.Path(__file__).resolve().parent.parent / "docs/continuations/simplest_walker.toml"
-    assert main(["continue", str(spec), "--out", str(tmp_path)]) == 0
-    rows = list(csv.DictReader(open(tmp_path / "simplest_walker.csv", encoding="utf-8")))
+    assert main(["continue", "--example", "simplest_walker", "--out", str(tmp_path)]) == 0
+    with open(tmp_path / "simplest_walker.csv", encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
     assert {r["period_n"] for r in rows} == {"1", "2", "4"}
     with open(tmp_path / "simplest_walker.json", encoding="utf-8") as fh:
         js = json.load(fh)

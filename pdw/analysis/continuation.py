@@ -1,9 +1,10 @@
 """Continuation of gaits in one parameter: branches, stability, bifurcations (docs/continuation.md).
 
 The problem: fixed points of the period-n step map, G(z, u) = P^n(z; lambda(u)) - z = 0, with z
-the section coordinates (`pdw.analysis.gait_maps`) and u the parameter coordinate, scaled so that the
-requested range is one unit: u = (mu - mu_0) / |mu_stop - mu_0|, mu = lambda (or log lambda
-with ``log=True``). A branch is a curve x(s) = (z, u)(s) of solutions.
+the section coordinates (`pdw.analysis.gait_maps`) and u the parameter coordinate, scaled so
+that the requested range is one unit: u = (mu - mu_0) / (mu_stop - mu_0), mu = lambda (or
+log lambda with ``log=True``). A branch is a curve x(s) = (z, u)(s) of solutions. The engine
+itself is `pdw.analysis.continuation_engine`.
 
 Pseudo-arclength (default): from a point x_i with unit tangent t_i (the null vector of
 DG = [M - I, dP/du], oriented by t_{i-1}), predict x_i + ds t_i and correct by Newton's method on
@@ -18,8 +19,8 @@ bifurcation there: fold: the tangent's u component (natural: det(M - I)); period
 det(M + I); Neimark-Sacker: prod_{j<k} (mu_j mu_k - 1) (a complex pair with |mu| = 1 makes a
 factor vanish; a real pair with mu_j mu_k = 1, a neutral saddle, is rejected after location);
 the end of the family: an admissibility function of the model through 0
-(`pdw.analysis.gait_maps.HybridProblem.ADMISSIBLE`, ...), or the step map failing (the walker falls, no
-heel strike, ...) where the corrector cannot go on. Each crossing is located by the Illinois
+(`pdw.analysis.gait_maps.HybridProblem.ADMISSIBLE`, ...), or the step map failing (the walker
+falls, no heel strike, ...) where the corrector cannot go on. Each crossing is located by the Illinois
 (regula falsi) method on the arclength s along the predictor from x_i, every trial point
 corrected onto the branch, until the bracket in the parameter is narrower than ``locate_tol``.
 
@@ -39,199 +40,11 @@ from ..core.errors import InvalidInputError
 from . import hybrid as H
 from . import limit_cycle as LC
 from .branch import Bifurcation, Branch
-from .gait_maps import ContinuousProblem, Evaluation, HybridProblem
+from .continuation_engine import Engine, Point, check_crossings, tests
+from .gait_maps import ContinuousProblem, HybridProblem
 from .gait_types import Gait, GaitNotFoundError
 
 MODELS = ("continuous", "hybrid")
-
-
-class _Point:
-    __slots__ = ("x", "ev", "tangent", "mult", "tests", "iters", "ds")
-
-    def __init__(self, x, ev, tangent, iters, ds):
-        self.x, self.ev, self.tangent, self.iters, self.ds = x, ev, tangent, iters, ds
-        m = np.linalg.eigvals(ev.M)
-        self.mult = m[np.argsort(-np.abs(m))]
-        self.tests = {}
-
-
-class _Engine:
-    """Predictor-corrector machinery on one problem, in the scaled coordinates x = (z, u)."""
-
-    def __init__(self, prob, mu0, scale, tol, max_newton, natural):
-        self.prob, self.mu0, self.scale = prob, mu0, scale
-        self.tol, self.max_newton, self.natural = tol, max_newton, natural
-        self.n = prob.dim
-
-    def mu(self, x):
-        return self.mu0 + x[-1] * self.scale
-
-    def value(self, x):
-        return self.prob.value(self.mu(x))
-
-    def evaluate(self, x, jac=True) -> Evaluation:
-        return self.prob.evaluate(x[:-1], self.mu(x), jac)
-
-    def dG(self, ev):
-        return np.hstack([ev.M - np.eye(self.n), (ev.P_lam * self.scale)[:, None]])
-
-    def tangent(self, ev, ref):
-        """Unit null vector of DG with ref . t > 0."""
-        A = np.vstack([self.dG(ev), ref[None, :]])
-        b = np.zeros(self.n + 1)
-        b[-1] = 1.0
-        try:
-            t = np.linalg.solve(A, b)
-        except np.linalg.LinAlgError:
-            t = np.linalg.lstsq(A, b, rcond=None)[0]
-        return t / np.linalg.norm(t)
-
-    def correct(self, x_pred, c):
-        """Newton on [G; c . (x - x_pred)] = 0: (x, ev, iterations) or (None, reason, its)."""
-        x = x_pred.copy()
-        last = "no convergence"
-        for it in range(self.max_newton + 1):
-            ev = self.evaluate(x)
-            if not ev.ok:
-                return None, ev.status, it
-            G = ev.Pz - x[:-1]
-            if np.max(np.abs(G)) < self.tol and it > 0:
-                return x, ev, it
-            if it == self.max_newton:
-                last = "no convergence in %d Newton iterations (residual %.2g)" % (
-                    it, np.max(np.abs(G)))
-                break
-            J = np.vstack([self.dG(ev), c[None, :]])
-            r = np.concatenate([G, [c @ (x - x_pred)]])
-            try:
-                dx = np.linalg.solve(J, -r)
-            except np.linalg.LinAlgError:
-                return None, "singular corrector matrix", it
-            if not np.isfinite(dx).all():
-                return None, "non-finite Newton step", it
-            x = x + dx
-            if np.max(np.abs(G)) < self.tol:      # converged at the predictor already
-                continue
-        return None, last, self.max_newton
-
-    def step_from(self, pt, ds):
-        """The next point at arclength ds from pt (natural: ds in u)."""
-        if self.natural:
-            e = np.zeros(self.n + 1)
-            e[-1] = 1.0
-            d = pt.tangent / pt.tangent[-1] if abs(pt.tangent[-1]) > 1e-12 else e
-            x_pred = pt.x + ds * d
-            c = e
-        else:
-            x_pred = pt.x + ds * pt.tangent
-            c = pt.tangent
-        x, ev, its = self.correct(x_pred, c)
-        if x is None:
-            return None, ev, its
-        ref = c if self.natural else pt.tangent
-        return _Point(x, ev, self.tangent(ev, ref), its, ds), None, its
-
-
-# --- test functions ---------------------------------------------------------------------------
-
-def _tests(engine, pt):
-    m = pt.mult
-    n = len(m)
-    ns = np.prod([m[j] * m[k] - 1.0 for j in range(n) for k in range(j + 1, n)])
-    t = {"period_doubling": float(np.real(np.prod(m + 1.0))),
-         "neimark_sacker": float(np.real(ns))}
-    if engine.natural:
-        t["fold"] = float(np.real(np.prod(m - 1.0)))
-    else:
-        t["fold"] = float(pt.tangent[-1])
-    for k, v in pt.ev.admissible.items():
-        t["end:" + k] = float(v)
-    return t
-
-
-def _locate(engine, a, b, name, locate_tol, max_iter=40):
-    """Illinois on s in (0, b.ds) along a's predictor for the test ``name``: (the point there,
-    the width of the final bracket in the parameter coordinate mu)."""
-    lo, hi = 0.0, b.ds
-    flo, fhi = a.tests[name], b.tests[name]
-    p_lo, p_hi = a, b
-    side = 0
-    for _ in range(max_iter):
-        if abs(engine.mu(p_lo.x) - engine.mu(p_hi.x)) < locate_tol:
-            break
-        s = (lo * fhi - hi * flo) / (fhi - flo) if fhi != flo else 0.5 * (lo + hi)
-        if not (lo < s < hi):
-            s = 0.5 * (lo + hi)
-        pt, _, _ = engine.step_from(a, s)
-        if pt is None:
-            s = 0.5 * (lo + hi)
-            pt, _, _ = engine.step_from(a, s)
-            if pt is None:
-                break
-        pt.tests = _tests(engine, pt)
-        f = pt.tests[name]
-        if np.sign(f) == np.sign(flo):
-            lo, flo, p_lo = s, f, pt
-            if side == -1:
-                fhi *= 0.5
-            side = -1
-        else:
-            hi, fhi, p_hi = s, f, pt
-            if side == 1:
-                flo *= 0.5
-            side = 1
-    best = p_lo if abs(p_lo.tests[name]) < abs(p_hi.tests[name]) else p_hi
-    return best, abs(engine.mu(p_lo.x) - engine.mu(p_hi.x))
-
-
-def _bifurcation(engine, kind, pt, index, width, reason, eigvec=None):
-    prob = engine.prob
-    gait = prob.gait(pt.x[:-1], engine.mu(pt.x), pt.ev, pt.mult)
-    return Bifurcation(kind=kind, value=engine.value(pt.x), gait=gait, index=index,
-                       tolerance=width, reason=reason, z=pt.x[:-1].copy(),
-                       mu=engine.mu(pt.x), tangent=pt.tangent.copy(), eigenvector=eigvec,
-                       multipliers=pt.mult.copy(), details={"orbit": pt.ev.info["orbit"]})
-
-
-def _check_crossings(engine, a, b, index, locate_tol, detect):
-    out = []
-    for name in a.tests:
-        kind = "end" if name.startswith("end:") else name
-        if kind not in detect:
-            continue
-        fa = a.tests[name]
-        fb = b.tests.get(name, fa)
-        if kind == "end":
-            crossed = fa > 0.0 >= fb
-        else:
-            crossed = np.sign(fa) != np.sign(fb) and fa != 0.0
-        if not crossed:
-            continue
-        pt, width = _locate(engine, a, b, name, locate_tol)
-        if kind == "end":
-            adm = name[4:]
-            out.append(_bifurcation(engine, "end", pt, index, width,
-                                    "%s -> 0: %s" % (adm, engine.prob.ADMISSIBLE.get(adm, adm))))
-            continue
-        m = pt.mult
-        if kind == "period_doubling":
-            j = int(np.argmin(np.abs(m + 1.0)))
-            w, V = np.linalg.eig(pt.ev.M)
-            v = np.real(V[:, int(np.argmin(np.abs(w - m[j])))])
-            out.append(_bifurcation(engine, kind, pt, index, width,
-                                    "a multiplier through -1 (%.6g)" % np.real(m[j]),
-                                    v / np.linalg.norm(v)))
-        elif kind == "neimark_sacker":
-            cx = [v for v in m if abs(v.imag) > 1e-8 and abs(abs(v) - 1.0) < 1e-3]
-            if cx:
-                out.append(_bifurcation(engine, kind, pt, index, width,
-                                        "a complex pair through the unit circle (|mu| = %.6g, "
-                                        "arg %.4g rad)" % (abs(cx[0]), abs(np.angle(cx[0])))))
-        else:
-            out.append(_bifurcation(engine, "fold", pt, index, width,
-                                    "turning point: the branch reverses in %s" % (
-                                        engine.prob.parameter)))
-    return out
 
 
 # --- the driver -------------------------------------------------------------------------------
@@ -374,7 +187,7 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
     scale = mu_stop - mu0          # signed: u runs from 0 to 1
     if hasattr(prob, "lam_rel"):
         prob.lam_step = prob.lam_rel * max(abs(mu0), abs(scale))
-    eng = _Engine(prob, mu0, scale, tol, max_newton, method == "natural")
+    eng = Engine(prob, mu0, scale, tol, max_newton, method == "natural")
     ds = abs(step / scale) if step else 0.02
     step_min = 1e-6 if step_min is None else step_min
     step_max = 0.1 if step_max is None else step_max
@@ -393,13 +206,24 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
     if direction is not None:
         dz, dmu = direction
         ref = np.append(np.asarray(dz, dtype=float), dmu / scale)
-    pts = [_Point(first, ev, eng.tangent(ev, ref), 0, 0.0)]
-    pts[0].tests = _tests(eng, pts[0])
+    pts = [Point(first, ev, eng.tangent(ev, ref), 0, 0.0)]
+    pts[0].tests = tests(eng, pts[0])
     bifs = []
     stop_reason = "max_points (%d) reached" % max_points
     while len(pts) < max_points:
         a = pts[-1]
         b, why, its = eng.step_from(a, ds)
+        if b is None and str(why).startswith("invalid parameter") and a.tangent[-1] > 0:
+            # the predictor left the parameter's allowed range: land on stop if it is there
+            c, evc, _ = eng.correct(a.x + (1.0 - a.x[-1]) / a.tangent[-1] * a.tangent, e)
+            if c is not None:
+                b = Point(c, evc, eng.tangent(evc, a.tangent), 0,
+                          (1.0 - a.x[-1]) / a.tangent[-1])
+                b.tests = tests(eng, b)
+                bifs += check_crossings(eng, a, b, len(pts) - 1, locate_tol, detect)
+                pts.append(b)
+                stop_reason = "reached stop = %.10g" % float(stop)
+                break
         if b is None:
             ds *= 0.5
             if ds < step_min:
@@ -411,8 +235,8 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
                 stop_reason = "end of the family: %s" % why
                 break
             continue
-        b.tests = _tests(eng, b)
-        found = _check_crossings(eng, a, b, len(pts) - 1, locate_tol, detect)
+        b.tests = tests(eng, b)
+        found = check_crossings(eng, a, b, len(pts) - 1, locate_tol, detect)
         ends = [f for f in found if f.kind == "end"]
         bifs += found
         u = b.x[-1]
@@ -423,8 +247,8 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
             # land on stop exactly
             c, why2, _ = eng.correct(a.x + (b.x - a.x) * (1.0 - a.x[-1]) / (u - a.x[-1]), e)
             if c is not None:
-                last = _Point(c, why2, eng.tangent(why2, a.tangent), 0, ds)
-                last.tests = _tests(eng, last)
+                last = Point(c, why2, eng.tangent(why2, a.tangent), 0, ds)
+                last.tests = tests(eng, last)
                 pts.append(last)
             else:
                 pts.append(b)
@@ -435,8 +259,8 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
             if min(a.x[-1], u) < ua < max(a.x[-1], u):
                 c, evc, _ = eng.correct(a.x + (b.x - a.x) * (ua - a.x[-1]) / (u - a.x[-1]), e)
                 if c is not None:
-                    extra = _Point(c, evc, eng.tangent(evc, a.tangent), 0, 0.0)
-                    extra.tests = _tests(eng, extra)
+                    extra = Point(c, evc, eng.tangent(evc, a.tangent), 0, 0.0)
+                    extra.tests = tests(eng, extra)
                     pts.append(extra)
         pts.append(b)
         if u < -1e-9 and not eng.natural:
@@ -492,8 +316,10 @@ def switch_branch(branch, bifurcation, amplitude=0.005, max_tries=6) -> Gait:
     prob.__dict__.update(p1.__dict__)
     prob.period = 2 * p1.period
     prob.n_maps = 0
-    eng = _Engine(prob, s["mu0"], s["scale"], s["tol"], 12, False)
-    eng1 = _Engine(p1, s["mu0"], s["scale"], s["tol"], 12, False)
+    if hasattr(prob, "ref_events"):
+        prob.ref_events = None
+    eng = Engine(prob, s["mu0"], s["scale"], s["tol"], 12, False)
+    eng1 = Engine(p1, s["mu0"], s["scale"], s["tol"], 12, False)
     x_star = np.append(bifurcation.z, (bifurcation.mu - s["mu0"]) / s["scale"])
     t1 = np.asarray(bifurcation.tangent, dtype=float)
     w = np.append(bifurcation.eigenvector, 0.0)

@@ -87,6 +87,21 @@ class _Problem:
                                     % (self.parameter, value))
         return float(math.log(value)) if self.log else float(value)
 
+    def lam_offsets(self, mu):
+        """Offsets (+, -) of the parameter difference: central, or one-sided at the edge of
+        the parameter's allowed range (e.g. k_hip -> 0)."""
+        h = self.lam_step
+        up, down = h, -h
+        for s in (h, -h):
+            try:
+                self.params_at(mu + s)
+            except InvalidInputError:
+                if s > 0:
+                    up = 0.0
+                else:
+                    down = 0.0
+        return up, down
+
     def params_at(self, mu) -> Params:
         v = self.value(mu)
         try:
@@ -150,14 +165,19 @@ class HybridProblem(_Problem):
         if jac:
             E = np.array([[1.0, 0, 0], [-1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0]])
             M = DP[list(H._SECTION)] @ E
-            h = self.lam_step
+            up, down = self.lam_offsets(mu)
+            if up == down:
+                return Evaluation(False, "invalid parameter: no room for a difference")
             vals = []
-            for s in (+h, -h):
+            for s in (up, down):
+                if s == 0.0:
+                    vals.append(y[list(H._SECTION)])
+                    continue
                 o = self._steps(parameter_vector(self.params_at(mu + s)), z, False)
                 if isinstance(o, str):
                     return Evaluation(False, "parameter derivative: " + o)
                 vals.append(o[0][list(H._SECTION)])
-            P_lam = (vals[0] - vals[1]) / (2 * h)
+            P_lam = (vals[0] - vals[1]) / (up - down)
         info = {"period": float(sum(s["t_strike"] for s in steps)),
                 "step_length": float(np.mean([s["step_length"] for s in steps])),
                 "double_support": 0.0, "state": H._y_of(z),
@@ -185,7 +205,9 @@ class ContinuousProblem(_Problem):
     #: admissibility: the double support must last (> 0; else the feet are never both down and
     #: the section's event order changes), and the swing phase too
     ADMISSIBLE = {"double_support": "the double support vanishes (flight or swapped events)",
-                  "swing_period": "the swing phase vanishes"}
+                  "swing_period": "the swing phase vanishes",
+                  "event_sequence": "the step's sequence of support events changes (a scuff "
+                                    "of the swing foot, an extra lift-off or touch-down)"}
 
     def __init__(self, params, parameter, params_of=None, period=1, log=False, variant="paper",
                  method="rodas4", options=None, fd_step=1e-5, executor=None, workers=None, **kw):
@@ -196,6 +218,7 @@ class ContinuousProblem(_Problem):
         self.executor = executor
         self.workers = max(1, int(workers or os.cpu_count() or 1))
         self.t_hint = None
+        self.ref_events = None       # support events per cycle at the branch's first point
 
     def section(self, state):
         s = np.asarray(state, dtype=float).reshape(-1)
@@ -222,9 +245,12 @@ class ContinuousProblem(_Problem):
             return Evaluation(False, "invalid parameter: %s" % e)
         tasks = [(z, mu)]
         if jac:
-            h, hl = self.fd_step, self.lam_step
+            h = self.fd_step
+            up, down = self.lam_offsets(mu)
+            if up == down:
+                return Evaluation(False, "invalid parameter: no room for a difference")
             tasks += [(z + e, mu) for e in np.eye(6) * h] + [(z - e, mu) for e in np.eye(6) * h]
-            tasks += [(z, mu + hl), (z, mu - hl)]
+            tasks += [(z, mu + up), (z, mu + down)]
         outs = self._run(tasks)
         self.n_maps += self.period * len(tasks)
         Pz, steps = outs[0]
@@ -238,15 +264,18 @@ class ContinuousProblem(_Problem):
                 bad = next(o[1][-1]["status"] for o in outs if o[0] is None)
                 return Evaluation(False, "finite-difference neighbour: " + bad)
             M = np.column_stack([(vals[1 + k] - vals[7 + k]) / (2 * h) for k in range(6)])
-            P_lam = (vals[13] - vals[14]) / (2 * hl)
+            P_lam = (vals[13] - vals[14]) / (up - down)
         info = {"period": float(sum(s["period"] for s in steps)),
                 "step_length": float(np.mean([s["step_length"] for s in steps])),
                 "double_support": float(np.mean([s["double_support"] for s in steps])),
                 "state": LC.embed(z, self.params_at(mu)),
                 "n_events": int(sum(s["n_events"] for s in steps)),
                 "orbit": np.array([z] + [s["z"] for s in steps[:-1]])}
+        if self.ref_events is None:
+            self.ref_events = info["n_events"]
         adm = {"double_support": min(s["double_support"] for s in steps),
-               "swing_period": min(s["swing_period"] for s in steps)}
+               "swing_period": min(s["swing_period"] for s in steps),
+               "event_sequence": 0.5 - abs(info["n_events"] - self.ref_events)}
         return Evaluation(True, "ok", Pz, M, P_lam, info, adm)
 
     def gait(self, z, mu, ev, multipliers) -> Gait:

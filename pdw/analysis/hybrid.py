@@ -200,17 +200,39 @@ def _jacobian(p, z, h, opts):
     return (P[1:4] - P[4:7]).T / (2 * h), P[0]
 
 
-def floquet(state, params=None, fd_step=1e-6, **options):
+def floquet(state, params=None, fd_step=1e-6, exact=False, **options):
     """(multipliers, jacobian) of the step map on the section at ``state`` (on the section).
 
     The 3x3 Jacobian in z = (theta_st, thetad_st, thetad_sw) is taken by central differences
-    with step ``fd_step`` in each coordinate; multipliers sorted by decreasing modulus.
+    with step ``fd_step`` in each coordinate, or with ``exact=True`` from `step_jacobian`;
+    multipliers sorted by decreasing modulus.
     """
     opts = {**_TIGHT, **_options(options)}
-    z = _state(state)[list(_SECTION)]
-    J, _ = _jacobian(_p(params), z, fd_step, opts)
+    if exact:
+        _, DP = step_jacobian(state, params, **options)
+        J = DP[list(_SECTION)] @ _SECTION_EMBED
+    else:
+        J, _ = _jacobian(_p(params), _state(state)[list(_SECTION)], fd_step, opts)
     mult = np.linalg.eigvals(J)
     return mult[np.argsort(-np.abs(mult))], J
+
+
+#: d y / d z of the section's embedding y = (z0, -z0, z1, z2)
+_SECTION_EMBED = np.array([[1.0, 0, 0], [-1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0]])
+
+
+def step_jacobian(state, params=None, **options):
+    """(P(state), DP): one step and its exact Jacobian d y+ / d y0 (4, 4).
+
+    DP = D_Delta S Phi(T) (docs/continuation.md): the variational equations of the symbolic
+    stance Jacobian integrated to the heel strike with the step map's own Dormand-Prince 5(4)
+    and tolerances (default rtol = atol = 1e-12 here), the saltation matrix S of the strike
+    event and the derivative of the impact map, all from derive/hybrid.py. Raises like
+    `step_map` when the step fails.
+    """
+    res, DP = _hybrid.step_jac(_p(params), _state(state), {**_TIGHT, **_options(options)})
+    _raise_for(res, params)
+    return res["y_plus"], DP
 
 
 _TIGHT = dict(rtol=1e-12, atol=1e-12)

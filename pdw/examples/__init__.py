@@ -1,6 +1,7 @@
 """Example scenes and study files shipped with pdw (package data).
 
-``pdw run --example NAME`` runs a scene, ``pdw sweep --example NAME`` a study;
+``pdw run --example NAME`` runs a scene, ``pdw sweep --example NAME`` a study,
+``pdw continue --example NAME`` a continuation (``continuations/*.toml``, docs/continuation.md);
 ``--list-examples`` lists them. In Python: `scene_path`, `study_path`, `scenes`, `studies`.
 
 Scenes (``*.toml`` here) are `pdw.Scene` files (docs/scenes.md); studies (``studies/*.toml``)
@@ -34,6 +35,16 @@ def _path(folder, names, kind, name) -> pathlib.Path:
     if stem not in names:
         raise InvalidInputError("no example %s %r; available: %s" % (kind, name, ", ".join(names)))
     return folder / (stem + ".toml")
+
+
+def continuations() -> list:
+    """Names of the example continuations (docs/continuation.md)."""
+    return _names(HERE / "continuations")
+
+
+def continuation_path(name: str) -> pathlib.Path:
+    """Path of the example continuation ``name`` (e.g. ``"compass_cascade"``)."""
+    return _path(HERE / "continuations", continuations(), "continuation", name)
 
 
 def scene_path(name: str) -> pathlib.Path:

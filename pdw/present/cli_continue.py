@@ -1,6 +1,7 @@
 """``pdw continue SPEC.toml``: a continuation from a TOML file -> CSV, JSON provenance, diagram.
 
-The spec (docs/continuation.md, examples in docs/continuations/)::
+The spec (docs/continuation.md; examples in pdw/examples/continuations/, run by
+``pdw continue --example NAME``)::
 
     name = "compass_cascade"          # output names
     title = "..."                     # figure title (optional)
@@ -43,6 +44,7 @@ import time
 
 import numpy as np
 
+from .. import examples
 from ..analysis.branch import _jsonable
 from ..analysis.continuation import continue_gait, follow_cascade
 from ..core.errors import InvalidInputError
@@ -169,14 +171,18 @@ def add_cli(subparsers):
     """Register ``pdw continue`` on an argparse subparsers object."""
     s = subparsers.add_parser("continue", help="follow a gait through a parameter: branches, "
                                                "stability, bifurcations (CSV + JSON + diagram)")
-    s.add_argument("spec", help="the continuation file (TOML; see docs/continuation.md)")
+    s.add_argument("spec", nargs="?", help="the continuation file (TOML; see docs/continuation.md)")
+    s.add_argument("--example", help="run an example continuation shipped with pdw (%s)"
+                                     % ", ".join(examples.continuations()))
     s.add_argument("--out", help="output folder (default out/continuation/<name>)")
     s.set_defaults(func=cli_main)
     return s
 
 
 def cli_main(args):
-    spec = load_spec(args.spec)
+    if (args.spec is None) == (args.example is None):
+        raise InvalidInputError("give a continuation file or --example NAME (one of them)")
+    spec = load_spec(examples.continuation_path(args.example) if args.example else args.spec)
     branches, paths = run_spec(spec, args.out)
     for b in branches:
         print("period %d: %d points, %s in [%.8g, %.8g], %d map evaluations, %.1f s; %s"
