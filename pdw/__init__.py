@@ -8,6 +8,7 @@ mass_matrix             M(q) of Eq. 2
 contact_forces          contact kinematics and forces of both feet (Eqs. 3-11)
 energies                kinetic and potential energies
 simulate, Result        one compiled simulation (support flags, events, status)
+Contact                 the normal and friction contact laws of a run (docs/contact_laws.md)
 Scene, run              everything a simulation needs, as one object or TOML file (docs/scenes.md)
 steps                   per-step gait descriptors (MODEL.md section 8)
 hybrid                  the rigid-ground impact-momentum model (MODEL.md section 9): find_gait, ...
@@ -25,6 +26,7 @@ from .errors import (DivergedError, FellError, InvalidInputError, PdwError, Simu
                      SingularSystemError, StepSizeError, StepSizeWarning)
 from .gait import Steps, steps
 from .params import Params
+from .contact import Contact
 from . import hybrid
 from .gait_types import Gait
 from .simulation import METHODS, X0_DISTURBED, X0_PAPER, Event, Result, simulate
@@ -41,5 +43,5 @@ __all__ = [
     "X0_DISTURBED", "steps", "Steps", "PdwError", "SimulationError", "DivergedError",
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait", "Scene", "run",
     "limit_cycle", "cell_mapping", "find_gait", "sweep",
-    "StepSizeWarning", "StepSizeError",
+    "StepSizeWarning", "StepSizeError", "Contact",
 ]

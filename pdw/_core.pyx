@@ -16,7 +16,7 @@ cdef extern from "pdw_model.h":
         PDW_NKERNELS, PDW_NEVENT, PDW_NREC
         PDW_WORK_TRIG, PDW_WORK_KIN, PDW_WORK_CONTACT, PDW_WORK_M, PDW_WORK_F, PDW_WORK_QDD
         PDW_STATUS_RUNNING, PDW_STATUS_EVENTS_FULL
-        PDW_NSTEP, PDW_STEP_RING
+        PDW_NSTEP, PDW_STEP_RING, PDW_NANCHOR
     ctypedef struct pdw_kernel:
         const char *name
         int variant
@@ -48,7 +48,7 @@ cdef extern from "pdw_sim.h":
     ctypedef struct pdw_discrete:
         int flags[2]
         int armed[2]
-        double anchors[2]
+        double anchors[4]
     ctypedef struct pdw_failure:
         double t
         double x[8]
@@ -165,14 +165,32 @@ def precompute(const double[::1] params, double[::1] p):
     pdw_precompute(&params[0], &p[0])
 
 
+cdef int _anchor_width(const double[:, ::1] anchors) except -1:
+    if anchors.shape[1] < 2 or anchors.shape[1] > PDW_NANCHOR:
+        raise ValueError("anchors must have 2 to %d columns (layout ANCHORS), got %d"
+                         % (PDW_NANCHOR, anchors.shape[1]))
+    return anchors.shape[1]
+
+
+cdef inline void _anchors(const double[:, ::1] anchors, Py_ssize_t i, int na,
+                          double *a) noexcept nogil:
+    """Row i of anchors, padded with zeros to PDW_NANCHOR (s0 only: no approach speeds)."""
+    cdef int j
+    for j in range(PDW_NANCHOR):
+        a[j] = anchors[i, j] if j < na else 0.0
+
+
 def rhs_batch(int k, const double[:, ::1] x, const double[::1] p, const int[:, ::1] flags,
               const double[:, ::1] anchors, double[:, ::1] xdot, double[:, ::1] work):
     """f(x) (Eq. A.4) for each row; work (N, NWORK) receives every stage's output."""
     cdef const pdw_kernel *kern = _kernel(k)
     cdef Py_ssize_t i, n = x.shape[0]
+    cdef double a[PDW_NANCHOR]
+    cdef int na = _anchor_width(anchors)
     with nogil:
         for i in range(n):
-            kern.rhs(&x[i, 0], &p[0], &flags[i, 0], &anchors[i, 0], &xdot[i, 0], &work[i, 0])
+            _anchors(anchors, i, na, a)
+            kern.rhs(&x[i, 0], &p[0], &flags[i, 0], a, &xdot[i, 0], &work[i, 0])
 
 
 def jacobian_batch(int k, const double[:, ::1] x, const double[::1] p, const int[:, ::1] flags,
@@ -180,9 +198,28 @@ def jacobian_batch(int k, const double[:, ::1] x, const double[::1] p, const int
     """df/dx (8x8 row-major per row of J, shape (N, 64)); work as in rhs_batch, with partials."""
     cdef const pdw_kernel *kern = _kernel(k)
     cdef Py_ssize_t i, n = x.shape[0]
+    cdef double a[PDW_NANCHOR]
+    cdef int na = _anchor_width(anchors)
     with nogil:
         for i in range(n):
-            kern.jacobian(&x[i, 0], &p[0], &flags[i, 0], &anchors[i, 0], &J[i, 0], &work[i, 0])
+            _anchors(anchors, i, na, a)
+            kern.jacobian(&x[i, 0], &p[0], &flags[i, 0], a, &J[i, 0], &work[i, 0])
+
+
+def contact_batch(int k, const double[:, ::1] kin, const int[:, ::1] flags, const double[::1] p,
+                  double[:, ::1] contact, bint partials=False):
+    """The contact stage alone: per row, kin (N, 2*NKIN) -> contact (N, 2*NCONTACT) (forces
+    only, or with ``partials`` the partial derivatives too); for tests of the force laws."""
+    cdef const pdw_kernel *kern = _kernel(k)
+    cdef Py_ssize_t i, n = kin.shape[0]
+    assert kin.shape[1] == 2 * PDW_NKIN and contact.shape[1] == 2 * PDW_NCONTACT
+    assert flags.shape[0] == n and contact.shape[0] == n
+    with nogil:
+        for i in range(n):
+            if partials:
+                kern.contact_partials(&kin[i, 0], &flags[i, 0], &p[0], &contact[i, 0])
+            else:
+                kern.contact(&kin[i, 0], &flags[i, 0], &p[0], &contact[i, 0])
 
 
 def energies_batch(int k, const double[:, ::1] x, const double[::1] p, double[:, ::1] e):
@@ -210,10 +247,11 @@ def bench(int k, str what, const double[::1] x, const double[::1] p, int f1, int
     """Mean ns per evaluation of `what` ("rhs" or "jacobian") over n calls in a C loop."""
     cdef const pdw_kernel *kern = _kernel(k)
     cdef int flags[2]
-    cdef double anchors[2]
+    cdef double anchors[4]
     cdef double work[PDW_NWORK]
     cdef double sink = 0.0, ns
-    flags[0] = f1; flags[1] = f2; anchors[0] = a1; anchors[1] = a2
+    flags[0] = f1; flags[1] = f2; anchors[0] = a1; anchors[1] = a2; anchors[2] = 0.0
+    anchors[3] = 0.0
     if what == "rhs":
         with nogil:
             ns = pdw_bench_rhs(kern, &x[0], &p[0], flags, anchors, n, work, &sink)
@@ -403,6 +441,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         "x_final": np.array(<double[:PDW_NX]> s.x),
         "flags_final": (s.disc.flags[0], s.disc.flags[1]),
         "anchors_final": (s.disc.anchors[0], s.disc.anchors[1]),
+        "approach_speeds_final": (s.disc.anchors[2], s.disc.anchors[3]),
         "failure": {"t": s.failure.t, "x": np.array(<double[:PDW_NX]> s.failure.x),
                     "leg": s.failure.leg, "reason": s.failure.reason},
     }

@@ -13,7 +13,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from . import _core, _layout, stability as _stability
+from . import _core, _layout, contact as _contact, stability as _stability
 from .errors import DivergedError, InvalidInputError, SingularSystemError
 from .gait import Steps, steps_from_rows
 from .model import STATE, check_variant, kernel_index, parameter_vector
@@ -114,6 +114,7 @@ class Result:
     energies: dict | None = None
     features: tuple = _layout.FEATURES
     scene: object = None
+    contact: object = None      # the pdw.Contact simulated (laws and parameters)
 
     @property
     def walked(self) -> bool:
@@ -160,7 +161,7 @@ _DEFAULTS = dict(t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
                  record_every=1, record_forces=True, on_failure="raise", fall_hip_height=None,
                  fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8, h_max=None, event_tol=1e-9,
                  features=None, record_events=True, record_energies=False, stop_steps=0,
-                 periodic_steps=0, periodic_tol=1e-3, check_step="warn")
+                 periodic_steps=0, periodic_tol=1e-3, check_step="warn", contact=None)
 
 
 def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
@@ -168,7 +169,7 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
              fall_hip_height=None, fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8,
              h_max=None, event_tol=1e-9, *, features=None, record_events=True,
              record_energies=False, stop_steps=0, periodic_steps=0, periodic_tol=1e-3,
-             check_step="warn"):
+             check_step="warn", contact=None):
     """Simulate the walker from ``x0`` for ``t_end`` seconds (or run a `pdw.Scene`).
 
     ``simulate(scene)`` runs the scene (as `pdw.run`); no other argument may be given then.
@@ -233,7 +234,12 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     check_step : {"warn", "error", "off"}
         Fixed-step methods: compare dt with `pdw.stability.step_limit` (the method's estimated
         stability limit for these parameters) and warn (`pdw.StepSizeWarning`) or refuse
-        (`pdw.StepSizeError`) above it, naming the limit and the force that sets it.
+        (`pdw.StepSizeError`) above it, naming the limit and the force that sets it. The
+        limit is calibrated on the default contact law only: runs with another normal law
+        are not checked.
+    contact : pdw.Contact, dict or str, optional
+        Normal and friction contact laws and their parameters (`pdw.Contact`,
+        docs/contact_laws.md); default the paper's Hunt-Crossley and smooth Coulomb laws.
 
     Returns
     -------
@@ -288,11 +294,14 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
                                 % (_layout.STEP_RING, periodic_steps))
     periodic_tol = _check_positive("periodic_tol", periodic_tol)
 
-    k = kernel_index(variant, feats)
+    contact = _contact.Contact.coerce(contact)
+    params = contact.parameters(params)
+    k = kernel_index(variant, feats, contact.normal)
     if feats != _layout.FEATURES:
         params = params.without(feats)
-    _stability.check_step(dt, params, method, variant, check_step)
-    p = parameter_vector(params)
+    if contact.normal == "hunt_crossley":
+        _stability.check_step(dt, params, method, variant, check_step)
+    p = contact.vector(parameter_vector(params), feats)
     start = time.perf_counter()
     raw = _core.run(k, METHODS.index(method), x, p, f0[0], f0[1], dt, n_steps, int(record_every),
                     bool(record_forces), hip, depth, max_speed, rtol, atol, h_max,
@@ -306,8 +315,10 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
             _core.energies_batch(k, np.ascontiguousarray(raw["x"]), p, e)
         energies = {name: e[:, i] for i, name in enumerate(_layout.ENERGY)}
         energies["E"] = e.sum(axis=1)
-    return _result(raw, params, variant, method, dt, t_end, wall, on_failure, feats,
-                   bool(record_events), energies)
+    res = _result(raw, params, variant, method, dt, t_end, wall, on_failure, feats,
+                  bool(record_events), energies)
+    res.contact = contact
+    return res
 
 
 def _same(a, b):
