@@ -131,3 +131,109 @@ def drop_test(contact, params: Params | None = None, v_in: float = 0.3, mass: fl
     if g > 0:     # settled under its weight: fully inelastic
         return Drop(0.0, v_in, 0.0, max_d, peak, t_force)
     raise RuntimeError("drop test did not end within 50 contact times (law %s)" % contact.normal)
+
+
+@dataclass(frozen=True)
+class Landing:
+    """The typical touch-down of the default walker: the landing foot's approach speed -v_y
+    [m/s] and its effective mass 1/(J M^-1 J^T) [kg] along the ground normal (J = dv_y/dq'),
+    medians over the touch-downs of a run."""
+
+    speed: float
+    mass: float
+    n: int
+
+
+def typical_landing(params: Params | None = None, variant: str = "paper", t_end: float = 6.0,
+                    skip: int = 3) -> Landing:
+    """Measure the touch-downs of the default (Hunt-Crossley) walker from the paper's start:
+    a cdm run at dt = 1e-4 s, the state one step before each touch-down after the first
+    ``skip`` (the start-up transient)."""
+    from .model import contact_forces, mass_matrix
+    from .simulation import simulate
+    params = Params.paper_steady() if params is None else params
+    r = simulate(params=params, variant=variant, t_end=t_end, dt=1e-4, method="cdm")
+    speeds, masses = [], []
+    td = [e for e in r.events if e.kind == "touch_down"][skip:]
+    for ev in td:
+        i = int(np.searchsorted(r.t, ev.t)) - 1
+        x, j = r.x[i], ev.leg - 1
+        cs = contact_forces(x, params, flags=(1, 1), variant=variant)
+        speeds.append(-cs.v_y[j])
+        th = x[2 + j]
+        J = np.zeros(4)
+        J[1] = 1.0
+        J[2 + j] = (params.l - params.r) * math.sin(th) + (params.r if variant == "paper" else 0.0)
+        masses.append(1.0 / float(J @ np.linalg.solve(mass_matrix(x[:4], params), J)))
+    if not speeds:
+        raise RuntimeError("no touch-down after the first %d in %g s" % (skip, t_end))
+    return Landing(float(np.median(speeds)), float(np.median(masses)), len(speeds))
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """Each law's `Contact` matched to the default ground: ``contacts[law]``; the target
+    restitution ``e_target`` (the Hunt-Crossley drop at the typical landing), each law's
+    measured ``e_drop`` and static sink ``sink`` [m]; ``reachable[law]`` is False when no
+    parameter of the law reaches e_target (it then gets its most dissipative setting)."""
+
+    landing: Landing
+    weight: float
+    sink: dict
+    e_target: float
+    e_drop: dict
+    contacts: dict
+    reachable: dict
+
+
+def _bisect(fun, lo, hi, target, log=False, n=40):
+    """x in [lo, hi] with fun(x) = target, fun monotone; None when target is outside."""
+    flo, fhi = fun(lo), fun(hi)
+    if (flo - target) * (fhi - target) > 0:
+        return None
+    for _ in range(n):
+        mid = math.sqrt(lo * hi) if log else 0.5 * (lo + hi)
+        fm = fun(mid)
+        if (fm - target) * (flo - target) > 0:
+            lo, flo = mid, fm
+        else:
+            hi = mid
+    return math.sqrt(lo * hi) if log else 0.5 * (lo + hi)
+
+
+def calibrate(params: Params | None = None, variant: str = "paper",
+              landing: Landing | None = None) -> Calibration:
+    """Parameters of every normal law matched to ``params``' Hunt-Crossley ground.
+
+    Static sink: the laws with delta^1.5 stiffness keep k = k_n (at rest their damping is 0,
+    so the sink under the weight W is (W/k_n)^(2/3) for each); Kelvin-Voigt gets
+    k = W / delta_s. Restitution: the Hunt-Crossley drop test at the typical landing
+    (`typical_landing`: speed and effective mass; no gravity, the impact alone) gives e_target;
+    Kelvin-Voigt's d and the e of Lankarani-Nikravesh and Flores are solved for so that their
+    own drop test (same speed and mass) gives e_target. Hertz has no damping (e = 1).
+    """
+    params = Params.paper_steady() if params is None else params
+    landing = typical_landing(params, variant) if landing is None else landing
+    W = params.weight
+    sink = (W / params.k_n) ** (2.0 / 3.0)
+    v, m = landing.speed, landing.mass
+
+    def e_of(contact):
+        return drop_test(contact, params, v_in=v, mass=m).e
+
+    hc = Contact()
+    e_target = e_of(hc)
+    contacts = {"hunt_crossley": hc, "hertz": Contact("hertz")}
+    reachable = {"hunt_crossley": True, "hertz": e_target >= 1.0 - 1e-9}
+    k_kv = W / sink
+    d_kv = _bisect(lambda d: e_of(Contact("kelvin_voigt", k=k_kv, d=d)), 1e-2, 1e5, e_target,
+                   log=True)
+    reachable["kelvin_voigt"] = d_kv is not None
+    contacts["kelvin_voigt"] = Contact("kelvin_voigt", k=k_kv, d=1e5 if d_kv is None else d_kv)
+    for law in ("lankarani_nikravesh", "flores"):
+        e = _bisect(lambda x: e_of(Contact(law, e=x)), 0.01, 1.0, e_target)
+        reachable[law] = e is not None
+        contacts[law] = Contact(law, e=0.01 if e is None else e)
+    e_drop = {law: e_of(c) for law, c in contacts.items()}
+    sinks = {law: sink for law in contacts}
+    return Calibration(landing, W, sinks, e_target, e_drop, contacts, reachable)

@@ -162,3 +162,21 @@ def test_scene_contact_table_runs_as_simulate():
 def test_bad_contact_is_named(bad, match):
     with pytest.raises(pdw.InvalidInputError, match=match):
         pdw.simulate(t_end=0.01, contact=bad)
+
+
+def test_calibration_matches_sink_and_restitution():
+    """Calibrated at a given landing: Kelvin-Voigt carries the weight at the Hunt-Crossley
+    sink; Kelvin-Voigt and Flores drop with the Hunt-Crossley restitution; Lankarani-Nikravesh
+    cannot dissipate that much (flagged). Flores has Hunt-Crossley's form, so matched at the
+    landing speed its damping k chi / v_in is Hunt-Crossley's d_n."""
+    from pdw.calibration import Landing, calibrate
+    P = pdw.Params.paper_steady()
+    cal = calibrate(P, landing=Landing(speed=0.7, mass=0.45, n=1))
+    kv = cal.contacts["kelvin_voigt"]
+    assert kv.k * cal.sink["kelvin_voigt"] == pytest.approx(P.weight, rel=1e-12)
+    assert cal.sink["hertz"] == pytest.approx((P.weight / P.k_n) ** (2 / 3), rel=1e-12)
+    for law in ("kelvin_voigt", "flores"):
+        assert cal.reachable[law] and abs(cal.e_drop[law] - cal.e_target) < 1e-6, law
+    assert not cal.reachable["lankarani_nikravesh"] and cal.e_drop["lankarani_nikravesh"] > 0.6
+    e = cal.contacts["flores"].e
+    assert P.k_n * 8 * (1 - e) / (5 * e) / 0.7 == pytest.approx(P.d_n, rel=1e-5)
