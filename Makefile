@@ -5,9 +5,9 @@ PY     := $(VENV)/bin/python
 PIP    := $(PY) -m pip
 OUT    ?= out/typical_gait
 STAMP  := $(VENV)/.pdw-installed
-SOURCES := $(wildcard generated/*.c generated/*.h pdw/*.pyx pdw/csrc/*.c pdw/csrc/*.h) setup.py pyproject.toml
+SOURCES := $(wildcard generated/*.c generated/*.h pdw/core/*.pyx pdw/core/csrc/*.c pdw/core/csrc/*.h) setup.py pyproject.toml
 
-.PHONY: all run test test-all derive check-generated bench study clean distclean
+.PHONY: all run test lint test-all derive check-generated bench study clean distclean
 
 all: $(STAMP)
 
@@ -25,16 +25,22 @@ $(STAMP): $(VENV)/bin/python $(SOURCES)
 run: $(STAMP)
 	$(PY) -m pdw walk --out $(OUT)
 
-## test: build everything, check generated/ against derive/, run the test suite
+## test: build everything, check generated/ against derive/, lint, the layer contract, the tests
 test: $(STAMP)
 	$(PY) -m derive --check
+	$(MAKE) --no-print-directory lint
 	$(PY) -m pytest -q
+
+## lint: ruff (rules in pyproject.toml) and the import contract (layers, no cycles: docs/architecture.md)
+lint: $(STAMP)
+	$(VENV)/bin/ruff check pdw tests benchmarks derive
+	$(VENV)/bin/lint-imports --no-cache
 
 ## test-all: also the slow studies
 test-all: $(STAMP)
 	$(PY) -m pytest -q -m ""
 
-## derive: regenerate generated/ and pdw/_layout.py from the symbolic derivation
+## derive: regenerate generated/ and pdw/core/_layout.py from the symbolic derivation
 derive: $(VENV)/bin/python
 	$(PIP) install --quiet "sympy>=1.12"
 	$(PY) -m derive
@@ -56,7 +62,7 @@ study: $(STAMP)
 	$(PY) benchmarks/stability_maps.py
 
 clean:
-	rm -rf build pdw/_core.c pdw/*.so out
+	rm -rf build pdw/core/_core.c pdw/core/_hybrid.c pdw/core/*.so out
 
 distclean: clean
 	rm -rf $(VENV) *.egg-info

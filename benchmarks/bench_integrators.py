@@ -1,11 +1,18 @@
 """Work-precision table of docs/integrators.md: the typical gait (simulate() defaults: x0 =
 X0_PAPER, 3.5 s, variant paper), error vs a RODAS4 run at rtol 1e-12 (event_tol 1e-12)."""
-import time, numpy as np
-from pdw.simulation import simulate
+import time
+
+import numpy as np
+
+from pdw.sim.simulation import simulate
+
+
 def best(f, n):
     ts=[]
     for _ in range(n):
-        t=time.perf_counter(); r=f(); ts.append(time.perf_counter()-t)
+        t = time.perf_counter()
+        r = f()
+        ts.append(time.perf_counter() - t)
     return r, min(ts)
 ref = simulate(method="rodas4", rtol=1e-12, atol=1e-14, record_every=0, event_tol=1e-12)
 evr = np.array([e.t for e in ref.events])
@@ -16,7 +23,7 @@ print("| method | options | wall [ms] | f evals | Jacobians | steps (rejected) |
 print("|---|---|---|---|---|---|---|---|")
 for m, kw in runs:
     n = 7 if m == "rodas4" or kw.get("dt", 0) >= 1e-4 else 2
-    r, w = best(lambda: simulate(method=m, record_every=0, **kw), n)
+    r, w = best(lambda m=m, kw=kw: simulate(method=m, record_every=0, **kw), n)
     ev = np.array([e.t for e in r.events])
     eve = "%.1e" % np.abs(ev-evr).max() if len(ev)==len(evr) else "n/a"
     st = r.stats

@@ -8,11 +8,11 @@ import platform
 import statistics
 
 import numpy as np
+from _results import publish
 
 import pdw
-from _results import publish
-from pdw import _core, _layout
-from pdw.model import kernel_index, parameter_vector
+from pdw.core import _core, _layout
+from pdw.core.model import kernel_index, parameter_vector
 
 N = 2_000_000
 REPEATS = 7

@@ -18,9 +18,10 @@ import sys
 import time
 import tracemalloc
 
-import pdw
-from pdw.scene import Forces, Record, Scene, Stop
 from _results import publish
+
+import pdw
+from pdw.sim.scene import Forces, Record, Scene, Stop
 
 REPEATS = 21
 T_END = 10.0
@@ -122,8 +123,9 @@ def main():
 
 def kernel_costs():
     import numpy as np
-    from pdw import _core
-    from pdw.model import parameter_vector
+
+    from pdw.core import _core
+    from pdw.core.model import parameter_vector
     x = np.array(pdw.X0_PAPER)
     x[1] -= 0.002                                   # both feet ~5 mm deep
     p = parameter_vector(pdw.Params.paper())

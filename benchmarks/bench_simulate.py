@@ -9,8 +9,9 @@ import statistics
 import time
 import tracemalloc
 
-import pdw
 from _results import publish
+
+import pdw
 
 REPEATS = 31
 REFERENCE_MS = (2.0, 4.0)

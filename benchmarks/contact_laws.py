@@ -33,8 +33,8 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 from _results import publish  # noqa: E402
 
 import pdw  # noqa: E402
-from pdw import stability as S  # noqa: E402
-from pdw.calibration import calibrate  # noqa: E402
+from pdw.analysis import stability_maps as S  # noqa: E402
+from pdw.analysis.calibration import calibrate  # noqa: E402
 
 P = pdw.Params.paper_steady()
 FIG = ROOT / "docs" / "figures" / "contact_laws_stance.png"
@@ -167,7 +167,7 @@ def main():
         slip, flips = chatter_cdm(c)
         lim = cdm_limit(c)
         cost, wall = rodas_cost(c)
-        f = lambda k, s=1.0, fmt="%.4f": fmt % (g[k] * s) if k in g else "—"  # noqa: E731
+        f = lambda k, s=1.0, fmt="%.4f", g=g: fmt % (g[k] * s) if k in g else "—"  # noqa: E731
         lines.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %.3f | %.3f | %s | %.0f | %.1f |" % (
             law, g["status"], f("L"), f("P"), f("v"), f("double_support", 1e3, "%.1f"),
             f("ds_fraction", 100, "%.2f"), f("F_peak", 1, "%.1f"), f("F_settled", 1, "%.2f"),

@@ -110,7 +110,7 @@ def basin(lines, gait):
               % fmt(cm.info["reference"]), cm.summary(),
               "Newton's fixed point: phi* = %.5f, thetad2* = %.5f; its cell %d is in group %d"
               % (fp[0], fp[1], cm.cell_of(*fp), cm.group[cm.cell_of(*fp)])]
-    for n, cells, (a, b) in cm.periodic_cells():
+    for n, _cells, (a, b) in cm.periodic_cells():
         lines.append("  periodic group of period %d at (%.5f, %.4f): offset from Newton "
                      "(%.2f, %.2f) cells" % (n, a, b, (a - fp[0]) / np.diff(cm.a_edges)[0],
                                              (b - fp[1]) / np.diff(cm.b_edges)[0]))

@@ -7,7 +7,7 @@ import sys
 import numpy as np
 
 import pdw
-from pdw.report import stance_forces, walk_report
+from pdw.present.report import stance_forces, walk_report
 
 
 def typical():

@@ -3,12 +3,12 @@
 The walker is a hybrid system: its right-hand side f depends on a discrete state (support
 flags, the arming of the scuffing guard, the tangential anchors; MODEL.md sections 5-6) that
 changes only at flag switches. pdw's adaptive loops locate each switch inside a step and
-restart there (pdw/csrc/pdw_ode.c); this module does the same with scipy:
+restart there (pdw/core/csrc/pdw_ode.c); this module does the same with scipy:
 
-* f and its Jacobian are pdw's compiled kernels (``pdw._core.rhs_batch`` and
-  ``pdw._core.jacobian_batch``, the very code that ``pdw.simulate`` calls), wrapped thinly on
+* f and its Jacobian are pdw's compiled kernels (``pdw.core._core.rhs_batch`` and
+  ``pdw.core._core.jacobian_batch``, the very code that ``pdw.simulate`` calls), wrapped thinly on
   preallocated (1, 8) arrays -- the same compiled right-hand side as pdw's integrators;
-* every switch rule of pdw/csrc/pdw_discrete.c that can fire from the current discrete state
+* every switch rule of pdw/core/csrc/pdw_discrete.c that can fire from the current discrete state
   is a *terminal* scipy event, with a continuous function that is positive exactly where the
   rule's conjunction holds (and rises through 0 when it starts to hold):
 
@@ -39,8 +39,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 import pdw
-from pdw import _core, _layout
-from pdw.model import kernel_index, parameter_vector
+from pdw.core import _core, _layout
+from pdw.core.model import kernel_index, parameter_vector
 
 _K0 = _layout.WORK["kin"][0]
 _NK = len(_layout.KIN)
@@ -86,7 +86,7 @@ class Model:
         return self.J[0].reshape(_core.NX, _core.NX).copy()
 
     def kinematics(self, y):
-        """(2, 6) contact kinematics `pdw._layout.KIN` of both feet at y (cached per y)."""
+        """(2, 6) contact kinematics `pdw.core._layout.KIN` of both feet at y (cached per y)."""
         key = y.tobytes()
         if key != self._kin_key:
             self.kx[0] = y
@@ -99,7 +99,7 @@ class Model:
 
 @dataclass
 class Discrete:
-    """pdw_discrete (pdw/csrc/pdw_sim.h): flags, arming and anchors of legs 1, 2 (index 0, 1)."""
+    """pdw_discrete (pdw/core/csrc/pdw_sim.h): flags, arming and anchors of legs 1, 2 (index 0, 1)."""
 
     flags: list
     armed: list = field(default_factory=lambda: [0, 0])
@@ -110,7 +110,7 @@ class Discrete:
 
 
 def update_flags(kin, d: Discrete, t, events):
-    """One pass of pdw_update_flags (pdw/csrc/pdw_discrete.c), rule by rule, on the contact
+    """One pass of pdw_update_flags (pdw/core/csrc/pdw_discrete.c), rule by rule, on the contact
     kinematics ``kin`` (2, 6) of the state; appends pdw.Event tuples to ``events``.
     ``kin`` must be recomputed by the caller after a touch-down (new anchor: xi only)."""
     for i in range(2):

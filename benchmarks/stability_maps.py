@@ -22,13 +22,14 @@ import numpy as np
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-import pdw  # noqa: E402
-from pdw import stability as S  # noqa: E402
-
 from _results import RESULTS, publish  # noqa: E402
 
+import pdw  # noqa: E402
+from pdw.analysis import stability_maps as S  # noqa: E402
+from pdw.sim import stepsize as SL  # noqa: E402
+
 FIGURES = ROOT / "docs" / "figures"
-FIXED = S.FIXED_STEP
+FIXED = SL.FIXED_STEP
 #: swept parameters: values (the paper's range is marked) -- a decade beyond each end
 SWEEPS = {
     "k_n": ([5e3, 1.6e4, 5e4, 1e5, 2.5e5, 8e5, 2.5e6], (0.5e5, 2.5e5)),
@@ -71,15 +72,15 @@ def linear_along(ref, method, idx=None):
     best = (math.inf, None, None)
     for i in idx:
         J = pdw.jacobian(ref.x[i], P, flags=tuple(ref.flags[i]), anchors=tuple(anchors[i]),
-                         variant=ref.variant, features=S._NO_FRICTION)
-        h = S.linear_limit(method, J)
+                         variant=ref.variant, features=SL._NO_FRICTION)
+        h = SL.linear_limit(method, J)
         if h < best[0]:
             best = (h, float(ref.t[i]), tuple(int(f) for f in ref.flags[i]))
     return best
 
 
 def adaptive_stats(P, method, ref):
-    x0 = S.typical_start(P, ref.variant)
+    x0 = SL.typical_start(P, ref.variant)
     t_end = DOPRI5_T_END if method == "dopri5" else ref.t_end
     t0 = time.perf_counter()
     r = S._sim(x0=x0, t_end=t_end, dt=1e-5, params=P, method=method, rtol=ADAPTIVE_RTOL,
@@ -111,7 +112,7 @@ def cell(args):
            "adaptive": {}}
     walks = ref.status == "walked"
     # a marginal gait (the reference falls soon after t_end) decides "walks" by chance
-    longer = S._sim(x0=S.typical_start(P, variant), t_end=MARGIN_T_END, params=P, method="rodas4",
+    longer = S._sim(x0=SL.typical_start(P, variant), t_end=MARGIN_T_END, params=P, method="rodas4",
                     variant=variant, rtol=1e-9, atol=1e-11, record_every=0)
     out["marginal"] = None if longer.status == "walked" else "reference %s at %.2f s" % (
         longer.status, longer.t_final)
@@ -126,16 +127,16 @@ def cell(args):
             d["walk"] = ls["walk"]
             d["correct"] = ls["correct"]
             d["runs"] = [(dt, v.walks, v.correct, v.reason) for dt, v in ls["runs"]]
-        d["h_states"] = S._limits(P, m, variant)
-        d["step_limit"] = S.step_limit(P, m, variant).dt_max
+        d["h_states"] = SL._limits(P, m, variant)
+        d["step_limit"] = SL.step_limit(P, m, variant).dt_max
         d["h_traj"], d["t_traj"], d["flags_traj"] = linear_along(ref, m, idx)
-        d["sensitivity"] = S.sensitivity(P, m, variant)
-        d["force"] = S.step_limit(P, m, variant).force
+        d["sensitivity"] = SL.sensitivity(P, m, variant)
+        d["force"] = SL.step_limit(P, m, variant).force
         out["methods"][m] = d
     if walks:
         for m in ("dopri5", "rodas4"):
             out["adaptive"][m] = adaptive_stats(P, m, ref)
-        out["adaptive"]["dopri5"]["h_linear_friction"] = S.step_limit(P, "dopri5", variant).dt_chatter
+        out["adaptive"]["dopri5"]["h_linear_friction"] = SL.step_limit(P, "dopri5", variant).dt_chatter
     out["wall"] = time.perf_counter() - t0
     return out
 
@@ -152,7 +153,7 @@ def chatter_cell(args):
         out["methods"][m] = {
             "slides": S.chatter_onset(P, m, variant, key="slides", hi=1e-3),
             "chatters": S.chatter_onset(P, m, variant, key="chatters", hi=1e-3),
-            "linear": S.step_limit(P, m, variant).dt_chatter,
+            "linear": SL.step_limit(P, m, variant).dt_chatter,
         }
     return out
 
@@ -170,13 +171,13 @@ def claims():
             key = "%s d_n=%g" % (preset, dn)
             out[key] = {"ref_status": ref.status, "walk": ls["walk"], "correct": ls["correct"],
                         "h_traj": linear_along(ref, "cdm")[0],
-                        "step_limit": S.step_limit(P, "cdm").dt_max,
+                        "step_limit": SL.step_limit(P, "cdm").dt_max,
                         "dt_1e-4": [(dt, v.walks, v.correct, v.td_error) for dt, v in ls["runs"]
                                     if abs(dt - 1e-4) < 1e-12]}
             if ls["walk"][0]:
                 # linear limit along cdm's own trajectory at 0.9 x its walking edge
                 dt = 0.9 * ls["walk"][0]
-                r = S._sim(x0=S.typical_start(P), t_end=1.0, dt=dt, params=P, method="cdm",
+                r = S._sim(x0=SL.typical_start(P), t_end=1.0, dt=dt, params=P, method="cdm",
                            record_every=1, record_forces=False)
                 out[key]["h_own_trajectory"] = linear_along(r, "cdm", np.arange(len(r.t)))
                 out[key]["own_dt"] = dt
@@ -334,7 +335,7 @@ def map_figure(cells, variant):
         v = np.array([c["value"] for c in cs])
         for m in FIXED:
             col = colors[m]
-            get = lambda key: np.array([(c["methods"][m].get(key) or [np.nan])[0] or np.nan
+            get = lambda key, m=m, cs=cs: np.array([(c["methods"][m].get(key) or [np.nan])[0] or np.nan
                                         for c in cs], dtype=float)
             ax.plot(v, get("walk"), "o-", color=col, label="%s walks" % m)
             ax.plot(v, get("correct"), "s--", color=col, mfc="none", label="%s walks correctly" % m)
@@ -367,7 +368,7 @@ def map_figure(cells, variant):
             "walks correctly: + touch-downs within max(2 ms, 1 %% cycle)\n"
             "linear: min over the rodas4 reference of the largest\n"
             "  stable step of the method on df/dx without friction\n"
-            "step_limit: pdw.stability.step_limit (calibrated)\n"
+            "step_limit: pdw.sim.stepsize.step_limit (calibrated)\n"
             "grey bars: marginal gait (the rodas4 reference falls\n"
             "  before 5 s, or bounces): 'walks' is decided by chance\n"
             "  there; not used for the calibration" % (BASE, variant),
@@ -479,7 +480,7 @@ def main(argv=None):
 def calibration(cells):
     """Ratio of the measured walking edge to the uncalibrated linear limit at the stance states
     (min over the states), per variant and method: its minimum over the non-marginal cells is
-    `pdw.stability.CALIBRATION`."""
+    `pdw.sim.stepsize.CALIBRATION`."""
     out = {}
     for variant in VARIANTS:
         out[variant] = {}

@@ -10,13 +10,12 @@ import pathlib
 import shutil
 import sys
 
-import numpy as np
-
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "benchmarks"))
 from _results import publish  # noqa: E402
 
 from pdw import sweep  # noqa: E402
+from pdw.present.study_plots import plot_study  # noqa: E402
 
 STUDIES = ROOT / "docs" / "studies"
 FIGURES = ROOT / "docs" / "figures"
@@ -69,7 +68,7 @@ def main(argv=None):
     total = 0.0
     for f in files:
         res = sweep.run_study(f, pathlib.Path(args.out) / f.stem, workers=args.workers,
-                              resume=False, progress=False)
+                              resume=False, progress=False, figures=plot_study)
         total += res.wall_s
         if "png" in res.paths:
             shutil.copy(res.paths["png"], FIGURES / ("study_%s.png" % f.stem))

@@ -32,10 +32,10 @@ import sys
 import time
 
 import numpy as np
-
-import pdw
 from _results import RESULTS
 from scipy_driver import simulate_scipy
+
+import pdw
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 FIGURE = ROOT / "docs" / "figures" / "work_precision.png"

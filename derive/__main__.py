@@ -1,4 +1,4 @@
-"""``python -m derive [--root DIR] [--check]``: regenerate generated/ and pdw/_layout.py.
+"""``python -m derive [--root DIR] [--check]``: regenerate generated/ and pdw/core/_layout.py.
 
 ``--check`` regenerates into a temporary tree and exits 1 if any file differs from
 the committed one (used by ``make check-generated``).

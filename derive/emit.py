@@ -1,4 +1,4 @@
-"""Emit ``generated/pdw_model.{h,c}`` and ``pdw/_layout.py`` from the symbolic stages.
+"""Emit ``generated/pdw_model.{h,c}`` and ``pdw/core/_layout.py`` from the symbolic stages.
 
 Deterministic: the same derive/ sources and SymPy version give the same bytes.
 Every emitted file carries `input_hash()`, the SHA-256 of the derive/ sources and
@@ -11,9 +11,8 @@ import pathlib
 
 import sympy as sp
 
-from . import contact_laws, hybrid, layout
+from . import contact_laws, hybrid, layout, stages
 from . import model as mdl
-from . import stages
 from .printer import c_block
 
 DERIVE_DIR = pathlib.Path(__file__).resolve().parent
@@ -22,7 +21,7 @@ DERIVE_DIR = pathlib.Path(__file__).resolve().parent
 # first), and the specializations that matter (docs/scenes.md): no hip spring-damper, no
 # tangential spring-damper, and both absent (the minimal walker). A feature set without a
 # kernel of its own runs on the general kernel with the absent parameters zeroed
-# (`pdw.model.kernel_index`, `pdw.Params.without`).
+# (`pdw.core.model.kernel_index`, `pdw.Params.without`).
 SPECIALIZATIONS = (
     (),
     ("hip_spring", "hip_damper"),
@@ -386,7 +385,7 @@ def write_all(root: pathlib.Path):
     files = {
         root / "generated" / "pdw_model.h": header(h),
         root / "generated" / "pdw_model.c": src,
-        root / "pdw" / "_layout.py": python_layout(h, ops),
+        root / "pdw" / "core" / "_layout.py": python_layout(h, ops),
     }
     for path, text in files.items():
         path.parent.mkdir(parents=True, exist_ok=True)

@@ -157,13 +157,13 @@ def impact_terms():
 
 def _names():
     names = {}
-    for i, s in enumerate(Y):
+    for s in Y:
         names[s] = "y[PDW_HY_%s]" % s.name.upper()
     for i, s in enumerate(PHIDD):
         names[s] = "ydd[%d]" % i
     for n, s in mdl.P.items():
         names[s] = "p[PDW_P_%s]" % n.upper()
-    for i, s in enumerate(mdl.Q):
+    for s in mdl.Q:
         names[s] = "q[PDW_X_%s]" % s.name.upper()
     return names
 

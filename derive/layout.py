@@ -2,7 +2,7 @@
 
 Each layout is an ordered tuple of field names; `derive.emit` turns them into C
 ``enum`` constants (``PDW_X_THETA1`` ...) in ``generated/pdw_model.h`` and into
-the Python module ``pdw/_layout.py``. No other file may hard-code an index.
+the Python module ``pdw/core/_layout.py``. No other file may hard-code an index.
 """
 
 # State x = [q, qdot] (paper Eq. 1), slope frame: X downhill along the slope, Y normal, up.
@@ -83,7 +83,7 @@ STOP = (
 )
 
 # Per-step gait descriptors (MODEL.md section 8), computed online in the compiled loop as the
-# events happen, with the definitions of pdw/gait.py; one row of doubles per complete step.
+# events happen, with the definitions of pdw/sim/gait.py; one row of doubles per complete step.
 STEP = (
     "leg",              # swing leg of the step (0 or 1, as in EVENT)
     "t_lift_off",       # its lift-off [s]

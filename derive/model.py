@@ -189,7 +189,7 @@ def contact_laws(variant: str, features=FEATURES, normal: str = "hunt_crossley")
     -------
     dict keyed by `layout.CONTACT` field names.
     """
-    kn, dn, kt, dt = P["k_n"], _fold(P["d_n"], "normal_damping", features), \
+    dn, kt, dt = _fold(P["d_n"], "normal_damping", features), \
         _fold(P["k_t"], "tangential", features), _fold(P["d_t"], "tangential", features)
     Pn = dict(P, d_n=dn)
     if normal in ("lankarani_nikravesh", "flores") and "normal_damping" not in features:

@@ -1,8 +1,13 @@
 """pdw: the flexible planar passive walker on compliant ground (JMST 2018).
 
+The package is built in layers, each importing only from the ones below it
+(docs/architecture.md): `pdw.core` (compiled model) -> `pdw.sim` (one simulation) ->
+`pdw.analysis` (gaits) -> `pdw.studies` (studies at scale) -> `pdw.present` (plots, reports,
+CLI). This module is the curated public API.
+
 Public API
 ----------
-Params                  model parameters and presets (MODEL.md section 1)
+Params                  model parameters and presets (docs/model.md section 1)
 rhs, jacobian           f(x) of Eq. A.4 and its Jacobian, compiled from the symbolic derivation
 mass_matrix             M(q) of Eq. 2
 contact_forces          contact kinematics and forces of both feet (Eqs. 3-11)
@@ -10,32 +15,57 @@ energies                kinetic and potential energies
 simulate, Result        one compiled simulation (support flags, events, status)
 Contact                 the normal and friction contact laws of a run (docs/contact_laws.md)
 Scene, run              everything a simulation needs, as one object or TOML file (docs/scenes.md)
-steps                   per-step gait descriptors (MODEL.md section 8)
-hybrid                  the rigid-ground impact-momentum model (MODEL.md section 9): find_gait, ...
+steps                   per-step gait descriptors (docs/model.md section 8)
+hybrid                  the rigid-ground impact-momentum model (docs/model.md section 9): find_gait, ...
 find_gait               period-one gait of the continuous model: Newton shooting on the touch-down
                         Poincare map, Floquet multipliers (pdw.limit_cycle; cell mapping:
                         pdw.cell_mapping)
 sweep                   parameter studies from TOML files: run_study, load_study (``pdw sweep``)
 PdwError, SimulationError, DivergedError, InvalidInputError   the error hierarchy
-STATE, VARIANTS         the state layout and the contact variants (MODEL.md section 6)
+STATE, VARIANTS         the state layout and the contact variants (docs/model.md section 6)
 """
-from ._layout import INPUT_HASH
-from .model import (STATE, VARIANTS, ContactState, contact_forces, energies, jacobian,
-                    mass_matrix, rhs)
-from .errors import (DivergedError, FellError, InvalidInputError, PdwError, SimulationError,
-                     SingularSystemError, StepSizeError, StepSizeWarning)
-from .gait import Steps, steps
-from .params import Params
-from .contact import Contact
-from . import hybrid
-from .gait_types import Gait
-from .simulation import METHODS, X0_DISTURBED, X0_PAPER, Event, Result, simulate
-from . import scene
-from .scene import Scene, run
-from . import limit_cycle, cell_mapping, sweep
-from .limit_cycle import find_gait
+import sys as _sys
 
-__version__ = "0.1.0"
+from .analysis import cell_mapping, hybrid, limit_cycle
+from .analysis.gait_types import Gait
+from .analysis.limit_cycle import find_gait
+from .core import __version__  # noqa: F401 (pdw.__version__)
+from .core._layout import INPUT_HASH
+from .core.contact import Contact
+from .core.errors import (
+    DivergedError,
+    FellError,
+    InvalidInputError,
+    PdwError,
+    SimulationError,
+    SingularSystemError,
+    StepSizeError,
+    StepSizeWarning,
+)
+from .core.integrators import METHODS
+from .core.model import (
+    STATE,
+    VARIANTS,
+    ContactState,
+    contact_forces,
+    energies,
+    jacobian,
+    mass_matrix,
+    rhs,
+)
+from .core.params import X0_DISTURBED, X0_PAPER, Params
+from .sim import scene
+from .sim.gait import Steps, steps
+from .sim.scene import Scene, run
+from .sim.simulation import Event, Result, simulate
+from .studies import sweep
+
+# The public modules of __all__ keep their flat import paths (``import pdw.hybrid``,
+# ``from pdw.sweep import run_study``) from before the layers.
+for _name, _module in (("scene", scene), ("hybrid", hybrid), ("limit_cycle", limit_cycle),
+                       ("cell_mapping", cell_mapping), ("sweep", sweep)):
+    _sys.modules[__name__ + "." + _name] = _module
+del _name, _module
 
 __all__ = [
     "Params", "rhs", "jacobian", "mass_matrix", "contact_forces", "ContactState", "energies",

@@ -1,6 +1,6 @@
-"""``python -m pdw``: the command line (see `pdw.cli`)."""
+"""``python -m pdw``: the command line (see `pdw.present.cli`)."""
 import sys
 
-from .cli import main
+from .present.cli import main
 
 sys.exit(main())

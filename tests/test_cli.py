@@ -3,7 +3,7 @@ import json
 
 import pytest
 
-from pdw import cli
+from pdw.present import cli
 
 
 def test_walk_writes_report_steps_and_run_info(tmp_path, capsys):

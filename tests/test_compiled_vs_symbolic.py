@@ -12,10 +12,9 @@ import pytest
 sp = pytest.importorskip("sympy")
 
 import pdw  # noqa: E402
-from pdw import _core  # noqa: E402
-from pdw.model import kernel_index, parameter_vector  # noqa: E402
-
 from derive import model as dm  # noqa: E402
+from pdw.core import _core  # noqa: E402
+from pdw.core.model import kernel_index, parameter_vector  # noqa: E402
 
 RTOL = 1e-12
 N_STATES = 240
@@ -171,7 +170,7 @@ def test_states_cover_every_branch(case):
     p = case["p"]
     cnt = dict(swing_pen=0, sup_above=0, both=0, clamp=0, xi_pos=0, xi_neg=0, branch=[0] * 5)
     edges = [-p.v_d, -p.v_s, p.v_s, p.v_d]
-    for (xdot, feet, M, f), fl in zip(case["refs"], case["flags"]):
+    for (_xdot, feet, _M, _f), fl in zip(case["refs"], case["flags"]):
         cnt["both"] += feet[0]["active"] and feet[1]["active"]
         for i, ft in enumerate(feet):
             cnt["swing_pen"] += fl[i] == 0 and ft["y_D"] < 0
@@ -238,14 +237,14 @@ def test_cdm_terms_match_reference(case, ref):
     X, p = case["X"], case["p"]
     k = kernel_index(case["variant"])
     pv = parameter_vector(p)
-    nc = len(pdw._layout.CONTACT)
+    nc = len(pdw.core._layout.CONTACT)
     rng = np.random.default_rng(5)
     for j in range(0, len(X), 7):
         F = rng.uniform(-200, 200, 4)             # F_n1, F_n2, F_t1, F_t2
         contact = np.zeros(2 * nc)
         for i in range(2):
-            contact[i * nc + pdw._layout.CONTACT.index("F_n")] = F[i]
-            contact[i * nc + pdw._layout.CONTACT.index("F_t")] = F[2 + i]
+            contact[i * nc + pdw.core._layout.CONTACT.index("F_n")] = F[i]
+            contact[i * nc + pdw.core._layout.CONTACT.index("F_t")] = F[2 + i]
         M, C, QmG = np.empty(16), np.empty(16), np.empty(4)
         _core.cdm_terms(k, np.ascontiguousarray(X[j]), pv, contact, M, C, QmG)
         a = ref._args(X[j], p)

@@ -14,10 +14,10 @@ import pytest
 import sympy as sp
 
 import pdw
-from pdw import _core, _layout
-from pdw.calibration import drop_test
-from pdw.contact import Contact
-from pdw.model import kernel_index, parameter_vector
+from pdw.analysis.calibration import drop_test
+from pdw.core import _core, _layout
+from pdw.core.contact import Contact
+from pdw.core.model import kernel_index, parameter_vector
 
 d, dd, vin, k, c, e, vmin = sp.symbols("delta deltad v_in k c e v_min", real=True)
 # the textbook laws (Hunt & Crossley 1975 as the paper prints it, Hertz, Kelvin-Voigt,
@@ -169,7 +169,7 @@ def test_calibration_matches_sink_and_restitution():
     sink; Kelvin-Voigt and Flores drop with the Hunt-Crossley restitution; Lankarani-Nikravesh
     cannot dissipate that much (flagged). Flores has Hunt-Crossley's form, so matched at the
     landing speed its damping k chi / v_in is Hunt-Crossley's d_n."""
-    from pdw.calibration import Landing, calibrate
+    from pdw.analysis.calibration import Landing, calibrate
     P = pdw.Params.paper_steady()
     cal = calibrate(P, landing=Landing(speed=0.7, mass=0.45, n=1))
     kv = cal.contacts["kelvin_voigt"]

@@ -16,8 +16,13 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import pdw
-from pdw import stability as S
-from pdw.errors import InvalidInputError, PdwError, SimulationError, StepSizeWarning
+from pdw.core.errors import (
+    InvalidInputError,
+    PdwError,
+    SimulationError,
+    StepSizeWarning,
+)
+from pdw.sim import stepsize as SL
 
 #: PDW_FUZZ_SCALE=20 (say) runs 20 times the examples, with fresh random draws: a bug hunt.
 SCALE = float(os.environ.get("PDW_FUZZ_SCALE", "1"))
@@ -93,7 +98,7 @@ def check_result(r, t_end):
     for a in (r.t, r.x, r.Fn, r.Ft, r.x_final):
         assert np.isfinite(a).all(), "non-finite values in a %s result" % r.status
     # fixed-step methods take round(t_end/dt) steps: t_final is within dt/2 of t_end
-    slack = 0.5 * r.dt if r.method in S.FIXED_STEP else 1e-12
+    slack = 0.5 * r.dt if r.method in SL.FIXED_STEP else 1e-12
     assert all(0.0 <= e.t <= r.t_final + 1e-12 and math.isfinite(e.x_D) for e in r.events)
     assert r.t_final <= t_end + slack + 1e-12
     if r.status == "walked":
@@ -155,7 +160,7 @@ def test_dopri5_runs_return_a_valid_result_or_a_pdw_error(P, s):
     """dopri5 is explicit: its steps are bounded by ~3/|lambda| of the stuck friction (1e-9 s on
     the stiffest ground); t_end is cut to about 2e5 such steps."""
     x0, flags = s
-    h = S.step_limit(P, "dopri5").dt_max
+    h = SL.step_limit(P, "dopri5").dt_max
     t_end = float(min(0.3, max(2e5 * h, 1e-3)))
     t_end = round(t_end / 1e-5) * 1e-5     # a multiple of dt (test_adaptive_runs_end_at_t_end)
     run_checked(x0=x0, flags0=flags, params=P, method="dopri5", rtol=1e-5, atol=1e-7,
@@ -166,12 +171,12 @@ def test_dopri5_runs_return_a_valid_result_or_a_pdw_error(P, s):
 @given(P=params(), method=st.sampled_from(list(pdw.METHODS)),
        variant=st.sampled_from(["paper", "consistent"]))
 def test_step_limit_is_defined_everywhere(P, method, variant):
-    lim = bounded(lambda: S.step_limit(P, method, variant), timeout=10.0)
+    lim = bounded(lambda: SL.step_limit(P, method, variant), timeout=10.0)
     assert lim.dt_max > 0 and not math.isnan(lim.dt_max)
-    if method in S.FIXED_STEP:
-        assert math.isfinite(lim.dt_max) and lim.force in S.FORCES
+    if method in SL.FIXED_STEP:
+        assert math.isfinite(lim.dt_max) and lim.force in SL.FORCES
         assert str(lim.dt_max)[:3] in lim.message(1.0) or "%.2g" % lim.dt_max in lim.message(1.0)
-    X, flags = S.stance_states(P, variant)
+    X, flags = SL.stance_states(P, variant)
     assert np.isfinite(X).all()
 
 

@@ -6,7 +6,7 @@ import pytest
 
 import pdw
 from pdw import Event
-from pdw.report import stance_forces
+from pdw.present.report import stance_forces
 
 
 def _events():

@@ -1,4 +1,4 @@
-"""generated/ and pdw/_layout.py against derive/.
+"""generated/ and pdw/core/_layout.py against derive/.
 
 Fast: every generated file carries `derive.emit.input_hash()` (SHA-256 of derive/*.py and the
 SymPy version); a change to derive/ without `make derive` changes the hash. Slower (a few
@@ -16,12 +16,11 @@ import pytest
 sp = pytest.importorskip("sympy")
 
 import pdw  # noqa: E402
-from pdw import _core, _layout  # noqa: E402
-
 from derive import emit, layout  # noqa: E402
+from pdw.core import _core, _layout  # noqa: E402
 
 GENERATED = ("generated/pdw_model.h", "generated/pdw_model.c", "generated/pdw_hybrid.h",
-             "generated/pdw_hybrid.c", "pdw/_layout.py")
+             "generated/pdw_hybrid.c", "pdw/core/_layout.py")
 
 
 @pytest.fixture(scope="module")
@@ -31,7 +30,7 @@ def current_hash():
 
 def test_layout_module_hash_matches_derive(current_hash):
     assert re.fullmatch(r"[0-9a-f]{64}", current_hash)
-    assert _layout.INPUT_HASH == current_hash, "pdw/_layout.py is stale: run `make derive`"
+    assert _layout.INPUT_HASH == current_hash, "pdw/core/_layout.py is stale: run `make derive`"
     assert pdw.INPUT_HASH == current_hash
     assert _layout.SYMPY_VERSION == sp.__version__
 

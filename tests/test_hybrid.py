@@ -7,8 +7,8 @@ import pytest
 
 import pdw
 from pdw import hybrid as H
-from pdw.errors import InvalidInputError, SimulationError
-from pdw.gait_types import Gait, GaitNotFoundError
+from pdw.analysis.gait_types import Gait, GaitNotFoundError
+from pdw.core.errors import InvalidInputError, SimulationError
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:
@@ -43,7 +43,7 @@ def _lagrangian_reduced(params):
     derive.model with the rolling constraint substituted, then Lagrange's equations."""
     sp = pytest.importorskip("sympy")
     from derive import model as mdl
-    P = {mdl.P[n]: getattr(params, n) for n in pdw._layout.PARAMS}
+    P = {mdl.P[n]: getattr(params, n) for n in pdw.core._layout.PARAMS}
     P[mdl.P["sin_gamma"]] = np.sin(params.gamma)
     P[mdl.P["cos_gamma"]] = np.cos(params.gamma)
     t = sp.Symbol("t")
@@ -88,6 +88,7 @@ def test_generated_stance_dynamics_equal_an_independent_lagrangian(name):
 def test_projection_and_lagrangian_routes_agree_symbolically():
     pytest.importorskip("sympy")
     import sympy as sp
+
     from derive import hybrid as dh
     Ma, fa = dh.reduced_dynamics("projection")
     Mb, fb = dh.reduced_dynamics("lagrangian")
@@ -189,7 +190,7 @@ def test_impact_map(name, compass_gait, steady_gait):
 
 
 def test_c_solver_matches_numpy():
-    from pdw import _hybrid
+    from pdw.core import _hybrid
     rng = np.random.default_rng(4)
     A = rng.normal(size=(6, 6))
     b = rng.normal(size=6)

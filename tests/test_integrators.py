@@ -1,4 +1,4 @@
-"""The integrators beyond the paper's (pdw/csrc/pdw_{verlet,rk4,dopri5,rodas4}.c,
+"""The integrators beyond the paper's (pdw/core/csrc/pdw_{verlet,rk4,dopri5,rodas4}.c,
 docs/integrators.md): tableaus, orders, stiffness, event location, agreement, bookkeeping."""
 import math
 
@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 import pdw
-from pdw import _core
-from pdw.integrators import INTEGRATORS
-from pdw.model import kernel_index, parameter_vector
-from pdw.simulation import METHODS, X0_PAPER, simulate
+from pdw import METHODS, X0_PAPER, simulate
+from pdw.core import _core
+from pdw.core.integrators import INTEGRATORS
+from pdw.core.model import kernel_index, parameter_vector
 
 ADAPTIVE = [n for n in METHODS if INTEGRATORS[n].adaptive]
 
@@ -38,7 +38,7 @@ def _trees(order):
                 yield [k] + rest
 
     for parts in partitions(order - 1, order - 1):
-        def combos(i):
+        def combos(i, parts=parts):
             if i == len(parts):
                 yield []
                 return

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 import pdw
-from pdw import _core, _layout
-from pdw.model import kernel_index, parameter_vector
+from pdw.core import _core, _layout
+from pdw.core.model import kernel_index, parameter_vector
 
 SPECIALIZED = [(name, variant, feats) for name, variant, feats in _layout.KERNELS
                if tuple(feats) != _layout.FEATURES]

@@ -9,7 +9,7 @@ import pdw
 from pdw import cell_mapping as CM
 from pdw import hybrid as H
 from pdw import limit_cycle as LC
-from pdw.gait_types import GaitNotFoundError
+from pdw.analysis.gait_types import GaitNotFoundError
 
 P = pdw.Params.paper_steady()
 

@@ -41,8 +41,8 @@ def test_unknown_preset_is_refused():
 def test_as_array_follows_the_kernel_layout():
     p = Params.paper(k_t=12.5)
     arr = p.as_array()
-    assert arr.dtype == float and arr.shape == (len(pdw._layout.PARAMS),)
-    for i, name in enumerate(pdw._layout.PARAMS):
+    assert arr.dtype == float and arr.shape == (len(pdw.core._layout.PARAMS),)
+    for i, name in enumerate(pdw.core._layout.PARAMS):
         assert arr[i] == getattr(p, name)
 
 

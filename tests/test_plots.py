@@ -1,4 +1,4 @@
-"""Tests of pdw.plots: files written, image sizes, GIF frames, the double-support zoom."""
+"""Tests of pdw.present.plots: files written, image sizes, GIF frames, the double-support zoom."""
 import subprocess
 import sys
 
@@ -8,8 +8,8 @@ import pytest
 pytest.importorskip("matplotlib")
 PIL_Image = pytest.importorskip("PIL.Image")
 
-from pdw import plots  # noqa: E402
-from pdw.simulation import simulate  # noqa: E402
+from pdw.present import plots  # noqa: E402
+from pdw.sim.simulation import simulate  # noqa: E402
 
 T_SHORT = 1.2  # two touch-downs (0.34 s, 0.91 s) and two double supports
 
@@ -38,7 +38,7 @@ def _events_double_supports(result):
 
 
 def test_import_does_not_need_matplotlib():
-    code = "import sys, pdw, pdw.plots; print('matplotlib' in sys.modules)"
+    code = "import sys, pdw, pdw.present.plots; print('matplotlib' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
 

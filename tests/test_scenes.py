@@ -8,10 +8,11 @@ import numpy as np
 import pytest
 
 import pdw
-from pdw import _layout, cli
-from pdw.gait import FIELDS
-from pdw.scene import Forces, Integrator, Record, Scene, Stop
-from pdw.simulation import METHODS
+from pdw import METHODS
+from pdw.core import _layout
+from pdw.present import cli
+from pdw.sim.gait import FIELDS
+from pdw.sim.scene import Forces, Integrator, Record, Scene, Stop
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 STEADY = pdw.Params.paper_steady()
@@ -72,7 +73,7 @@ def test_ring_keeps_the_last_steps_of_a_long_run():
     ref = pdw.steps(full)
     assert len(ref) > _layout.STEP_RING and d.n_gait_steps == len(ref)
     assert len(d.gait) == _layout.STEP_RING
-    last = pdw.gait.Steps({f: ref[f][-_layout.STEP_RING:] for f in FIELDS})
+    last = pdw.sim.gait.Steps({f: ref[f][-_layout.STEP_RING:] for f in FIELDS})
     _assert_steps_equal(d.gait, last)
 
 
@@ -107,10 +108,10 @@ def test_stop_when_periodic_stops_as_soon_as_the_last_k_steps_agree(k, tol, full
     assert not any(_agree(ref.table, m, k, tol) for m in range(k, n))
     # the right descriptors: those of the full run, up to that step (whose double support is
     # not known yet when the run stops)
-    head = pdw.gait.Steps({f: ref[f][:n] for f in FIELDS})
+    head = pdw.sim.gait.Steps({f: ref[f][:n] for f in FIELDS})
     _assert_steps_equal(r.gait, head, ALL_BUT_LAST_DS)
-    _assert_steps_equal(pdw.gait.Steps({f: r.gait[f][:-1] for f in FIELDS}),
-                        pdw.gait.Steps({f: head[f][:-1] for f in FIELDS}))
+    _assert_steps_equal(pdw.sim.gait.Steps({f: r.gait[f][:-1] for f in FIELDS}),
+                        pdw.sim.gait.Steps({f: head[f][:-1] for f in FIELDS}))
     assert math.isnan(r.gait["double_support"][-1])
     # and the events it kept are the full run's up to the stop
     assert r.events == [e for e in full_10s.events if e.t <= r.t_final]
@@ -215,7 +216,7 @@ def test_scene_descriptors_only_periodic_in_one_object(full_10s):
     r = sc.run()
     assert r.status == "periodic" and r.events == [] and len(r.t) == 0
     ref = pdw.steps(full_10s)
-    _assert_steps_equal(r.gait, pdw.gait.Steps({f: ref[f][:len(r.gait)] for f in FIELDS}),
+    _assert_steps_equal(r.gait, pdw.sim.gait.Steps({f: ref[f][:len(r.gait)] for f in FIELDS}),
                         ALL_BUT_LAST_DS)
 
 
@@ -348,7 +349,8 @@ def test_pdw_walk_still_works(tmp_path, capsys):
 
 def test_docs_list_every_scene_key():
     import dataclasses
-    from pdw.scene import SECTION_TYPES
+
+    from pdw.sim.scene import SECTION_TYPES
     text = (ROOT / "docs" / "scenes.md").read_text()
     for f in dataclasses.fields(Scene):
         assert "`%s`" % f.name in text or "[%s]" % f.name in text, f.name
@@ -358,7 +360,8 @@ def test_docs_list_every_scene_key():
 
 
 def test_random_scenes_round_trip():
-    from hypothesis import given, settings, strategies as st
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
     finite = st.floats(allow_nan=False, allow_infinity=False, width=64)
     positive = st.floats(min_value=1e-300, max_value=1e300)
 

@@ -40,7 +40,7 @@ def test_touch_down_times_match_pdw_rodas4(rodas4_events, method):
 
 def test_update_flags_mirrors_the_c_rules():
     """One pass of update_flags on hand-made kinematics follows pdw_update_flags rule by rule."""
-    from pdw import _layout
+    from pdw.core import _layout
     K = {n: i for i, n in enumerate(_layout.KIN)}
 
     def kin(xd1, y1, vy1, xd2, y2, vy2, s1=0.1, s2=0.2):

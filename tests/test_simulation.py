@@ -6,9 +6,9 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import pdw
-from pdw import _core
-from pdw.model import kernel_index, parameter_vector
-from pdw.simulation import X0_PAPER
+from pdw import X0_PAPER
+from pdw.core import _core
+from pdw.core.model import kernel_index, parameter_vector
 
 FLIGHT_X0 = np.array([0.0, 10.0, -0.2, 0.3, 0.5, 0.0, 2.0, -1.0])  # feet ~9.5 m above the ground
 

@@ -8,9 +8,18 @@ import numpy as np
 import pytest
 
 import pdw
-from pdw import stability as S
-from pdw.errors import (DivergedError, FellError, InvalidInputError, PdwError, SimulationError,
-                        SingularSystemError, StepSizeError, StepSizeWarning)
+from pdw.analysis import stability_maps as S
+from pdw.core.errors import (
+    DivergedError,
+    FellError,
+    InvalidInputError,
+    PdwError,
+    SimulationError,
+    SingularSystemError,
+    StepSizeError,
+    StepSizeWarning,
+)
+from pdw.sim import stepsize as SL
 
 
 def _finite_result(r):
@@ -28,7 +37,7 @@ def test_hierarchy():
     assert issubclass(StepSizeError, InvalidInputError)
     assert issubclass(StepSizeWarning, UserWarning)
     for name in ("StepSizeError", "StepSizeWarning"):
-        assert getattr(pdw, name) is getattr(pdw.errors, name) and name in pdw.__all__
+        assert getattr(pdw, name) is getattr(pdw.core.errors, name) and name in pdw.__all__
 
 
 def test_diverged_error_carries_time_state_reason_and_partial_result():
@@ -82,7 +91,7 @@ def test_singular_system_error_carries_time_state_reason(monkeypatch):
     """The loop status 'singular' (a singular step matrix) maps onto SingularSystemError with
     the failure's time, state and reason (a regular mass matrix makes it unreachable from
     valid input, so the raw loop output of a real run is doctored here)."""
-    from pdw import simulation as sim
+    from pdw.sim import simulation as sim
     captured = {}
     real_run = sim._core.run
 
@@ -92,7 +101,7 @@ def test_singular_system_error_carries_time_state_reason(monkeypatch):
 
     monkeypatch.setattr(sim._core, "run", capture)
     r = pdw.simulate(t_end=0.01, record_every=1, check_step="off")
-    raw = dict(captured["raw"], status=pdw._layout.STATUS.index("singular"),
+    raw = dict(captured["raw"], status=pdw.core._layout.STATUS.index("singular"),
                failure={"t": 0.005, "x": r.x[50], "reason": 5, "leg": -1})
     with pytest.raises(SingularSystemError) as ei:
         sim._result(raw, r.params, "paper", "cdm", 1e-4, 0.01, 0.0, "raise")
@@ -153,26 +162,26 @@ def test_paper_dt_does_not_warn():
     """The paper's own dt = 1e-4 with cdm, at the paper's parameters (it walks there)."""
     r = _no_warning(record_every=0)
     assert r.walked
-    for method in S.FIXED_STEP:
+    for method in SL.FIXED_STEP:
         for P in (pdw.Params.paper(), pdw.Params.paper_steady()):
-            assert S.step_limit(P, method).dt_max > 1e-4
+            assert SL.step_limit(P, method).dt_max > 1e-4
 
 
 def test_step_above_the_limit_warns_with_the_limit_and_the_force():
-    lim = S.step_limit(pdw.Params.paper(), "cdm")
+    lim = SL.step_limit(pdw.Params.paper(), "cdm")
     dt = 2.5 * lim.dt_max
     with pytest.warns(StepSizeWarning) as rec:
         pdw.simulate(dt=dt, record_every=0, on_failure="return")
     w = rec[0].message
     assert w.dt == dt and w.limit == lim.dt_max and w.force == lim.force
     text = str(w)
-    assert "%.2g" % lim.dt_max in text and S.FORCES[lim.force] in text and "'cdm'" in text
+    assert "%.2g" % lim.dt_max in text and SL.FORCES[lim.force] in text and "'cdm'" in text
     assert rec[0].filename == __file__       # points at the caller's line
 
 
 def test_check_step_error_refuses_and_off_is_silent():
     P = pdw.Params(d_n=1e7)
-    lim = S.step_limit(P, "rk4")
+    lim = SL.step_limit(P, "rk4")
     with pytest.raises(StepSizeError, match="%.2g" % lim.dt_max) as ei:
         pdw.simulate(dt=3 * lim.dt_max, params=P, method="rk4", check_step="error")
     assert ei.value.limit == lim.dt_max and ei.value.force == lim.force == "d_n"
@@ -184,28 +193,28 @@ def test_check_step_error_refuses_and_off_is_silent():
 
 def test_adaptive_methods_are_not_checked():
     _no_warning(method="rodas4", dt=0.1, t_end=0.5)
-    assert S.step_limit(method="rodas4").dt_max == math.inf
-    d5 = S.step_limit(method="dopri5")
+    assert SL.step_limit(method="rodas4").dt_max == math.inf
+    d5 = SL.step_limit(method="dopri5")
     assert d5.force == "v_s" and 1e-7 < d5.dt_max < 1e-5
 
 
 def test_step_limit_names_the_limiting_force():
-    assert S.step_limit(pdw.Params.paper_steady(d_n=1e7), "cdm").force == "d_n"
-    lim = S.step_limit(pdw.Params.paper_steady(d_t=1e4), "cdm")
+    assert SL.step_limit(pdw.Params.paper_steady(d_n=1e7), "cdm").force == "d_n"
+    lim = SL.step_limit(pdw.Params.paper_steady(d_t=1e4), "cdm")
     assert lim.force == "d_t" and lim.sensitivity["d_t"] < -0.9      # limit ~ 1/d_t
-    lim = S.step_limit(pdw.Params.paper_steady(), "rk4")
+    lim = SL.step_limit(pdw.Params.paper_steady(), "rk4")
     assert lim.dt_chatter < 5e-6                      # the stuck foot's friction mode
 
 
 @pytest.mark.parametrize("kw, variant", [
     ({}, "paper"), (dict(d_n=1e7), "paper"), (dict(d_t=1e4), "paper"), (dict(k_n=1e4), "paper"),
     (dict(k_t=850), "paper"), ({}, "consistent"), (dict(d_n=2.5e7), "consistent")])
-@pytest.mark.parametrize("method", S.FIXED_STEP)
+@pytest.mark.parametrize("method", SL.FIXED_STEP)
 def test_the_gait_walks_at_the_step_limit(method, kw, variant):
     """At dt = step_limit the typical gait walks (the calibration is conservative), also where
     the friction chatter sets the limit (k_t = 850: the stuck foot at its friction limit)."""
     P = pdw.Params.paper_steady(**kw)
-    lim = S.step_limit(P, method, variant)
+    lim = SL.step_limit(P, method, variant)
     ref = S.reference(P, variant)
     v = S.judge(S.run_fixed(P, method, lim.dt_max, variant), ref)
     assert v.walks, v.reason
@@ -215,12 +224,12 @@ def test_friction_bound_limit():
     """k_t = 850: the stuck foot needs 115 % of mu_s F_n; the limit is the chatter's, and the
     message says so. Explicit runs above it fail (cdm at the paper's dt loses a step)."""
     P = pdw.Params.paper_steady(k_t=850)
-    lim = S.step_limit(P, "cdm")
+    lim = SL.step_limit(P, "cdm")
     assert lim.force == "v_s" and lim.friction_load > 1.0
-    assert lim.dt_max == pytest.approx(S.CHATTER_CALIBRATION * lim.dt_chatter)
+    assert lim.dt_max == pytest.approx(SL.CHATTER_CALIBRATION * lim.dt_chatter)
     assert "static friction" in lim.message(1e-4)
     assert not S.judge(S.run_fixed(P, "cdm", 1e-4), S.reference(P)).walks
-    assert S.step_limit(pdw.Params.paper_steady(), "cdm").friction_load < 0.2
+    assert SL.step_limit(pdw.Params.paper_steady(), "cdm").friction_load < 0.2
 
 
 # -------------------------------------------------------------- linear stability regions ----
@@ -237,10 +246,10 @@ def test_linear_limit_matches_the_stability_regions(method, real, imag):
     Z, E = np.zeros((4, 4)), np.eye(4)
     damping = np.block([[Z, E], [Z, -lam * E]])          # qdd = -lam qd: real eigenvalue -lam
     spring = np.block([[Z, E], [-lam ** 2 * E, Z]])      # qdd = -lam^2 q: eigenvalues +-i lam
-    assert S.linear_limit(method, damping) * lam == pytest.approx(real, rel=2e-3)
+    assert SL.linear_limit(method, damping) * lam == pytest.approx(real, rel=2e-3)
     if imag:
-        assert S.linear_limit(method, spring) * lam == pytest.approx(imag, rel=2e-3)
-    assert S.linear_limit("rodas4", damping) == math.inf
+        assert SL.linear_limit(method, spring) * lam == pytest.approx(imag, rel=2e-3)
+    assert SL.linear_limit("rodas4", damping) == math.inf
 
 
 def test_linear_limit_tolerates_physically_unstable_modes():
@@ -249,18 +258,18 @@ def test_linear_limit_tolerates_physically_unstable_modes():
     J = np.zeros((8, 8))
     J[:4, 4:] = np.eye(4)
     J[4:, :4] = np.diag([25.0, -1e4, -1e4, -1e4])      # lambda = +5 and +-100 i
-    assert S.linear_limit("cdm", J) == pytest.approx(2 / 100, rel=1e-2)
+    assert SL.linear_limit("cdm", J) == pytest.approx(2 / 100, rel=1e-2)
 
 
 def test_stance_states_carry_the_weight():
     for kw in ({}, dict(k_n=5e3), dict(k_n=2.5e6), dict(d_n=0.0)):
         P = pdw.Params.paper(**kw)
-        X, flags = S.stance_states(P)
-        for x, fl, load in zip(X, flags, (1, 1, 1, S.DOUBLE_SUPPORT_LOAD)):
+        X, flags = SL.stance_states(P)
+        for x, fl, load in zip(X, flags, (1, 1, 1, SL.DOUBLE_SUPPORT_LOAD)):
             cs = pdw.contact_forces(x, P, flags=fl)
             assert cs.F_n.sum() == pytest.approx(load * P.weight, rel=1e-4)
             assert abs(cs.v_x[fl.index(1)]) < 1e-12
-    x = S.typical_start(pdw.Params.paper())
+    x = SL.typical_start(pdw.Params.paper())
     assert abs(x[1] - pdw.X0_PAPER[1]) < 2e-4
 
 
@@ -358,6 +367,6 @@ def test_maps_nominal_cell_and_claims():
     ls = S.largest_step(P, "cdm", ref)
     a, b = ls["walk"]
     assert 1.5e-3 < a < 3e-3 and b < 1.2 * a
-    assert S.step_limit(P, "cdm").dt_max < a
+    assert SL.step_limit(P, "cdm").dt_max < a
     for dt in (1e-5, 1e-4, 1e-3, 0.9 * a):
         assert S.chatter(P, "cdm", dt).chatters

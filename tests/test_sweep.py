@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 import pdw
-import pdw.cli
+import pdw.present.cli
 from pdw import sweep as S
+from pdw.present.study_plots import plot_study
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 STUDY_FILES = sorted((ROOT / "docs" / "studies").glob("*.toml"))
@@ -95,7 +96,8 @@ def test_points_order_and_tasks(tiny):
 @pytest.fixture(scope="module")
 def tiny_serial(tmp_path_factory):
     out = tmp_path_factory.mktemp("serial")
-    return S.run_study(S.parse_study(TINY), out, backend="serial", progress=False)
+    return S.run_study(S.parse_study(TINY), out, backend="serial", progress=False,
+                       figures=plot_study)
 
 
 def test_run_writes_csv_provenance_and_figure(tiny_serial):
@@ -214,12 +216,12 @@ def test_cli_sweep(tmp_path, capsys):
     f = tmp_path / "tiny.toml"
     f.write_text(TINY.replace("values = [0.95, 1.0]", "values = [0.95]"))
     out = tmp_path / "out"
-    rc = pdw.cli.main(["sweep", str(f), "--out", str(out), "--no-progress", "--no-figures",
+    rc = pdw.present.cli.main(["sweep", str(f), "--out", str(out), "--no-progress", "--no-figures",
                        "--workers", "2"])
     assert rc == 0
     assert "3 points (3 computed, 0 resumed)" in capsys.readouterr().out
     assert (out / "tiny.csv").exists() and (out / "tiny.json").exists()
-    assert pdw.cli.main(["sweep", str(tmp_path / "missing.toml")]) == 2
+    assert pdw.present.cli.main(["sweep", str(tmp_path / "missing.toml")]) == 2
 
 
 def test_run_point_reports_bad_points_as_rows(tiny):

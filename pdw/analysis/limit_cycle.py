@@ -1,0 +1,525 @@
+"""Limit cycles of the continuous (compliant-ground) walker: Poincaré map, Newton shooting,
+Floquet multipliers, period-n detection (issue 7; docs/studies.md, "Limit cycles").
+
+Poincaré section
+----------------
+The section is the **touch-down of the swing foot**: the instant its support flag turns on
+(MODEL.md section 5, Eq. 18b), with both flags then 1 (the old stance foot is still on the
+ground: double support begins). The state is taken just after the flag change, i.e. the
+recorded sample at the event time; with ``rodas4``/``dopri5`` the event is located to
+``event_tol`` (default here 1e-12 s), so the new stance foot's height is 0 to ~1e-12 m.
+
+Coordinates (translation-invariant, legs relabelled): the leg that has just touched down (the
+*leading* leg) is called leg 2 and the other (the *trailing*, old stance leg, about to lift off)
+leg 1, as at the paper's initial condition (leg 2 support). On the section the new stance
+foot's contact point is put at the origin, x_D2 = 0 and y_D2 = 0, which fixes the hip position
+from theta2:
+
+    x_o = -(l - r) sin(theta2),   y_o = r + (l - r) cos(theta2)
+
+so the section is 6-dimensional, with coordinates (`SECTION`)
+
+    z = (theta1, theta2, xd_o, yd_o, thetad1, thetad2)
+      = (trailing angle, leading angle, hip velocity along / normal to the slope,
+         trailing leg's rate, leading (swing) leg's rate)        [rad, rad, m/s, m/s, rad/s, rad/s]
+
+`embed(z)` is the full state (flags (1, 1)); `section_coordinates(x, leg)` goes back (relabelling
+when leg 1 touched down). The discarded coordinates are x_o (translation along the slope: the
+map is invariant under it) and y_o (y_D2 = 0 on the section).
+
+The step map
+------------
+`step(z)`: ``pdw.simulate(embed(z), flags0=(1, 1), record_every=1, ...)`` until past the
+trailing leg's next touch-down; the sample recorded at that event's time (adaptive methods end
+an accepted step exactly there and record it after the flag update) is relabelled and mapped
+to z'. Nothing in the compiled code is changed: the loop records every accepted step (a few
+thousand samples) and Python picks the one at the event. The simulation runs to
+``1.3 * t_hint + 0.05`` s (``t_hint``: the previous period, default 0.75 s) and, if the touch-down
+has not happened by then, again to ``t_max``.
+
+*Restarting the discrete state.* At the section both legs are support, so nobody is armed
+(MODEL.md section 5) and the restart's discrete state equals the running one, except for the
+`consistent` variant's tangential anchors: `simulate` anchors a support leg at its initial
+state, which is right for the new stance leg (it has just touched down) but resets the
+trailing leg's accumulated slip since its own touch-down (micrometres; it lifts off ~16-50 ms
+later). The `paper` variant (default) has no anchors, and its map is exact.
+
+*Fixed-step methods* (``cdm``, ``verlet``, ``rk4``) switch flags at step boundaries; the section
+state is then interpolated linearly between the last sample above ground and the first below
+(y_D = 0), but the map stays quantised by dt (its event times jump by dt), so Newton with
+finite differences is meaningless below ~dt-sized changes: use ``rodas4``.
+
+Newton shooting and Floquet multipliers
+---------------------------------------
+`find_gait` solves P^n(z) = z (n = ``period``, default 1) by Newton's method with a damped step
+(halved until the residual decreases). The Jacobian DP is taken by **central differences** with
+an absolute step ``fd_step`` (default 1e-5 in every coordinate: rad, m/s, rad/s), each column
+from two step-map evaluations (12 per Jacobian, run in parallel threads: the compiled loop
+releases the GIL). With the default tolerances (rtol 1e-10, atol 1e-12, event_tol 1e-12) one map
+evaluation is reproducible to ~1e-10, so the Jacobian is good to ~1e-5 and Newton converges to a
+residual max|P(z) - z| < ``tol`` = 1e-9 (the floor is ~3e-10). The Floquet multipliers are the
+eigenvalues of the 6x6 Jacobian of P^n at the fixed point (the full 8x8 map would add the
+neutral translation and the section's constraint); multipliers far below the Jacobian's noise
+(~1e-4 in modulus) are not resolved. ``details["multipliers_check"]`` repeats them with
+10 x ``fd_step``.
+
+Starting guesses (`default_guesses`): the paper's initial condition and its disturbed start
+(Fig. 9), and the hybrid model's gait (pre-impact state, `pdw.hybrid`), each first walked for
+``settle_time`` seconds in one simulation (a stable gait attracts them); Newton starts from the
+last touch-down of that walk.
+
+Period-n detection: `detect_period` iterates the map and reports the smallest n with
+max|z_{k+n} - z_k| < tol over the last iterates (or that the walker fell, or no period up to
+``n_max``).
+"""
+from __future__ import annotations
+
+import math
+import os
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+from ..core.errors import FellError, InvalidInputError, SimulationError
+from ..core.integrators import INTEGRATORS, METHODS
+from ..core.params import X0_DISTURBED, X0_PAPER, Params
+from ..sim.simulation import simulate
+from .gait_types import Gait, GaitNotFoundError
+
+#: Section coordinates z (legs relabelled: leg 2 has just touched down, leg 1 trails).
+SECTION = ("theta1", "theta2", "xd_o", "yd_o", "thetad1", "thetad2")
+
+#: Defaults of the step map used by `find_gait` (accurate) ...
+TIGHT = dict(rtol=1e-10, atol=1e-12, event_tol=1e-12)
+#: ... and for cheap uses (settling walks, cell mapping): errors ~1e-6.
+LOOSE = dict(rtol=1e-7, atol=1e-9, event_tol=1e-10)
+
+STEP_STATUS = ("ok", "fell", "diverged", "no_touch_down", "flight", "bad_state")
+
+
+# --- the section ------------------------------------------------------------------------------
+
+def _params(params):
+    params = Params.paper_steady() if params is None else params
+    if not isinstance(params, Params):
+        raise InvalidInputError("params must be a pdw.Params, got %s" % type(params).__name__)
+    return params
+
+
+def _z(z, name="z"):
+    a = np.array(z, dtype=float).reshape(-1)
+    if a.shape != (6,):
+        raise InvalidInputError("%s must have 6 components %s, got shape %s"
+                                % (name, SECTION, np.shape(z)))
+    if not np.isfinite(a).all():
+        raise InvalidInputError("%s must be finite, got %r" % (name, a))
+    return a
+
+
+def embed(z, params=None) -> np.ndarray:
+    """The full state (`pdw.STATE`) of section point z: leg 2's contact point at the origin
+    (x_D2 = y_D2 = 0), to be simulated with flags (1, 1)."""
+    p = _params(params)
+    th1, th2, xd, yd, w1, w2 = _z(z)
+    return np.array([-(p.l - p.r) * math.sin(th2), p.r + (p.l - p.r) * math.cos(th2),
+                     th1, th2, xd, yd, w1, w2])
+
+
+def section_coordinates(x, leg=2) -> np.ndarray:
+    """z of a full state x recorded at the touch-down of ``leg`` (1 or 2): relabels the legs
+    when leg 1 touched down, drops x_o and y_o."""
+    x = np.asarray(x, dtype=float)
+    if leg == 2:
+        return x[[2, 3, 4, 5, 6, 7]].copy()
+    if leg == 1:
+        return x[[3, 2, 4, 5, 7, 6]].copy()
+    raise InvalidInputError("leg must be 1 or 2, got %r" % (leg,))
+
+
+def _foot_height(x, leg, p):
+    th = x[1 + leg]
+    return x[1] - p.r - (p.l - p.r) * math.cos(th)
+
+
+# --- one step -----------------------------------------------------------------------------------
+
+def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max=2.5,
+         dt=1e-4, rtol=TIGHT["rtol"], atol=TIGHT["atol"], event_tol=TIGHT["event_tol"],
+         record=False, contact=None) -> dict:
+    """One step of the Poincaré map from section point z; never raises on a failed step.
+
+    Returns a dict: ``status`` (one of `STEP_STATUS`: "ok"; "fell"/"diverged" as `simulate`;
+    "no_touch_down" by ``t_max``; "flight": the stance foot was off the ground at the
+    touch-down; "bad_state": z is not a valid start), ``z`` (z', NaN unless ok), ``x_touch``
+    (the full state at the touch-down, legs not relabelled), ``period`` (touch-down to
+    touch-down [s]), ``double_support`` (until the trailing leg's lift-off [s]),
+    ``swing_period`` (the trailing leg's lift-off to its touch-down), ``step_length``
+    (footprint spacing: leg 1's contact point at touch-down, leg 2's being 0), ``travel``
+    (the swing foot's own travel), ``n_events``, ``stats``; with ``record=True`` also
+    ``result`` (the `Result`, legs not relabelled, time from the section).
+    """
+    p = _params(params)
+    nan6 = np.full(6, np.nan)
+    out = dict(status="ok", z=nan6, x_touch=np.full(8, np.nan), period=np.nan,
+               double_support=np.nan, swing_period=np.nan, step_length=np.nan, travel=np.nan,
+               n_events=0, stats={})
+    try:
+        x0 = embed(z, p)
+    except InvalidInputError:
+        out["status"] = "bad_state"
+        return out
+    if method not in METHODS:
+        raise InvalidInputError("method must be one of %s, got %r" % (", ".join(METHODS), method))
+    adaptive = INTEGRATORS[method].adaptive
+    t_first = 1.3 * (0.75 if t_hint is None or not np.isfinite(t_hint) else float(t_hint)) + 0.05
+    ends = [min(t_first, t_max), t_max] if t_first < t_max else [t_max]
+    for t_end in ends:
+        t_end = max(t_end, 10 * dt)
+        res = simulate(x0, t_end=t_end, dt=dt, params=p, variant=variant, method=method,
+                       flags0=(1, 1), record_every=1, record_forces=record, on_failure="return",
+                       rtol=rtol, atol=atol, event_tol=event_tol, contact=contact)
+        out["stats"] = dict(res.stats)
+        lo = next((e for e in res.events if e.leg == 1 and e.kind == "lift_off"), None)
+        td = next((e for e in res.events if e.leg == 1 and e.kind == "touch_down"), None)
+        if td is not None or res.status != "walked":
+            break
+    if record:
+        out["result"] = res
+    if td is None:
+        out["status"] = res.status if res.status != "walked" else "no_touch_down"
+        return out
+    i = int(np.argmin(np.abs(res.t - td.t)))
+    x, t = res.x[i].copy(), float(res.t[i])
+    if res.flags[i, 1] != 1:
+        out["status"] = "flight"
+        return out
+    if not adaptive and i > 0:
+        # fixed step: interpolate to the touch-down foot's height 0 between samples i-1, i
+        y0, y1 = _foot_height(res.x[i - 1], 1, p), _foot_height(x, 1, p)
+        if y0 >= 0.0 > y1:
+            s = y0 / (y0 - y1)
+            x = res.x[i - 1] + s * (x - res.x[i - 1])
+            t = float(res.t[i - 1] + s * (res.t[i] - res.t[i - 1]))
+    out.update(status="ok", z=section_coordinates(x, 1), x_touch=x, period=t,
+               double_support=lo.t, swing_period=t - lo.t,
+               step_length=x[0] + (p.l - p.r) * math.sin(x[2]),
+               travel=x[0] + (p.l - p.r) * math.sin(x[2]) - lo.x_D,
+               n_events=sum(1 for e in res.events if e.t <= td.t))
+    return out
+
+
+def step_map(z, params=None, variant="paper", method="rodas4", **options) -> np.ndarray:
+    """P(z): the section point after the next touch-down. Raises `FellError` or
+    `SimulationError` when the step fails."""
+    s = step(z, params, variant, method, **options)
+    if s["status"] == "fell":
+        raise FellError("the walker fell during the step from z = %r" % (np.asarray(z),),
+                        reason="fell")
+    if s["status"] != "ok":
+        raise SimulationError("step from z = %r failed: %s" % (np.asarray(z), s["status"]),
+                              reason=s["status"])
+    return s["z"]
+
+
+def orbit(z, n, params=None, variant="paper", method="rodas4", **options):
+    """n iterates of the map from z: (Z of shape (k+1, 6), list of step dicts); stops early
+    (k < n) at a failed step."""
+    Z, info = [_z(z)], []
+    t_hint = options.pop("t_hint", None)
+    for _ in range(int(n)):
+        s = step(Z[-1], params, variant, method, t_hint=t_hint, **options)
+        info.append(s)
+        if s["status"] != "ok":
+            break
+        t_hint = s["period"]
+        Z.append(s["z"])
+    return np.array(Z), info
+
+
+# --- parallel evaluation ----------------------------------------------------------------------
+
+def _workers(workers):
+    return max(1, int(workers if workers is not None else (os.cpu_count() or 1)))
+
+
+def map_batch(Z, params=None, variant="paper", method="rodas4", *, workers=None, **options):
+    """Steps from every row of Z (N, 6), in ``workers`` threads: list of step dicts."""
+    Z = np.atleast_2d(np.asarray(Z, dtype=float))
+    fn = lambda z: step(z, params, variant, method, **options)   # noqa: E731
+    nw = min(_workers(workers), len(Z))
+    if nw <= 1:
+        return [fn(z) for z in Z]
+    with ThreadPoolExecutor(nw) as ex:
+        return list(ex.map(fn, Z))
+
+
+def _compose(z, n, params, variant, method, options):
+    """P^n(z) and the steps (None if a step failed)."""
+    steps, t_hint = [], options.get("t_hint")
+    for _ in range(n):
+        s = step(z, params, variant, method, **{**options, "t_hint": t_hint})
+        steps.append(s)
+        if s["status"] != "ok":
+            return None, steps
+        z, t_hint = s["z"], s["period"]
+    return z, steps
+
+
+def jacobian(z, params=None, variant="paper", method="rodas4", *, fd_step=1e-5, period=1,
+             workers=None, **options):
+    """(J, P^n(z), steps at z): central-difference Jacobian of P^n at z, step ``fd_step`` (absolute,
+    every coordinate); the 13 evaluations run in ``workers`` threads. J is NaN where a
+    perturbed step failed."""
+    z = _z(z)
+    E = np.eye(6) * fd_step
+    pts = [z] + [z + e for e in E] + [z - e for e in E]
+    fn = lambda zz: _compose(zz, period, params, variant, method, options)  # noqa: E731
+    nw = min(_workers(workers), len(pts))
+    if nw <= 1:
+        outs = [fn(q) for q in pts]
+    else:
+        with ThreadPoolExecutor(nw) as ex:
+            outs = list(ex.map(fn, pts))
+    val = [o[0] if o[0] is not None else np.full(6, np.nan) for o in outs]
+    J = np.column_stack([(val[1 + k] - val[7 + k]) / (2 * fd_step) for k in range(6)])
+    return J, val[0], outs[0][1]
+
+
+def floquet(z, params=None, variant="paper", method="rodas4", *, fd_step=1e-5, period=1,
+            workers=None, **options):
+    """(multipliers sorted by decreasing modulus, Jacobian) of P^n at z (a fixed point)."""
+    opts = {**TIGHT, **options}
+    J, _, _ = jacobian(z, params, variant, method, fd_step=fd_step, period=period,
+                       workers=workers, **opts)
+    mult = np.linalg.eigvals(J)
+    return mult[np.argsort(-np.abs(mult))], J
+
+
+# --- settling walks and guesses ---------------------------------------------------------------
+
+def settle(x0, params=None, variant="paper", method="rodas4", *, flags0=(0, 1), t_end=8.0,
+           rtol=LOOSE["rtol"], atol=LOOSE["atol"], event_tol=LOOSE["event_tol"]):
+    """Walk from full state x0 for ``t_end`` s (one simulation) and return the section point
+    of the last touch-down with both feet on the ground, or None if there was none."""
+    p = _params(params)
+    res = simulate(x0, t_end=t_end, dt=1e-4, params=p, variant=variant, method=method,
+                   flags0=flags0, record_every=1, record_forces=False, on_failure="return",
+                   rtol=rtol, atol=atol, event_tol=event_tol)
+    for e in reversed(res.events):
+        if e.kind != "touch_down":
+            continue
+        i = int(np.argmin(np.abs(res.t - e.t)))
+        if abs(res.t[i] - e.t) < 1e-12 + 1e-9 * e.t and res.flags[i].all():
+            return section_coordinates(res.x[i], e.leg)
+    return None
+
+
+def hybrid_guess(params=None):
+    """A section point from the hybrid (rigid-ground) model's gait: its pre-impact state with
+    the hip velocity of the rolling stance foot, legs relabelled (None if it has no gait)."""
+    from . import hybrid
+    p = _params(params)
+    try:
+        g = hybrid.find_gait(p)
+    except Exception:      # noqa: BLE001 - no hybrid gait: no guess
+        return None
+    x = hybrid.full_state(g.details["y_minus"], p)        # leg 1 stance (trailing), 2 leading
+    return section_coordinates(x, 2)
+
+
+def default_guesses(params=None, variant="paper", method="rodas4", settle_time=8.0):
+    """Starting points for Newton (list of (name, z)): the paper's initial condition, its
+    disturbed start (Fig. 9) and the hybrid gait, each walked for ``settle_time`` s."""
+    p = _params(params)
+    out = []
+    for name, x0, f0 in (("paper x0", X0_PAPER, (0, 1)), ("disturbed x0", X0_DISTURBED, (1, 0))):
+        z = settle(x0, p, variant, method, flags0=f0, t_end=settle_time)
+        if z is not None:
+            out.append((name + " settled", z))
+    zh = hybrid_guess(p)
+    if zh is not None:
+        z = settle(embed(zh, p), p, variant, method, flags0=(1, 1), t_end=settle_time)
+        out.append(("hybrid gait settled", z if z is not None else zh))
+        if z is not None:
+            out.append(("hybrid gait", zh))
+    return out
+
+
+def _guess_z(guess, params):
+    if isinstance(guess, Gait):
+        if guess.model == "continuous":
+            return _z(guess.details["z"])
+        from . import hybrid
+        x = hybrid.full_state(guess.details["y_minus"], params)
+        return section_coordinates(x, 2)
+    g = np.asarray(guess, dtype=float).reshape(-1)
+    if g.shape == (8,):
+        return section_coordinates(g, 2 if g[3] >= g[2] else 1)
+    return _z(g, "guess")
+
+
+# --- Newton shooting ----------------------------------------------------------------------------
+
+def _newton(z, period, params, variant, method, opts, tol, max_iter, fd_step, workers):
+    z = np.array(z, dtype=float)
+    res = None
+    for it in range(max_iter):
+        J, Pz, steps = jacobian(z, params, variant, method, fd_step=fd_step, period=period,
+                                workers=workers, **opts)
+        if not np.isfinite(Pz).all():
+            return None, dict(reason="step failed at iterate %d (%s)"
+                              % (it, steps[-1]["status"]), iterations=it)
+        res = Pz - z
+        rn = float(np.max(np.abs(res)))
+        if rn < tol:
+            return z, dict(reason="converged", iterations=it, residual=rn, jacobian=J,
+                           steps=steps)
+        A = J - np.eye(6)
+        if not np.isfinite(A).all():
+            return None, dict(reason="Jacobian not finite at iterate %d" % it, iterations=it)
+        try:
+            dz = np.linalg.solve(A, -res)
+        except np.linalg.LinAlgError:
+            return None, dict(reason="singular Newton matrix", iterations=it)
+        lam = 1.0
+        for _ in range(8):
+            zt = z + lam * dz
+            Pt, _ = _compose(zt, period, params, variant, method, opts)
+            if Pt is not None and np.max(np.abs(Pt - zt)) < rn:
+                break
+            lam *= 0.5
+        z = z + lam * dz
+    return None, dict(reason="no convergence in %d iterations (residual %.3g)"
+                      % (max_iter, np.nan if res is None else np.max(np.abs(res))),
+                      iterations=max_iter)
+
+
+def find_gait(params=None, variant="paper", guess=None, method="rodas4", *, period=1, tol=1e-9,
+              max_iter=20, fd_step=1e-5, settle_time=8.0, workers=None, **options) -> Gait:
+    """The period-``period`` gait of the continuous (compliant-ground) walker by Newton shooting
+    on the touch-down Poincaré map (module docstring).
+
+    Parameters
+    ----------
+    params : Params
+        Default `Params.paper_steady()`.
+    variant : {"paper", "consistent"}
+        Contact reading (MODEL.md section 6).
+    guess : array_like (6,) section point, (8,) full state at a touch-down, or a `Gait`
+        (hybrid or continuous), optional. Default: `default_guesses` in turn. A guess is used
+        as it is (no settling walk).
+    method : str
+        Integrator of the step map; ``rodas4`` (default) locates the touch-down to ``event_tol``.
+    period : int
+        Solve P^period(z) = z (2 for a period-two gait, ...).
+    tol : float
+        Newton converges when max|P^n(z) - z| < tol.
+    fd_step : float
+        Absolute step of the central-difference Jacobian.
+    settle_time : float
+        Length of the settling walk of the default guesses [s].
+    workers : int
+        Threads for the Jacobian's 13 map evaluations (default: all cores).
+    options
+        Step-map options: rtol, atol, event_tol (default `TIGHT`), t_max, dt, and
+        ``contact`` (`pdw.Contact`: the contact laws; the section re-initialises both feet's
+        approach speeds, so with lankarani_nikravesh or flores the trailing foot's damping
+        during the double support differs from a continuous run's).
+
+    Returns
+    -------
+    Gait
+        ``model="continuous"``; ``state``: the full state at the section (flags (1, 1), leg 2
+        just touched down, its contact point at the origin); ``period``: touch-down to
+        touch-down [s] (for period n > 1: the whole n-step cycle); ``step_length``: footprint
+        spacing (n > 1: the mean); ``double_support`` [s] (n > 1: the mean); ``multipliers``: the
+        6 eigenvalues of DP^n. ``details``: ``z``, ``jacobian``, ``fd_step``, ``residual``,
+        ``newton_iterations``, ``swing_period``, ``travel``, ``orbit`` (n section points),
+        ``steps``, ``multipliers_check`` (with 10 x fd_step), the guess used.
+
+    Raises
+    ------
+    GaitNotFoundError
+        No guess converged (``attempts`` says why for each).
+    """
+    p = _params(params)
+    period = int(period)
+    if period < 1:
+        raise InvalidInputError("period must be >= 1, got %r" % (period,))
+    opts = {**TIGHT, **options}
+    if guess is not None:
+        guesses = [("given", _guess_z(guess, p))]
+    else:
+        guesses = default_guesses(p, variant, method, settle_time)
+    attempts = []
+    for name, z0 in guesses:
+        z, info = _newton(z0, period, p, variant, method, opts, tol, max_iter, fd_step, workers)
+        attempts.append({"guess": name, "z0": z0, **{k: v for k, v in info.items()
+                                                      if k not in ("jacobian", "steps")}})
+        if z is not None:
+            return _gait(p, variant, method, z, period, info, fd_step, opts, workers, name)
+    raise GaitNotFoundError("no period-%d gait of the continuous model found from %d guess(es); "
+                            "last: %s" % (period, len(guesses),
+                                          attempts[-1]["reason"] if attempts else "no guess"),
+                            attempts)
+
+
+def _gait(p, variant, method, z, period, info, fd_step, opts, workers, guess_name):
+    J = info["jacobian"]
+    mult = np.linalg.eigvals(J)
+    mult = mult[np.argsort(-np.abs(mult))]
+    J10, _, _ = jacobian(z, p, variant, method, fd_step=10 * fd_step, period=period,
+                         workers=workers, **opts)
+    m10 = np.linalg.eigvals(J10)
+    m10 = m10[np.argsort(-np.abs(m10))]
+    steps = info["steps"]
+    orbit_z = [z] + [s["z"] for s in steps[:-1]]
+    T = float(sum(s["period"] for s in steps))
+    details = {
+        "section": "touch-down of the swing foot (flags (1, 1)); legs relabelled so that leg 2 "
+                   "has just touched down; z = %s; x_D2 = y_D2 = 0" % (SECTION,),
+        "z": z, "variant": variant, "method": method, "options": dict(opts), "fd_step": fd_step,
+        "jacobian": J, "multipliers_check": m10, "residual": info["residual"],
+        "newton_iterations": info["iterations"], "guess": guess_name, "period_n": period,
+        "orbit": np.array(orbit_z), "steps": [{k: v for k, v in s.items() if k != "result"}
+                                              for s in steps],
+        "swing_period": float(np.mean([s["swing_period"] for s in steps])),
+        "travel": float(np.mean([s["travel"] for s in steps])),
+        "cycle": float(np.mean([s["period"] for s in steps])),
+    }
+    return Gait(state=embed(z, p), period=T,
+                step_length=float(np.mean([s["step_length"] for s in steps])),
+                double_support=float(np.mean([s["double_support"] for s in steps])),
+                multipliers=mult, model="continuous", params=p, details=details)
+
+
+# --- period-n detection -------------------------------------------------------------------------
+
+def detect_period(params=None, z0=None, variant="paper", method="rodas4", *, n_transient=30,
+                  n_max=8, tol=1e-6, **options) -> dict:
+    """Iterate the map ``n_transient + 2 n_max`` times from z0 (default: the paper's initial
+    condition settled for 4 s) and classify the orbit.
+
+    Returns a dict: ``kind`` ("period", "fell" (or another failed step: ``status``), or
+    "aperiodic": no period up to n_max within tol), ``n`` (the period, or None), ``Z`` (the
+    iterates), ``distance`` (max|z_{k+n} - z_k| over the last n_max iterates for n = 1..n_max).
+    """
+    p = _params(params)
+    opts = {**LOOSE, **options}
+    if z0 is None:
+        z0 = settle(X0_PAPER, p, variant, method, flags0=(0, 1), t_end=4.0)
+        if z0 is None:
+            return dict(kind="fell", status="fell", n=None, Z=np.empty((0, 6)), distance={})
+    N = n_transient + 2 * n_max
+    Z, info = orbit(z0, N, p, variant, method, **opts)
+    if len(Z) < N + 1:
+        return dict(kind="fell" if info[-1]["status"] == "fell" else "failed",
+                    status=info[-1]["status"], n=None, Z=Z, distance={})
+    tail = Z[-(n_max + 1):]
+    dist = {}
+    for n in range(1, n_max + 1):
+        dist[n] = float(np.max(np.abs(Z[-n_max:] - Z[-n_max - n:len(Z) - n])))
+    for n in range(1, n_max + 1):
+        if dist[n] < tol:
+            return dict(kind="period", status="ok", n=n, Z=Z, distance=dist, tail=tail)
+    return dict(kind="aperiodic", status="ok", n=None, Z=Z, distance=dist, tail=tail)

@@ -1,0 +1,447 @@
+# cython: language_level=3
+"""Thin Cython layer over the generated C model and the compiled time loops.
+
+Private: the public API is in `pdw.core.model` and `pdw.sim.simulation`. Every function
+takes caller-allocated, C-contiguous float64 arrays (typed memoryviews; no NumPy
+C headers). Time loops release the GIL and are entered once per simulation.
+"""
+import numpy as np
+
+from libc.string cimport memset, memcpy
+
+
+cdef extern from "pdw_model.h":
+    enum:
+        PDW_NX, PDW_NQ, PDW_NP, PDW_NPARAM, PDW_NKIN, PDW_NCONTACT, PDW_NENERGY, PDW_NWORK
+        PDW_NKERNELS, PDW_NEVENT, PDW_NREC
+        PDW_WORK_TRIG, PDW_WORK_KIN, PDW_WORK_CONTACT, PDW_WORK_M, PDW_WORK_F, PDW_WORK_QDD
+        PDW_STATUS_RUNNING, PDW_STATUS_EVENTS_FULL
+        PDW_NSTEP, PDW_STEP_RING, PDW_NANCHOR
+    ctypedef struct pdw_kernel:
+        const char *name
+        int variant
+        unsigned features
+        void (*kinematics)(const double *x, const double *trig, const double *p,
+                           const double *anchors, double *kin) noexcept nogil
+        void (*contact)(const double *kin, const int *flags, const double *p,
+                        double *contact) noexcept nogil
+        void (*contact_partials)(const double *kin, const int *flags, const double *p,
+                                 double *contact) noexcept nogil
+        void (*dynamics)(const double *x, const double *trig, const double *p,
+                         const double *contact, double *M, double *f) noexcept nogil
+        void (*cdm_terms)(const double *x, const double *trig, const double *p,
+                          const double *contact, double *M, double *C, double *QmG) noexcept nogil
+        void (*dynamics_jacobian)(const double *x, const double *trig, const double *p,
+                                  const double *contact, const double *qdd, double *A) noexcept nogil
+        void (*energies)(const double *x, const double *trig, const double *p,
+                         double *e) noexcept nogil
+        void (*rhs)(const double *x, const double *p, const int *flags, const double *anchors,
+                    double *xdot, double *work) noexcept nogil
+        void (*jacobian)(const double *x, const double *p, const int *flags,
+                         const double *anchors, double *J, double *work) noexcept nogil
+    const pdw_kernel pdw_kernels[]
+    void pdw_precompute(const double *params, double *p) noexcept nogil
+    void pdw_trig(const double *x, double *trig) noexcept nogil
+
+
+cdef extern from "pdw_sim.h":
+    ctypedef struct pdw_discrete:
+        int flags[2]
+        int armed[2]
+        double anchors[4]
+    ctypedef struct pdw_failure:
+        double t
+        double x[8]
+        int leg
+        int reason
+    ctypedef struct pdw_gait:
+        long n_steps
+        long n_touch_down, n_lift_off
+        double ring[1][1]
+    ctypedef struct pdw_sim:
+        const pdw_kernel *kernel
+        double p[32]
+        double dt
+        long n_steps
+        long record_every
+        double fall_hip_height
+        double fall_depth
+        double max_speed
+        double t_end
+        double rtol, atol
+        double h_max
+        double event_tol
+        int record_events
+        long stop_steps
+        int periodic_k
+        double periodic_tol
+        double *rec_t
+        double *rec_x
+        int *rec_flags
+        double *rec_contact
+        long rec_capacity, n_rec
+        double *events
+        long ev_capacity, n_events
+        long n
+        double t
+        double h
+        double x[8]
+        double u_prev[4]
+        int started
+        pdw_discrete disc
+        double work[1]
+        long n_rhs, n_jac, n_rejected
+        pdw_gait gait
+        int status
+        int stop_reason
+        pdw_failure failure
+    ctypedef int (*pdw_advance_fn)(pdw_sim *s) noexcept nogil
+    ctypedef struct pdw_method:
+        const char *name
+        int order
+        int adaptive
+        pdw_advance_fn advance
+    const pdw_method pdw_methods[]
+    const int pdw_nmethods
+    void pdw_discrete_init(const pdw_kernel *k, const double *p, const double *x,
+                           const int *flags0, pdw_discrete *d, double *work) noexcept nogil
+    void pdw_gait_init(pdw_gait *g) noexcept nogil
+    enum:
+        PDW_STATUS_RECORDS_FULL
+
+
+cdef extern from "pdw_tableaus.h":
+    enum:
+        PDW_RK_MAXSTAGES, PDW_ROS_MAXSTAGES
+    ctypedef struct pdw_rk_tableau:
+        const char *name
+        int stages, order, embedded_order, fsal
+        double c[7]
+        double a[7][7]
+        double b[7]
+        double e[7]
+    ctypedef struct pdw_ros_tableau:
+        const char *name
+        int stages, order, embedded_order
+        double gamma
+        double a[6][6]
+        double C[6][6]
+        double m[6]
+        double e[6]
+    const pdw_rk_tableau pdw_tableau_rk4
+    const pdw_rk_tableau pdw_tableau_dopri5
+    const pdw_ros_tableau pdw_tableau_rodas4
+
+
+cdef extern from "pdw_bench.h":
+    double pdw_bench_rhs(const pdw_kernel *k, const double *x0, const double *p, const int *flags,
+                         const double *anchors, long n, double *work, double *sink) noexcept nogil
+    double pdw_bench_jacobian(const pdw_kernel *k, const double *x0, const double *p,
+                              const int *flags, const double *anchors, long n, double *work,
+                              double *sink) noexcept nogil
+
+
+NX = PDW_NX
+NQ = PDW_NQ
+NP = PDW_NP
+NWORK = PDW_NWORK
+
+
+def kernel_table():
+    """[(name, variant index, feature mask)] in the order of the C table."""
+    return [(pdw_kernels[i].name.decode(), pdw_kernels[i].variant, pdw_kernels[i].features)
+            for i in range(PDW_NKERNELS)]
+
+
+cdef const pdw_kernel *_kernel(int k) except NULL:
+    if k < 0 or k >= PDW_NKERNELS:
+        raise IndexError("kernel index %d out of range [0, %d)" % (k, PDW_NKERNELS))
+    return &pdw_kernels[k]
+
+
+def precompute(const double[::1] params, double[::1] p):
+    """Fill the kernel parameter vector p (NP,) from the physical parameters (NPARAM,)."""
+    assert params.shape[0] == PDW_NPARAM and p.shape[0] == PDW_NP
+    pdw_precompute(&params[0], &p[0])
+
+
+cdef int _anchor_width(const double[:, ::1] anchors) except -1:
+    if anchors.shape[1] < 2 or anchors.shape[1] > PDW_NANCHOR:
+        raise ValueError("anchors must have 2 to %d columns (layout ANCHORS), got %d"
+                         % (PDW_NANCHOR, anchors.shape[1]))
+    return anchors.shape[1]
+
+
+cdef inline void _anchors(const double[:, ::1] anchors, Py_ssize_t i, int na,
+                          double *a) noexcept nogil:
+    """Row i of anchors, padded with zeros to PDW_NANCHOR (s0 only: no approach speeds)."""
+    cdef int j
+    for j in range(PDW_NANCHOR):
+        a[j] = anchors[i, j] if j < na else 0.0
+
+
+def rhs_batch(int k, const double[:, ::1] x, const double[::1] p, const int[:, ::1] flags,
+              const double[:, ::1] anchors, double[:, ::1] xdot, double[:, ::1] work):
+    """f(x) (Eq. A.4) for each row; work (N, NWORK) receives every stage's output."""
+    cdef const pdw_kernel *kern = _kernel(k)
+    cdef Py_ssize_t i, n = x.shape[0]
+    cdef double a[PDW_NANCHOR]
+    cdef int na = _anchor_width(anchors)
+    with nogil:
+        for i in range(n):
+            _anchors(anchors, i, na, a)
+            kern.rhs(&x[i, 0], &p[0], &flags[i, 0], a, &xdot[i, 0], &work[i, 0])
+
+
+def jacobian_batch(int k, const double[:, ::1] x, const double[::1] p, const int[:, ::1] flags,
+                   const double[:, ::1] anchors, double[:, ::1] J, double[:, ::1] work):
+    """df/dx (8x8 row-major per row of J, shape (N, 64)); work as in rhs_batch, with partials."""
+    cdef const pdw_kernel *kern = _kernel(k)
+    cdef Py_ssize_t i, n = x.shape[0]
+    cdef double a[PDW_NANCHOR]
+    cdef int na = _anchor_width(anchors)
+    with nogil:
+        for i in range(n):
+            _anchors(anchors, i, na, a)
+            kern.jacobian(&x[i, 0], &p[0], &flags[i, 0], a, &J[i, 0], &work[i, 0])
+
+
+def contact_batch(int k, const double[:, ::1] kin, const int[:, ::1] flags, const double[::1] p,
+                  double[:, ::1] contact, bint partials=False):
+    """The contact stage alone: per row, kin (N, 2*NKIN) -> contact (N, 2*NCONTACT) (forces
+    only, or with ``partials`` the partial derivatives too); for tests of the force laws."""
+    cdef const pdw_kernel *kern = _kernel(k)
+    cdef Py_ssize_t i, n = kin.shape[0]
+    assert kin.shape[1] == 2 * PDW_NKIN and contact.shape[1] == 2 * PDW_NCONTACT
+    assert flags.shape[0] == n and contact.shape[0] == n
+    with nogil:
+        for i in range(n):
+            if partials:
+                kern.contact_partials(&kin[i, 0], &flags[i, 0], &p[0], &contact[i, 0])
+            else:
+                kern.contact(&kin[i, 0], &flags[i, 0], &p[0], &contact[i, 0])
+
+
+def energies_batch(int k, const double[:, ::1] x, const double[::1] p, double[:, ::1] e):
+    """T, V_gravity, V_hip for each row of x."""
+    cdef const pdw_kernel *kern = _kernel(k)
+    cdef Py_ssize_t i, n = x.shape[0]
+    cdef double trig[4]
+    with nogil:
+        for i in range(n):
+            pdw_trig(&x[i, 0], trig)
+            kern.energies(&x[i, 0], trig, &p[0], &e[i, 0])
+
+
+def cdm_terms(int k, const double[::1] x, const double[::1] p, const double[::1] contact,
+              double[::1] M, double[::1] C, double[::1] QmG):
+    """M, the appendix C matrix and Q_f - G at x for given contact forces (central difference)."""
+    cdef const pdw_kernel *kern = _kernel(k)
+    cdef double trig[4]
+    pdw_trig(&x[0], trig)
+    kern.cdm_terms(&x[0], trig, &p[0], &contact[0], &M[0], &C[0], &QmG[0])
+
+
+def bench(int k, str what, const double[::1] x, const double[::1] p, int f1, int f2,
+          double a1, double a2, long n):
+    """Mean ns per evaluation of `what` ("rhs" or "jacobian") over n calls in a C loop."""
+    cdef const pdw_kernel *kern = _kernel(k)
+    cdef int flags[2]
+    cdef double anchors[4]
+    cdef double work[PDW_NWORK]
+    cdef double sink = 0.0, ns
+    flags[0] = f1; flags[1] = f2; anchors[0] = a1; anchors[1] = a2; anchors[2] = 0.0
+    anchors[3] = 0.0
+    if what == "rhs":
+        with nogil:
+            ns = pdw_bench_rhs(kern, &x[0], &p[0], flags, anchors, n, work, &sink)
+    elif what == "jacobian":
+        with nogil:
+            ns = pdw_bench_jacobian(kern, &x[0], &p[0], flags, anchors, n, work, &sink)
+    else:
+        raise ValueError("what must be 'rhs' or 'jacobian', got %r" % what)
+    return ns
+
+
+def method_table():
+    """[(name, order, adaptive)] of the compiled integrators, in method-id order."""
+    return [(pdw_methods[i].name.decode(), pdw_methods[i].order, bool(pdw_methods[i].adaptive))
+            for i in range(pdw_nmethods)]
+
+
+def rk_tableau(str name):
+    """The Butcher tableau the compiled loops use for ``name`` ("rk4" or "dopri5"): a dict with
+    stages, order, embedded_order, fsal and arrays c (s,), A (s, s), b (s,), e = b - bhat (s,)."""
+    cdef const pdw_rk_tableau *T
+    if name == "rk4":
+        T = &pdw_tableau_rk4
+    elif name == "dopri5":
+        T = &pdw_tableau_dopri5
+    else:
+        raise ValueError("no explicit Runge-Kutta tableau %r (rk4, dopri5)" % name)
+    n = T.stages
+    return {"name": T.name.decode(), "stages": n, "order": T.order,
+            "embedded_order": T.embedded_order, "fsal": bool(T.fsal),
+            "c": np.array([T.c[i] for i in range(n)]),
+            "A": np.array([[T.a[i][j] for j in range(n)] for i in range(n)]),
+            "b": np.array([T.b[i] for i in range(n)]),
+            "e": np.array([T.e[i] for i in range(n)])}
+
+
+def ros_tableau(str name="rodas4"):
+    """The Rosenbrock tableau (Hairer-Wanner transformed form, see pdw_tableaus.h) of ``name``:
+    a dict with stages, order, embedded_order, gamma and arrays a, C (s, s), m, e (s,)."""
+    cdef const pdw_ros_tableau *T
+    if name == "rodas4":
+        T = &pdw_tableau_rodas4
+    else:
+        raise ValueError("no Rosenbrock tableau %r (rodas4)" % name)
+    n = T.stages
+    return {"name": T.name.decode(), "stages": n, "order": T.order,
+            "embedded_order": T.embedded_order, "gamma": T.gamma,
+            "a": np.array([[T.a[i][j] for j in range(n)] for i in range(n)]),
+            "C": np.array([[T.C[i][j] for j in range(n)] for i in range(n)]),
+            "m": np.array([T.m[i] for i in range(n)]),
+            "e": np.array([T.e[i] for i in range(n)])}
+
+
+def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, int f2,
+        double dt, long n_steps, long record_every, bint record_contact,
+        double fall_hip_height, double fall_depth, double max_speed,
+        double rtol=1e-6, double atol=1e-8, double h_max=0.0, long max_records=0,
+        long event_capacity=256, double event_tol=1e-9, bint record_events=True,
+        long stop_steps=0, int periodic_k=0, double periodic_tol=0.0, double t_end=0.0):
+    """Run one simulation in compiled code (GIL released). Returns a dict of arrays and status.
+
+    The online gait analysis runs for every method: the result's "gait" holds the last
+    min(n_gait_steps, PDW_STEP_RING) complete steps (rows of layout STEP, oldest first), with
+    the step and event counts. record_events=False stores no event (only counts). stop_steps > 0
+    stops at that many complete steps, periodic_k > 0 when the last periodic_k steps agree within
+    periodic_tol (relative); "stop_reason" says which (layout STOP).
+
+    Fixed-step methods take n_steps steps of dt; adaptive ones integrate to t_end (default
+    n_steps*dt) with
+    first step dt, locating flag switches to within event_tol [s]. The record buffer first holds
+    max_records samples (default: n_steps/record_every+2, exact for fixed-step methods; for
+    adaptive ones at most 4096 to start with). When a loop fills the event or the record buffer
+    it returns PDW_STATUS_EVENTS_FULL / PDW_STATUS_RECORDS_FULL; this function then doubles that
+    buffer and calls the loop again, which resumes where it stopped: no sample is dropped.
+    """
+    cdef pdw_sim s
+    cdef int flags0[2]
+    cdef long n_rec_cap = (n_steps // record_every + 2) if record_every > 0 else 0
+    if max_records > 0 and record_every > 0:
+        n_rec_cap = max_records
+    if method < 0 or method >= pdw_nmethods:
+        raise ValueError("method id %d out of range [0, %d)" % (method, pdw_nmethods))
+    cdef pdw_advance_fn advance = pdw_methods[method].advance
+    if pdw_methods[method].adaptive and max_records <= 0 and n_rec_cap > 4096:
+        n_rec_cap = 4096        # adaptive: the number of steps is unknown; grown on demand
+    memset(&s, 0, sizeof(pdw_sim))
+    s.kernel = _kernel(k)
+    s.t_end = t_end if t_end > 0 else n_steps * dt   # adaptive methods end exactly at t_end
+    s.rtol = rtol
+    s.atol = atol
+    s.h_max = h_max if h_max > 0 else s.t_end
+    s.h = dt
+    s.event_tol = event_tol
+    memcpy(s.p, &p[0], PDW_NP * sizeof(double))
+    s.dt = dt
+    s.n_steps = n_steps
+    s.record_every = record_every
+    s.fall_hip_height = fall_hip_height
+    s.fall_depth = fall_depth
+    s.max_speed = max_speed
+    rec_t = np.zeros(n_rec_cap)
+    rec_x = np.zeros((n_rec_cap, PDW_NX))
+    rec_flags = np.zeros((n_rec_cap, 2), dtype=np.intc)
+    rec_contact = np.zeros((n_rec_cap if record_contact else 0, PDW_NREC))
+    events = np.zeros((max(event_capacity, 4) if record_events else 1, PDW_NEVENT))
+    cdef double[::1] v_t = rec_t
+    cdef double[:, ::1] v_x = rec_x
+    cdef int[:, ::1] v_f = rec_flags
+    cdef double[:, ::1] v_c = rec_contact
+    cdef double[:, ::1] v_e = events
+    if n_rec_cap > 0:
+        s.rec_t = &v_t[0]
+        s.rec_x = &v_x[0, 0]
+        s.rec_flags = &v_f[0, 0]
+        if record_contact:
+            s.rec_contact = &v_c[0, 0]
+    s.rec_capacity = n_rec_cap
+    s.record_events = record_events
+    s.events = &v_e[0, 0] if record_events else NULL
+    s.ev_capacity = events.shape[0] if record_events else 0
+    s.stop_steps = stop_steps
+    if periodic_k < 0 or periodic_k == 1 or periodic_k > PDW_STEP_RING:
+        raise ValueError("periodic_k must be 0 (off) or in [2, %d], got %d" % (PDW_STEP_RING, periodic_k))
+    s.periodic_k = periodic_k
+    s.periodic_tol = periodic_tol
+    pdw_gait_init(&s.gait)
+    memcpy(s.x, &x0[0], PDW_NX * sizeof(double))
+    flags0[0] = f1; flags0[1] = f2
+    pdw_discrete_init(s.kernel, s.p, s.x, flags0, &s.disc, s.work)
+    cdef int status
+    while True:
+        with nogil:
+            status = advance(&s)
+        if status == PDW_STATUS_EVENTS_FULL:
+            grown = np.zeros((2 * events.shape[0], PDW_NEVENT))
+            grown[:events.shape[0]] = events
+            events = grown
+            v_e = events
+            s.events = &v_e[0, 0]
+            s.ev_capacity = events.shape[0]
+        elif status == PDW_STATUS_RECORDS_FULL:
+            # adaptive methods only: double the record arrays (copying what is there) and resume
+            n_rec_cap = 2 * max(n_rec_cap, 1)
+            rec_t = np.concatenate([rec_t, np.zeros(n_rec_cap - rec_t.shape[0])])
+            rec_x = np.concatenate([rec_x, np.zeros((n_rec_cap - rec_x.shape[0], PDW_NX))])
+            rec_flags = np.concatenate([rec_flags,
+                                        np.zeros((n_rec_cap - rec_flags.shape[0], 2), dtype=np.intc)])
+            if record_contact:
+                rec_contact = np.concatenate(
+                    [rec_contact, np.zeros((n_rec_cap - rec_contact.shape[0], PDW_NREC))])
+            v_t = rec_t
+            v_x = rec_x
+            v_f = rec_flags
+            s.rec_t = &v_t[0]
+            s.rec_x = &v_x[0, 0]
+            s.rec_flags = &v_f[0, 0]
+            if record_contact:
+                v_c = rec_contact
+                s.rec_contact = &v_c[0, 0]
+            s.rec_capacity = n_rec_cap
+        else:
+            break
+    n_rec = s.n_rec
+    cdef long n_gait = s.gait.n_steps
+    cdef long n_keep = min(n_gait, <long>PDW_STEP_RING)
+    cdef double *ring = &s.gait.ring[0][0]
+    # fixed size (a view of the first n_keep rows is returned): the same memory however long
+    # the run
+    gait = np.full((PDW_STEP_RING, PDW_NSTEP), np.nan)
+    cdef long r, c, slot
+    for r in range(n_keep):
+        slot = (n_gait - n_keep + r) % PDW_STEP_RING
+        for c in range(PDW_NSTEP):
+            gait[r, c] = ring[slot * PDW_NSTEP + c]
+    return {
+        "gait": gait[:n_keep],
+        "n_gait_steps": n_gait,
+        "event_counts": {"touch_down": s.gait.n_touch_down, "lift_off": s.gait.n_lift_off},
+        "stop_reason": s.stop_reason,
+        "status": status,
+        "t": rec_t[:n_rec], "x": rec_x[:n_rec], "flags": rec_flags[:n_rec],
+        "contact": rec_contact[:n_rec] if record_contact else None,
+        "events": events[:s.n_events].copy() if record_events else np.zeros((0, PDW_NEVENT)),
+        "n_steps": s.n,
+        "t_final": s.t,
+        "stats": {"steps": s.n, "rhs": s.n_rhs, "jacobians": s.n_jac, "rejected": s.n_rejected},
+        "x_final": np.array(<double[:PDW_NX]> s.x),
+        "flags_final": (s.disc.flags[0], s.disc.flags[1]),
+        "anchors_final": (s.disc.anchors[0], s.disc.anchors[1]),
+        "approach_speeds_final": (s.disc.anchors[2], s.disc.anchors[3]),
+        "failure": {"t": s.failure.t, "x": np.array(<double[:PDW_NX]> s.failure.x),
+                    "leg": s.failure.leg, "reason": s.failure.reason},
+    }

@@ -1,0 +1,247 @@
+# cython: language_level=3
+"""Thin Cython layer over the hybrid walker (generated/pdw_hybrid.c, pdw/core/csrc/pdw_hybrid_sim.c).
+
+Private: the public API is `pdw.hybrid`. Parameter vectors are the full model's ``p``
+(`pdw.core.model.parameter_vector`); reduced states are y = [theta_st, theta_sw, thetad_st,
+thetad_sw]. The stance-phase integration, heel-strike location and impact run in C with the
+GIL released.
+"""
+import numpy as np
+
+from libc.string cimport memset
+
+
+cdef extern from "pdw_hybrid.h":
+    enum:
+        PDW_NX, PDW_NP, PDW_NHY, PDW_NHYFOOT, PDW_NENERGY
+    void pdw_hybrid_stance(const double *y, const double *p, double *Mr, double *fr) noexcept nogil
+    int pdw_hybrid_rhs(const double *y, const double *p, double *ydot) noexcept nogil
+    void pdw_hybrid_ground_force(const double *y, const double *ydd, const double *p,
+                                 double *F) noexcept nogil
+    void pdw_hybrid_swing_foot(const double *y, const double *p, double *foot) noexcept nogil
+    void pdw_hybrid_energies(const double *y, const double *p, double *e) noexcept nogil
+    void pdw_hybrid_full_state(const double *y, const double *p, double *x) noexcept nogil
+    void pdw_hybrid_impact_terms(const double *q, const double *p, double *MJ) noexcept nogil
+
+
+cdef extern from "pdw_hybrid_sim.h":
+    ctypedef struct pdw_hybrid_opts:
+        double rtol, atol, h0, h_max, t_max, event_tol, min_step_angle, fall_angle
+        long max_steps
+        double dt_out
+    ctypedef struct pdw_hybrid_result:
+        int status
+        double t0, s0
+        double y0[4]
+        double t_strike
+        double y_minus[4]
+        double y_plus[4]
+        double qd_minus[4]
+        double qd_plus[4]
+        double impulse[2]
+        double v_old[2]
+        int old_foot_down
+        double vy_strike, T_minus, T_plus, x_touch, step_length, s0_next, E0, dE_max
+        double Fn_min, ratio_max
+        long n_steps, n_rejected, n_rhs, n_rec
+        int rec_full
+    void pdw_hybrid_default_opts(pdw_hybrid_opts *o) noexcept nogil
+    int pdw_hybrid_impact(const double *p, const double *y_minus, pdw_hybrid_result *r) noexcept nogil
+    int pdw_hybrid_step(const double *p, const double *y0, double t0, double s0,
+                        const pdw_hybrid_opts *o, pdw_hybrid_result *r,
+                        double *rec_t, double *rec_y, long rec_cap) noexcept nogil
+    long pdw_hybrid_walk(const double *p, const double *y0, double s0, long n_steps,
+                         const pdw_hybrid_opts *o, pdw_hybrid_result *results,
+                         double *rec_t, double *rec_y, long *rec_step, long rec_cap) noexcept nogil
+    int pdw_hybrid_solve(int n, double *A, double *b, double *x) noexcept nogil
+
+
+NY = PDW_NHY
+NFOOT = PDW_NHYFOOT
+STATUS = ("ok", "no_strike", "fell", "singular", "nonfinite", "max_steps", "step_tiny")
+OPTION_NAMES = ("rtol", "atol", "h0", "h_max", "t_max", "event_tol", "min_step_angle",
+                "fall_angle", "max_steps", "dt_out")
+
+
+def default_options():
+    """The C defaults of the step map's options, as a dict."""
+    cdef pdw_hybrid_opts o
+    pdw_hybrid_default_opts(&o)
+    return _opts_dict(&o)
+
+
+cdef dict _opts_dict(pdw_hybrid_opts *o):
+    return {"rtol": o.rtol, "atol": o.atol, "h0": o.h0, "h_max": o.h_max, "t_max": o.t_max,
+            "event_tol": o.event_tol, "min_step_angle": o.min_step_angle,
+            "fall_angle": o.fall_angle, "max_steps": o.max_steps, "dt_out": o.dt_out}
+
+
+cdef void _fill_opts(pdw_hybrid_opts *o, dict opts) except *:
+    pdw_hybrid_default_opts(o)
+    for k, v in opts.items():
+        if k == "rtol": o.rtol = v
+        elif k == "atol": o.atol = v
+        elif k == "h0": o.h0 = v
+        elif k == "h_max": o.h_max = v
+        elif k == "t_max": o.t_max = v
+        elif k == "event_tol": o.event_tol = v
+        elif k == "min_step_angle": o.min_step_angle = v
+        elif k == "fall_angle": o.fall_angle = v
+        elif k == "max_steps": o.max_steps = v
+        elif k == "dt_out": o.dt_out = v
+        else:
+            raise ValueError("unknown hybrid option %r; allowed: %s" % (k, ", ".join(OPTION_NAMES)))
+
+
+cdef dict _result_dict(pdw_hybrid_result *r):
+    return {
+        "status": STATUS[r.status] if 0 <= r.status < len(STATUS) else str(r.status),
+        "t0": r.t0, "s0": r.s0, "y0": np.array(<double[:4]> r.y0),
+        "t_strike": r.t_strike,
+        "y_minus": np.array(<double[:4]> r.y_minus), "y_plus": np.array(<double[:4]> r.y_plus),
+        "qd_minus": np.array(<double[:4]> r.qd_minus), "qd_plus": np.array(<double[:4]> r.qd_plus),
+        "impulse": np.array(<double[:2]> r.impulse), "v_old": np.array(<double[:2]> r.v_old),
+        "old_foot_down": bool(r.old_foot_down), "vy_strike": r.vy_strike,
+        "T_minus": r.T_minus, "T_plus": r.T_plus, "x_touch": r.x_touch,
+        "step_length": r.step_length, "s0_next": r.s0_next, "E0": r.E0, "dE_max": r.dE_max,
+        "Fn_min": r.Fn_min, "ratio_max": r.ratio_max,
+        "n_steps": r.n_steps, "n_rejected": r.n_rejected, "n_rhs": r.n_rhs, "n_rec": r.n_rec,
+        "rec_full": bool(r.rec_full),
+    }
+
+
+def rhs(const double[::1] p, const double[::1] y):
+    """dy/dt of the stance phase; raises on a singular reduced mass matrix."""
+    out = np.empty(PDW_NHY)
+    cdef double[::1] v = out
+    if pdw_hybrid_rhs(&y[0], &p[0], &v[0]):
+        raise ArithmeticError("singular reduced mass matrix at y = %r" % (np.asarray(y),))
+    return out
+
+
+def stance_terms(const double[::1] p, const double[::1] y):
+    """(M_r (2, 2), f_r (2,)) of M_r phidd = f_r."""
+    Mr = np.empty(4)
+    fr = np.empty(2)
+    cdef double[::1] vm = Mr, vf = fr
+    pdw_hybrid_stance(&y[0], &p[0], &vm[0], &vf[0])
+    return Mr.reshape(2, 2), fr
+
+
+def ground_force(const double[::1] p, const double[::1] y, const double[::1] ydd):
+    """Ground reaction (F_x, F_y) on the stance foot for accelerations ydd (2,)."""
+    F = np.empty(2)
+    cdef double[::1] v = F
+    pdw_hybrid_ground_force(&y[0], &ydd[0], &p[0], &v[0])
+    return F
+
+
+def swing_foot(const double[::1] p, const double[::1] y):
+    """[y_sw, vy_sw, x_sw, x_st] (stance rolling coordinate 0)."""
+    out = np.empty(PDW_NHYFOOT)
+    cdef double[::1] v = out
+    pdw_hybrid_swing_foot(&y[0], &p[0], &v[0])
+    return out
+
+
+def energies(const double[::1] p, const double[::1] y):
+    """[T, V_gravity, V_hip] of the stance phase (stance rolling coordinate 0)."""
+    out = np.empty(PDW_NENERGY)
+    cdef double[::1] v = out
+    pdw_hybrid_energies(&y[0], &p[0], &v[0])
+    return out
+
+
+def full_state_batch(const double[::1] p, const double[:, ::1] y, double[:, ::1] x):
+    """Full-model states x (N, 8) of reduced states y (N, 4): stance leg = leg 1, s0 = 0."""
+    cdef Py_ssize_t i, n = y.shape[0]
+    assert x.shape[0] == n and x.shape[1] == PDW_NX
+    with nogil:
+        for i in range(n):
+            pdw_hybrid_full_state(&y[i, 0], &p[0], &x[i, 0])
+
+
+def impact_terms(const double[::1] p, const double[::1] q):
+    """M(q) (4, 4) and the material-point Jacobians J (2 feet, 2, 4)."""
+    out = np.empty(32)
+    cdef double[::1] v = out
+    pdw_hybrid_impact_terms(&q[0], &p[0], &v[0])
+    return out[:16].reshape(4, 4), out[16:].reshape(2, 2, 4)
+
+
+def impact(const double[::1] p, const double[::1] y_minus):
+    """The impact map at a pre-impact state; a dict (see pdw_hybrid_result)."""
+    cdef pdw_hybrid_result r
+    memset(&r, 0, sizeof(r))
+    r.status = pdw_hybrid_impact(&p[0], &y_minus[0], &r)
+    return _result_dict(&r)
+
+
+def solve(double[:, ::1] A, double[::1] b):
+    """x of A x = b by the C Gaussian elimination (A, b overwritten); for tests."""
+    cdef int n = A.shape[0]
+    assert A.shape[1] == n and b.shape[0] == n and n <= 8
+    x = np.empty(n)
+    cdef double[::1] vx = x
+    if pdw_hybrid_solve(n, &A[0, 0], &b[0], &vx[0]):
+        raise ArithmeticError("singular matrix")
+    return x
+
+
+def step(const double[::1] p, const double[::1] y0, dict opts, double t0=0.0, double s0=0.0,
+         long rec_cap=0):
+    """One step of the hybrid map. Returns (result dict, rec_t, rec_y)."""
+    cdef pdw_hybrid_opts o
+    cdef pdw_hybrid_result r
+    _fill_opts(&o, opts)
+    rec_t = np.zeros(max(rec_cap, 1))
+    rec_y = np.zeros((max(rec_cap, 1), PDW_NHY))
+    cdef double[::1] vt = rec_t
+    cdef double[:, ::1] vy = rec_y
+    with nogil:
+        pdw_hybrid_step(&p[0], &y0[0], t0, s0, &o, &r, &vt[0], &vy[0, 0], rec_cap)
+    d = _result_dict(&r)
+    return d, rec_t[:r.n_rec], rec_y[:r.n_rec]
+
+
+def step_batch(const double[::1] p, const double[:, ::1] y0, dict opts, double[:, ::1] y_plus,
+               int[::1] status):
+    """The step map of each row of y0 (N, 4) into y_plus (N, 4); status (N,) per row."""
+    cdef pdw_hybrid_opts o
+    cdef pdw_hybrid_result r
+    cdef Py_ssize_t i, j, n = y0.shape[0]
+    _fill_opts(&o, opts)
+    assert y_plus.shape[0] == n and status.shape[0] == n
+    with nogil:
+        for i in range(n):
+            pdw_hybrid_step(&p[0], &y0[i, 0], 0.0, 0.0, &o, &r, NULL, NULL, 0)
+            status[i] = r.status
+            for j in range(PDW_NHY):
+                y_plus[i, j] = r.y_plus[j]
+
+
+def walk(const double[::1] p, const double[::1] y0, double s0, long n_steps, dict opts,
+         long rec_cap):
+    """n_steps steps; returns (list of result dicts, rec_t, rec_y, rec_step)."""
+    cdef pdw_hybrid_opts o
+    _fill_opts(&o, opts)
+    if n_steps < 1:
+        raise ValueError("n_steps must be >= 1, got %d" % n_steps)
+    results = np.zeros(n_steps * sizeof(pdw_hybrid_result), dtype=np.uint8)
+    cdef unsigned char[::1] vr = results
+    cdef pdw_hybrid_result *res = <pdw_hybrid_result *> &vr[0]
+    rec_t = np.zeros(max(rec_cap, 1))
+    rec_y = np.zeros((max(rec_cap, 1), PDW_NHY))
+    rec_step = np.zeros(max(rec_cap, 1), dtype=np.int_)
+    cdef double[::1] vt = rec_t
+    cdef double[:, ::1] vy = rec_y
+    cdef long[::1] vs = rec_step
+    cdef long done, k, n_rec = 0
+    with nogil:
+        done = pdw_hybrid_walk(&p[0], &y0[0], s0, n_steps, &o, res, &vt[0], &vy[0, 0],
+                               &vs[0], rec_cap)
+    out = []
+    for k in range(min(done + 1, n_steps)):
+        out.append(_result_dict(&res[k]))
+        n_rec += res[k].n_rec
+    return out, rec_t[:n_rec], rec_y[:n_rec], rec_step[:n_rec]

@@ -1,0 +1,190 @@
+/* The compiled time loops: discrete contact state, recording, stop conditions.
+ *
+ * A pdw_sim holds everything one simulation needs. The caller (pdw/core/_core.pyx) allocates
+ * every array; the loops allocate nothing. A loop advances until it finishes, fails, or
+ * fills its event buffer; in the last case the caller grows the buffer and calls again,
+ * and the loop resumes exactly where it stopped (all loop state lives in the struct). */
+#ifndef PDW_SIM_H
+#define PDW_SIM_H
+
+#include "pdw_model.h"
+
+/* Discrete state carried by every loop (MODEL.md sections 5 and 6). */
+typedef struct pdw_discrete {
+    int flags[2];       /* 1 = support, 0 = swing */
+    int armed[2];       /* swing foot has been above ground while ahead of the other foot */
+    double anchors[PDW_NANCHOR];  /* per foot, captured at touch-down (layout ANCHORS): the rolling
+                                   * coordinate s_i (consistent variant's xi), then the approach
+                                   * speed -v_y (Lankarani-Nikravesh and Flores damping) */
+} pdw_discrete;
+
+/* Why and where a loop failed. */
+typedef struct pdw_failure {
+    double t;           /* time of the last good state [s] */
+    double x[PDW_NX];   /* that state */
+    int leg;            /* leg involved (fell through the ground), or -1 */
+    int reason;         /* PDW_REASON_* */
+} pdw_failure;
+
+enum {
+    PDW_REASON_NONE = 0,
+    PDW_REASON_NONFINITE = 1,     /* a NaN or infinity in the new state */
+    PDW_REASON_SPEED = 2,         /* a velocity above max_speed */
+    PDW_REASON_HIP_LOW = 3,       /* hip below fall_hip_height */
+    PDW_REASON_FOOT_DEEP = 4,     /* a foot deeper than fall_depth below the ground */
+    PDW_REASON_SINGULAR = 5,      /* singular step matrix */
+    PDW_REASON_STEP_SIZE = 6      /* adaptive step size underflow (error test never passed) */
+};
+
+/* Online gait analysis (MODEL.md section 8): the per-step descriptors of pdw/sim/gait.py, computed
+ * as the events happen, in O(1) memory: the latest touch-down and lift-off of each leg, counts,
+ * and the last PDW_STEP_RING complete steps (layout PDW_STEP_*) in a ring buffer. */
+typedef struct pdw_gait {
+    double td_t[2], td_x[2];    /* each leg's latest touch-down: time [s], contact point x_D [m] */
+    double lo_t[2], lo_x[2];    /* each leg's latest lift-off */
+    int has_td[2], has_lo[2];
+    double prev_td_t;           /* the latest touch-down of either leg */
+    int has_prev_td;
+    int ds_leg;                 /* the latest step's double support ends at this leg's lift-off;
+                                 * -1: none awaited */
+    long n_steps;               /* complete steps so far (the rows pdw.steps would give) */
+    long n_touch_down, n_lift_off;
+    double ring[PDW_STEP_RING][PDW_NSTEP];   /* step k (from 0) is ring[k % PDW_STEP_RING] */
+} pdw_gait;
+
+/* A loop status beyond the generated PDW_STATUS_*: the record buffer is full. Like
+ * PDW_STATUS_EVENTS_FULL it never reaches Python's result: _core.run grows the record arrays
+ * and calls advance again, which resumes where it stopped. Only adaptive methods (whose
+ * number of samples is not known in advance) return it. */
+enum { PDW_STATUS_RECORDS_FULL = 64 };
+
+typedef struct pdw_sim {
+    /* --- model and settings (inputs) --- */
+    const pdw_kernel *kernel;
+    double p[PDW_NP];           /* parameters + derived constants (pdw_precompute) */
+    double dt;                  /* step [s] */
+    long n_steps;               /* number of steps to take */
+    long record_every;          /* record every k-th step; 0 = record nothing */
+    double fall_hip_height;     /* fell when y_o < this [m] */
+    double fall_depth;          /* fell when a foot is deeper than this [m] */
+    double max_speed;           /* diverged when |qd_i| > this [m/s, rad/s] */
+    double t_end;               /* end time [s] (adaptive methods; = n_steps*dt for fixed) */
+    double rtol, atol;          /* tolerances of adaptive methods */
+    double h_max;               /* largest step of adaptive methods [s] */
+    double event_tol;           /* adaptive methods: a flag switch is located to within this [s] */
+    int record_events;          /* 1: store every event in `events`; 0: only count them (the
+                                 * online gait analysis sees them either way) */
+    long stop_steps;            /* stop (PDW_STATUS_DONE, PDW_STOP_STEPS) at this many complete
+                                 * gait steps; 0: no limit */
+    int periodic_k;             /* stop (PDW_STATUS_PERIODIC) when the last periodic_k steps agree:
+                                 * each PDW_PERIODIC_FIELDS descriptor within periodic_tol (relative,
+                                 * max - min <= tol |latest|); 0: off. 2 <= k <= PDW_STEP_RING */
+    double periodic_tol;
+    /* --- outputs (caller-allocated) --- */
+    double *rec_t;              /* (rec_capacity,) */
+    double *rec_x;              /* (rec_capacity, PDW_NX) */
+    int *rec_flags;             /* (rec_capacity, 2) */
+    double *rec_contact;        /* (rec_capacity, PDW_NREC), may be NULL */
+    long rec_capacity, n_rec;
+    double *events;             /* (ev_capacity, PDW_NEVENT) */
+    long ev_capacity, n_events;
+    /* --- loop state --- */
+    long n;                     /* steps taken (accepted) */
+    double t;                   /* time of x [s] */
+    double h;                   /* next step size of adaptive methods [s] */
+    double x[PDW_NX];           /* state at step n: [U_n, U'_n] */
+    double u_prev[PDW_NQ];      /* U_{n-1} (central difference) */
+    int started;
+    pdw_discrete disc;
+    double work[PDW_NWORK];
+    double cache[PDW_NX];       /* method-private: f(x) (FSAL) or verlet's a_n, for exact resumption */
+    int cache_valid;            /* cache holds a value for the current x and discrete state */
+    double err_prev;            /* adaptive methods: previous accepted error (step controllers) */
+    double h_prev;              /* adaptive methods: previous accepted step (0: none yet) */
+    /* --- work counters (every method) --- */
+    long n_rhs, n_jac, n_rejected;
+    /* --- online gait analysis (every method; see pdw_update_flags) --- */
+    pdw_gait gait;
+    /* --- termination --- */
+    int status;                 /* PDW_STATUS_* */
+    int stop_reason;            /* PDW_STOP_*: which stop condition ended the run (NONE: t_end or a failure) */
+    pdw_failure failure;
+} pdw_sim;
+
+/* Initialise the discrete state for x0 and initial flags: anchors of support legs at x0. */
+void pdw_discrete_init(const pdw_kernel *k, const double *p, const double *x,
+                       const int flags0[2], pdw_discrete *d, double *work);
+
+/* Update flags and arming once from s->x (MODEL.md section 5); each flag change is an event:
+ * stored in s->events (if record_events), counted, and fed to the online gait analysis
+ * (s->gait), which checks the stop conditions (stop_steps, periodic_k) at each complete step.
+ * Leaves the trig and kinematics of s->x (with the new anchors) in s->work. Returns 0; -1 when
+ * the event buffer is full (nothing changed then; the caller returns PDW_STATUS_EVENTS_FULL);
+ * 1 when a stop condition was met (s->status and s->stop_reason are set: the caller stores the
+ * final sample with pdw_record_final and returns s->status). */
+int pdw_update_flags(pdw_sim *s, double t);
+
+/* Room for `n` more events (always, when events are not stored)? */
+static inline int pdw_events_room(const pdw_sim *s, long n)
+{
+    return !s->record_events || s->n_events + n <= s->ev_capacity;
+}
+
+/* Reset the online gait analysis (before the first step). */
+void pdw_gait_init(pdw_gait *g);
+
+/* After pdw_update_flags: fell if a foot is deeper than fall_depth (sets status, returns 1). */
+int pdw_check_feet(pdw_sim *s, double t);
+
+/* Check a new state (finite, speeds, hip height); on failure sets s->status and s->failure
+ * and returns nonzero. */
+int pdw_check_state(pdw_sim *s, const double *xnew, double t);
+
+/* A stop condition ended the run at s->x (time t) right after pdw_update_flags: store the
+ * sample if step n is a recording step (contact forces computed here). */
+void pdw_record_final(pdw_sim *s, double t);
+
+/* Store sample n (time t) if it is a recording step. */
+void pdw_record(pdw_sim *s, double t);
+
+/* Store a sample of s->x at time t now, whatever n (if there is room); the contact forces are
+ * taken from s->work's contact block, which the caller must have filled for s->x. */
+void pdw_record_now(pdw_sim *s, double t);
+
+/* Would pdw_update_flags change the discrete state (flag, arming) at state x? Returns a bit
+ * mask (bit i: leg i), 0 if nothing would change. Mirrors pdw_update_flags's rules exactly;
+ * adaptive methods use it to locate switches inside a step. work: PDW_NWORK scratch. */
+int pdw_switch_pending(const pdw_sim *s, const double *x, double *work);
+
+/* --- the integrators: one module each, all behind this contract ---------------------------
+ * advance(s): take steps from s->x (time s->t, step count s->n) until s->t reaches t_end (or
+ * n_steps for fixed-step methods), updating the discrete state once per step through
+ * pdw_update_flags, recording through pdw_record, checking each new state with
+ * pdw_check_state, counting work in n_rhs / n_jac / n_rejected. When pdw_update_flags reports
+ * a stop condition (returns 1) the method stores the final sample (fixed step: pdw_record_final;
+ * adaptive: always, as at t_end) and returns s->status at once.
+ * Returns s->status: PDW_STATUS_DONE, PDW_STATUS_PERIODIC, a failure, or
+ * PDW_STATUS_EVENTS_FULL (the caller grows s->events and calls again; the method resumes where
+ * it stopped). */
+typedef int (*pdw_advance_fn)(pdw_sim *s);
+
+typedef struct pdw_method {
+    const char *name;
+    int order;          /* order of accuracy of the state on smooth problems */
+    int adaptive;       /* 1: uses rtol/atol and t_end; 0: fixed step dt, n_steps */
+    pdw_advance_fn advance;
+} pdw_method;
+
+extern const pdw_method pdw_methods[];
+extern const int pdw_nmethods;
+
+/* The paper's central difference method (MODEL.md section 7). Returns s->status. */
+int pdw_cdm_advance(pdw_sim *s);
+
+/* Integrators beyond the paper's (docs/integrators.md); one module each. */
+int pdw_verlet_advance(pdw_sim *s);   /* pdw_verlet.c: velocity Verlet, order 2, fixed step */
+int pdw_rk4_advance(pdw_sim *s);      /* pdw_rk4.c: classical Runge-Kutta, order 4, fixed step */
+int pdw_dopri5_advance(pdw_sim *s);   /* pdw_dopri5.c: Dormand-Prince 5(4), adaptive */
+int pdw_rodas4_advance(pdw_sim *s);   /* pdw_rodas4.c: Rosenbrock RODAS4(3), adaptive, stiff */
+
+#endif /* PDW_SIM_H */

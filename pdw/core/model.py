@@ -1,0 +1,213 @@
+"""Evaluate the compiled model: right-hand side, Jacobian, mass matrix, contact forces, energies.
+
+Every function accepts one state, shape (8,), or a batch, shape (N, 8), laid out as
+`pdw.STATE` = [x_o, y_o, theta1, theta2, xd_o, yd_o, thetad1, thetad2] (paper Eq. 1;
+metres, radians, and their rates), and returns arrays of matching leading shape.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _core, _layout
+from .params import Params
+
+STATE = _layout.STATE
+VARIANTS = _layout.VARIANTS
+_KERNELS = {name: i for i, (name, _, _) in enumerate(_core.kernel_table())}
+_IX = {n: i for i, n in enumerate(STATE)}
+
+
+def kernel_index(variant: str = "paper", features=None, normal: str = "hunt_crossley") -> int:
+    """Index of the generated kernel for ``variant`` with the given force elements and normal
+    contact law (`pdw.core._layout.NORMAL_LAWS`).
+
+    ``features=None`` means every element (`pdw.core._layout.FEATURES`). A combination without
+    a specialized kernel falls back to the general one (of its normal law).
+    """
+    check_variant(variant)
+    if normal != "hunt_crossley":
+        if normal not in _layout.NORMAL_LAWS:
+            raise ValueError("normal law must be one of %s, got %r"
+                             % (", ".join(_layout.NORMAL_LAWS), normal))
+        return _KERNELS[variant + "_" + normal]
+    feats = _layout.FEATURES if features is None else tuple(features)
+    unknown = set(feats) - set(_layout.FEATURES)
+    if unknown:
+        raise ValueError("unknown feature(s) %s; allowed: %s"
+                         % (", ".join(sorted(unknown)), ", ".join(_layout.FEATURES)))
+    name = variant + "".join("_no_" + f for f in _layout.FEATURES if f not in feats)
+    return _KERNELS.get(name, _KERNELS[variant])
+
+
+def check_variant(variant):
+    if variant not in VARIANTS:
+        raise ValueError("variant must be one of %s, got %r" % (", ".join(map(repr, VARIANTS)), variant))
+
+
+def parameter_vector(params: Params | None) -> np.ndarray:
+    """Kernel parameter vector: `Params.as_array` plus derived constants, shape (NP,)."""
+    params = Params.paper() if params is None else params
+    if not isinstance(params, Params):
+        raise TypeError("params must be a pdw.Params, got %s" % type(params).__name__)
+    p = np.zeros(_core.NP)
+    _core.precompute(params.as_array(), p)
+    return p
+
+
+def _states(x, name="x", width=_core.NX):
+    arr = np.array(x, dtype=float, order="C", copy=True)
+    single = arr.ndim == 1
+    arr = np.atleast_2d(arr)
+    if arr.ndim != 2 or arr.shape[1] != width:
+        raise ValueError("%s must have shape (%d,) or (N, %d), got %s" % (name, width, width, np.shape(x)))
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        row, col = np.argwhere(bad)[0]
+        field = STATE[col] if width == _core.NX else _layout.STATE[col]
+        raise ValueError("%s[%s] is not finite (%r)" % (name, field, arr[row, col]))
+    return np.ascontiguousarray(arr), single
+
+
+def _discrete(flags, anchors, n):
+    f = np.broadcast_to(np.asarray(flags, dtype=np.intc), (n, 2)).copy()
+    if not np.isin(f, (0, 1)).all():
+        raise ValueError("flags must be 0 (swing) or 1 (support), got %r" % (flags,))
+    a = np.broadcast_to(np.asarray(anchors, dtype=float), (n, 2)).copy()
+    if not np.isfinite(a).all():
+        raise ValueError("anchors must be finite, got %r" % (anchors,))
+    return np.ascontiguousarray(f), np.ascontiguousarray(a)
+
+
+def _folded(params, features):
+    """Parameters with absent force elements zeroed: a specialized kernel, or the general
+    kernel's fallback, then computes exactly the requested forces."""
+    params = Params.paper() if params is None else params
+    return params if features is None else params.without(features)
+
+
+def _evaluate(x, params, flags, anchors, variant, features=None):
+    X, single = _states(x)
+    k = kernel_index(variant, features)
+    f, a = _discrete(flags, anchors, len(X))
+    p = parameter_vector(_folded(params, features))
+    xdot = np.empty_like(X)
+    work = np.empty((len(X), _core.NWORK))
+    _core.rhs_batch(k, X, p, f, a, xdot, work)
+    return X, single, k, p, f, a, xdot, work
+
+
+def rhs(x, params=None, flags=(0, 1), anchors=(0.0, 0.0), variant="paper", features=None):
+    """Right-hand side f(x) = [qd; M^-1 (Q_f - C qd - G)] of Eq. A.4.
+
+    Parameters
+    ----------
+    x : array_like, shape (8,) or (N, 8)
+        State [q, qd].
+    params : Params, optional
+        Default `Params.paper()`.
+    flags : (int, int)
+        Support flags of legs 1 and 2 (1 support, 0 swing; MODEL.md section 5).
+    anchors : (float, float)
+        Rolling coordinate s_i at the last touch-down of each foot [m]; only the
+        ``consistent`` variant's tangential deformation uses them.
+    variant : {"paper", "consistent"}
+        MODEL.md section 6.
+
+    Returns
+    -------
+    ndarray, shape (8,) or (N, 8)
+    """
+    X, single, *_, xdot, _ = _evaluate(x, params, flags, anchors, variant, features)
+    return xdot[0] if single else xdot
+
+
+def jacobian(x, params=None, flags=(0, 1), anchors=(0.0, 0.0), variant="paper", features=None):
+    """Jacobian df/dx of `rhs`, from the symbolic derivation; shape (8, 8) or (N, 8, 8).
+
+    At the switching surfaces of the force laws (clamp, friction branches, Eq. 11's gate)
+    it is the derivative of the branch that is active at x.
+    """
+    X, single = _states(x)
+    k = kernel_index(variant, features)
+    f, a = _discrete(flags, anchors, len(X))
+    J = np.empty((len(X), _core.NX * _core.NX))
+    work = np.empty((len(X), _core.NWORK))
+    _core.jacobian_batch(k, X, parameter_vector(_folded(params, features)), f, a, J, work)
+    J = J.reshape(len(X), _core.NX, _core.NX)
+    return J[0] if single else J
+
+
+def mass_matrix(q, params=None):
+    """Mass matrix M(q) of Eq. 2 (MODEL.md section 3), shape (4, 4) or (N, 4, 4).
+
+    ``q`` may be a configuration (4,) / (N, 4) or a full state (8,) / (N, 8).
+    """
+    Q = np.asarray(q, dtype=float)
+    if Q.shape[-1] == _core.NQ:
+        Q = np.concatenate([Q, np.zeros_like(Q)], axis=-1)
+    *_, work = _evaluate(Q, params, (0, 0), (0.0, 0.0), "paper")
+    M = work[:, _layout.WORK["M"][0]:_layout.WORK["M"][0] + 16].reshape(-1, 4, 4)
+    return M[0] if np.ndim(q) == 1 else M
+
+
+@dataclass(frozen=True)
+class ContactState:
+    """Contact kinematics and forces of both feet; each field has shape (..., 2) (foot 1, foot 2).
+
+    x_D, y_D : contact point along / normal to the slope [m] (Eq. 4); depth = -y_D.
+    v_x : slip velocity of the foot's material point [m/s] (Eq. 9).
+    v_y : normal rate of the variant [m/s] (Eq. 5).
+    s : rolling coordinate [m]; xi : tangential deformation of the variant [m].
+    F_n, F_t : normal (+Y) and tangential (+X) contact forces [N]; mu : friction coefficient.
+    """
+
+    x_D: np.ndarray
+    y_D: np.ndarray
+    v_x: np.ndarray
+    v_y: np.ndarray
+    s: np.ndarray
+    xi: np.ndarray
+    F_n: np.ndarray
+    F_t: np.ndarray
+    mu: np.ndarray
+
+
+def contact_forces(x, params=None, flags=(0, 1), anchors=(0.0, 0.0), variant="paper",
+                   features=None) -> ContactState:
+    """Contact kinematics (Eqs. 4-9) and forces (Eqs. 3, 6, 7, 10, 11) of both feet.
+
+    Forces act only on a support foot (flag 1) that penetrates (y_D < 0); otherwise 0.
+    """
+    X, single, *_, work = _evaluate(x, params, flags, anchors, variant, features)
+    k0, nk = _layout.WORK["kin"]
+    c0, nc = _layout.WORK["contact"]
+    kin = work[:, k0:k0 + nk].reshape(-1, 2, len(_layout.KIN))
+    con = work[:, c0:c0 + nc].reshape(-1, 2, len(_layout.CONTACT))
+    out = {}
+    for i, name in enumerate(_layout.KIN):
+        out[name] = kin[:, :, i]
+    for name in ("F_n", "F_t", "mu"):
+        out[name] = con[:, :, _layout.CONTACT.index(name)]
+    if single:
+        out = {k: v[0] for k, v in out.items()}
+    return ContactState(**{k: out[k] for k in ContactState.__dataclass_fields__})
+
+
+def energies(x, params=None) -> dict:
+    """Kinetic energy T, gravitational potential V_gravity, hip-spring energy V_hip and their
+    sum E [J] (MODEL.md section 3; V_gravity is zero at the slope-frame origin)."""
+    X, single = _states(x)
+    e = np.empty((len(X), len(_layout.ENERGY)))
+    _core.energies_batch(kernel_index("paper"), X, parameter_vector(params), e)
+    out = {name: e[:, i] for i, name in enumerate(_layout.ENERGY)}
+    out["E"] = e.sum(axis=1)
+    return {k: (v[0] if single else v) for k, v in out.items()}
+
+
+def state_index(name: str) -> int:
+    """Index of a state component by name (see `STATE`)."""
+    if name not in _IX:
+        raise KeyError("unknown state component %r; allowed: %s" % (name, ", ".join(STATE)))
+    return _IX[name]

@@ -1,0 +1,152 @@
+"""Gait descriptors per step (MODEL.md section 8, paper Sec. 4.1) from a simulation's events.
+
+A *step* ends at a touch-down of the swing leg j (time t_td, contact point x_td):
+
+- step length L: x_td minus the other foot's contact point at that foot's own previous
+  touch-down (footprint spacing; the paper's L of about 0.40 m);
+- travel: x_td minus leg j's contact point at its previous lift-off (the swing foot's own
+  travel, about 0.6 m);
+- period P: t_td minus leg j's previous lift-off (the swing time);
+- velocity v = L / P;
+- cycle: t_td minus the previous touch-down (of the other leg);
+- double support: from t_td to the other leg's next lift-off (both flags 1), and its
+  fraction of the step's cycle; NaN when the run ends before that lift-off, or when
+  the other leg does not lift off before the next touch-down.
+
+The compiled loops compute the same descriptors online, as the events happen (pdw/core/csrc/
+pdw_discrete.c, layout `pdw.core._layout.STEP`), keeping the last `pdw.core._layout.STEP_RING` steps:
+`Result.gait`. `steps` recomputes every step from a run's events; for a run that did not keep
+its events (``record_events=False``) it returns `Result.gait`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core import _layout
+
+FIELDS = _layout.STEP
+UNITS = {"leg": "", "t_lift_off": "s", "t_touch_down": "s", "L": "m", "travel": "m", "P": "s",
+         "v": "m/s", "cycle": "s", "double_support": "s", "ds_fraction": ""}
+
+
+@dataclass
+class Steps:
+    """Per-step gait descriptors; ``table[name]`` is an array with one entry per step."""
+
+    table: dict
+
+    def __len__(self):
+        return len(self.table["leg"])
+
+    def __getitem__(self, name):
+        return self.table[name]
+
+    def steady(self, last: int = 4) -> dict:
+        """Mean of the last ``last`` complete steps, and how much successive steps still
+        differ there (``spread_<name>``: largest |difference| between consecutive steps)."""
+        out = {"n_steps": len(self), "last": min(last, len(self))}
+        for name in ("L", "travel", "P", "v", "cycle", "double_support", "ds_fraction"):
+            a = self.table[name]
+            a = a[np.isfinite(a)][-last:]
+            out[name] = float(np.mean(a)) if len(a) else float("nan")
+            out["spread_" + name] = float(np.max(np.abs(np.diff(a)))) if len(a) > 1 else float("nan")
+        return out
+
+    def describe_step(self, k: int = -1) -> str:
+        """One step in words: ``"leg 2, L 0.3685 m, P 0.5644 s, v 0.653 m/s, double support
+        16.5 ms (2.84 %)"`` (the last complete step by default)."""
+        t = self.table
+        return ("leg %d, L %.4f m, P %.4f s, v %.4f m/s, double support %.1f ms (%.2f %%)"
+                % (t["leg"][k], t["L"][k], t["P"][k], t["v"][k], 1e3 * t["double_support"][k],
+                   100 * t["ds_fraction"][k]))
+
+    def __repr__(self):
+        if not len(self):
+            return "<pdw.Steps: no complete step>"
+        t = self.table
+        return ("<pdw.Steps: %d steps, touch-downs %.4f .. %.4f s\n  last: %s>"
+                % (len(self), t["t_touch_down"][0], t["t_touch_down"][-1], self.describe_step()))
+
+    def to_text(self) -> str:
+        """The table as aligned text (times in s, lengths in m, double support in ms)."""
+        head = "%4s %3s %9s %9s %8s %8s %7s %7s %7s %8s %7s" % (
+            "step", "leg", "lift-off", "touch", "L [m]", "travel", "P [s]", "v [m/s]",
+            "cycle", "DS [ms]", "DS [%]")
+        rows = [head]
+        t = self.table
+        for k in range(len(self)):
+            rows.append("%4d %3d %9.4f %9.4f %8.4f %8.4f %7.4f %7.4f %7.4f %8.1f %7.2f" % (
+                k + 1, t["leg"][k], t["t_lift_off"][k], t["t_touch_down"][k], t["L"][k],
+                t["travel"][k], t["P"][k], t["v"][k], t["cycle"][k],
+                1e3 * t["double_support"][k], 100 * t["ds_fraction"][k]))
+        return "\n".join(rows)
+
+
+def steps_from_rows(rows, capacity: int = _layout.STEP_RING) -> Steps:
+    """Steps from rows of the compiled online analysis (layout `pdw.core._layout.STEP`, legs 0/1).
+
+    The columns are views of arrays of ``capacity`` (at least len(rows)) entries, so that the
+    memory of a result does not depend on how many steps its ring holds."""
+    rows = np.asarray(rows, dtype=float).reshape(-1, len(FIELDS))
+    n = len(rows)
+    cols = np.full((len(FIELDS), max(capacity, n)), np.nan)
+    cols[:, :n] = rows.T
+    legs = np.zeros(cols.shape[1], dtype=int)
+    legs[:n] = cols[FIELDS.index("leg"), :n]
+    legs[:n] += 1
+    table = {f: (legs[:n] if f == "leg" else cols[i, :n]) for i, f in enumerate(FIELDS)}
+    return Steps(table)
+
+
+def steps(result_or_events) -> Steps:
+    """Gait descriptors of every complete step of a run.
+
+    Parameters
+    ----------
+    result_or_events : Result or sequence of Event
+        A `pdw.simulate` result, or its ``events`` (time-ordered touch-downs and lift-offs,
+        legs numbered 1 and 2). For a result that did not keep its events
+        (``record_events=False``): its online descriptors, `Result.gait` (the last
+        `pdw.core._layout.STEP_RING` steps).
+
+    Returns
+    -------
+    Steps
+        Steps whose swing leg has a known lift-off and whose other foot has a known
+        touch-down (the first, partial step of a run is skipped).
+    """
+    if getattr(result_or_events, "events_recorded", True) is False:
+        return result_or_events.gait
+    events = getattr(result_or_events, "events", result_or_events)
+    events = sorted(events, key=lambda e: e.t)
+    last_td = {1: None, 2: None}     # (t, x_D) of each leg's latest touch-down
+    last_lo = {1: None, 2: None}     # (t, x_D) of each leg's latest lift-off
+    prev_td_t = None
+    rows = []
+    for k, e in enumerate(events):
+        if e.kind == "lift_off":
+            last_lo[e.leg] = (e.t, e.x_D)
+            continue
+        j, i = e.leg, 3 - e.leg
+        if last_lo[j] is not None and last_td[i] is not None and prev_td_t is not None:
+            L = e.x_D - last_td[i][1]
+            P = e.t - last_lo[j][0]
+            ds, nxt_td = float("nan"), None
+            for f in events[k + 1:]:
+                if f.kind == "lift_off" and f.leg == i and np.isnan(ds):
+                    ds = f.t - e.t
+                if f.kind == "touch_down":
+                    nxt_td = f.t
+                    break
+            if nxt_td is not None and not np.isnan(ds) and ds > nxt_td - e.t:
+                ds = float("nan")
+            rows.append(dict(leg=j, t_lift_off=last_lo[j][0], t_touch_down=e.t, L=L,
+                             travel=e.x_D - last_lo[j][1], P=P, v=L / P if P > 0 else float("nan"),
+                             cycle=e.t - prev_td_t, double_support=ds,
+                             ds_fraction=ds / (e.t - prev_td_t)))
+        last_td[j] = (e.t, e.x_D)
+        prev_td_t = e.t
+    table = {f: np.array([r[f] for r in rows], dtype=int if f == "leg" else float) for f in FIELDS}
+    return Steps(table)

@@ -1,0 +1,409 @@
+"""`simulate`: one walker, one initial state, one compiled time loop.
+
+The loop (C, GIL released) carries the support flags, the arming of the scuffing
+guard and the tangential anchors as discrete state, updated once per step (paper
+Fig. 3, MODEL.md sections 5-7). Python is entered once per simulation.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import NamedTuple
+
+import numpy as np
+
+from ..core import _core, _layout
+from ..core import contact as _contact
+from ..core.errors import DivergedError, InvalidInputError, SingularSystemError
+from ..core.integrators import METHODS
+from ..core.model import STATE, check_variant, kernel_index, parameter_vector
+from ..core.params import X0_PAPER, Params
+from . import stepsize as _stepsize
+from .gait import Steps, steps_from_rows
+
+_STATUS = {i: s for i, s in enumerate(_layout.STATUS)}
+_REASONS = {
+    0: "none",
+    1: "a non-finite value (NaN or infinity) appeared in the state",
+    2: "a velocity exceeded max_speed (runaway state)",
+    3: "the hip dropped below fall_hip_height",
+    4: "a foot sank deeper than fall_depth below the ground",
+    5: "the step's linear system was singular",
+    6: "the adaptive step size underflowed (the error test never passed)",
+}
+
+
+class Event(NamedTuple):
+    """A support-flag change (MODEL.md section 5) at time t [s] of leg 1 or 2."""
+
+    t: float
+    leg: int          # 1 or 2 (the paper's numbering)
+    kind: str         # "touch_down" or "lift_off"
+    x_D: float        # contact point along the slope [m]
+    y_D: float        # contact point height [m]
+
+
+@dataclass
+class Result:
+    """Outcome of `simulate`.
+
+    Attributes
+    ----------
+    t : ndarray (N,)
+        Recorded times [s] (every ``record_every``-th step).
+    x : ndarray (N, 8)
+        Recorded states, layout `pdw.STATE`.
+    flags : ndarray (N, 2)
+        Support flags of legs 1, 2 at those times.
+    Fn, Ft : ndarray (N, 2)
+        Normal and tangential contact forces of feet 1, 2 [N] (empty if not recorded).
+    events : list of Event
+        Every touch-down and lift-off (empty when ``record_events=False``; `event_counts`
+        counts them either way).
+    status : str
+        ``"walked"`` (reached t_end, or the requested number of gait steps), ``"periodic"``
+        (stopped because the last steps agreed), ``"fell"`` (see `failure`) or ``"diverged"``.
+    failure : dict or None
+        For a fall or divergence: ``t`` and ``x`` of the last good state, ``reason`` and ``leg``.
+    params : Params
+        The parameters simulated: with the parameters of absent force elements zeroed
+        (`Params.without`) when ``features`` was given.
+    gait : Steps
+        The gait descriptors computed online in the compiled loop (MODEL.md section 8, the
+        definitions of `pdw.steps`): the last ``min(n_gait_steps, pdw.core._layout.STEP_RING)``
+        complete steps. A run stopped by a stop condition ends at a touch-down, so its last
+        step's double support is NaN (not known yet).
+    n_gait_steps : int
+        Complete gait steps of the whole run.
+    event_counts : dict
+        ``{"touch_down": n, "lift_off": n}`` over the whole run.
+    stop_reason : str
+        ``"t_end"``, ``"steps"`` (stop_steps reached), ``"periodic"``, or the failure status.
+    energies : dict or None
+        With ``record_energies``: T, V_gravity, V_hip and E [J] at the recorded samples.
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    flags: np.ndarray
+    Fn: np.ndarray
+    Ft: np.ndarray
+    events: list
+    status: str
+    failure: dict | None
+    x_final: np.ndarray
+    t_final: float
+    params: Params
+    variant: str
+    method: str
+    dt: float
+    t_end: float
+    n_steps: int
+    wall_time: float
+    stats: dict = field(default_factory=dict)
+    gait: Steps | None = None
+    n_gait_steps: int = 0
+    event_counts: dict = field(default_factory=dict)
+    events_recorded: bool = True
+    stop_reason: str = "t_end"
+    energies: dict | None = None
+    features: tuple = _layout.FEATURES
+    scene: object = None
+    contact: object = None      # the pdw.Contact simulated (laws and parameters)
+
+    @property
+    def walked(self) -> bool:
+        """Did the walker keep walking to the end of the run (t_end or a stop condition)?"""
+        return self.status in ("walked", "periodic")
+
+    def state(self, name: str) -> np.ndarray:
+        """Recorded time series of one state component by name, e.g. ``"thetad1"``."""
+        return self.x[:, STATE.index(name)]
+
+    def __repr__(self):
+        counts = self.event_counts or {}
+        lines = ["<pdw.Result %s: %s variant, %s, t = 0 .. %.6g s of %.6g s, %d steps, %.3g s wall"
+                 % (self.status, self.variant, self.method if self.method in ("dopri5", "rodas4")
+                    else "%s dt = %.3g s" % (self.method, self.dt), self.t_final, self.t_end,
+                    self.n_steps, self.wall_time),
+                 "  events: %d touch-downs, %d lift-offs; %d gait steps; stopped by %s"
+                 % (counts.get("touch_down", 0), counts.get("lift_off", 0), self.n_gait_steps,
+                    self.stop_reason),
+                 "  recorded: %d samples%s%s" % (len(self.t), " + forces" if np.size(self.Fn) else "",
+                                                  " + energies" if self.energies else "")]
+        if self.gait is not None and len(self.gait):
+            lines.append("  last step: " + self.gait.describe_step())
+        if self.failure:
+            lines.append("  failure: %s at t = %.6g s" % (self.failure["reason"], self.failure["t"]))
+        return "\n".join(lines) + ">"
+
+    def summary(self) -> str:
+        n_ev = sum(self.event_counts.values()) if self.event_counts else len(self.events)
+        s = "%s: %s, %d steps of %.3g s to t = %.4f s, %d events, %d gait steps" % (
+            self.method, self.status, self.n_steps, self.dt, self.t_final, n_ev, self.n_gait_steps)
+        if self.stop_reason in ("steps", "periodic"):
+            s += " (stopped: %s)" % self.stop_reason
+        if self.failure:
+            s += "; %s at t = %.4f s" % (self.failure["reason"], self.failure["t"])
+        return s
+
+
+def _check_positive(name, value):
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InvalidInputError("%s must be a number, got %r" % (name, value)) from None
+    if not math.isfinite(v) or v <= 0:
+        raise InvalidInputError("%s must be finite and > 0, got %r" % (name, value))
+    return v
+
+
+def check_state(x0, name="x0"):
+    x = np.array(x0, dtype=float).ravel() if np.ndim(x0) else None
+    if x is None or x.shape != (_core.NX,):
+        raise InvalidInputError("%s must have 8 components %s, got shape %s"
+                                % (name, STATE, np.shape(x0)))
+    for i, v in enumerate(x):
+        if not math.isfinite(v):
+            raise InvalidInputError("%s[%d] (%s) must be finite, got %r" % (name, i, STATE[i], v))
+    return x
+
+
+_DEFAULTS = dict(t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm", flags0=(0, 1),
+                 record_every=1, record_forces=True, on_failure="raise", fall_hip_height=None,
+                 fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8, h_max=None, event_tol=1e-9,
+                 features=None, record_events=True, record_energies=False, stop_steps=0,
+                 periodic_steps=0, periodic_tol=1e-3, check_step="warn", contact=None)
+
+
+def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
+             flags0=(0, 1), record_every=1, record_forces=True, on_failure="raise",
+             fall_hip_height=None, fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8,
+             h_max=None, event_tol=1e-9, *, features=None, record_events=True,
+             record_energies=False, stop_steps=0, periodic_steps=0, periodic_tol=1e-3,
+             check_step="warn", contact=None):
+    """Simulate the walker from ``x0`` for ``t_end`` seconds (or run a `pdw.Scene`).
+
+    ``simulate(scene)`` runs the scene (as `pdw.run`); no other argument may be given then.
+
+    Parameters
+    ----------
+    x0 : array_like (8,) or Scene
+        Initial state [x_o, y_o, theta1, theta2, xd_o, yd_o, thetad1, thetad2] (m, rad, m/s,
+        rad/s). Default: the paper's typical gait (`X0_PAPER`).
+    t_end : float
+        Duration [s].
+    dt : float
+        Step [s] (the paper: 1e-4).
+    params : Params, optional
+        Default `Params.paper()`.
+    variant : {"paper", "consistent"}
+        Contact reading of MODEL.md section 6.
+    method : str
+        Integrator (`pdw.core.integrators.INTEGRATORS`, docs/integrators.md): ``"cdm"`` is the
+        paper's central difference method (MODEL.md section 7); ``"verlet"``, ``"rk4"`` are
+        fixed-step, ``"dopri5"`` and ``"rodas4"`` (stiff, recommended) adaptive.
+    flags0 : (int, int)
+        Initial support flags of legs 1, 2 (the paper's start: leg 1 swing, leg 2 support).
+    record_every : int
+        Record every k-th step (0: record nothing but events and the final state).
+    record_forces : bool
+        Also record the contact forces Fn, Ft.
+    on_failure : {"raise", "return"}
+        A diverged run raises `pdw.DivergedError` (with the partial result attached), or
+        returns a Result with status ``"diverged"``. A fall is a status, never an error.
+    fall_hip_height : float, optional
+        The walker fell when the hip is lower than this above the slope [m]; default 0.5 l.
+    fall_depth : float, optional
+        ... or when a foot is deeper than this below the ground [m]; default 0.25 l.
+    max_speed : float
+        Diverged when any velocity component exceeds this [m/s or rad/s].
+    rtol, atol : float
+        Relative and absolute error tolerances of adaptive methods (ignored by fixed-step
+        ones); for adaptive methods ``dt`` is the first trial step.
+    h_max : float, optional
+        Largest step of adaptive methods [s] (default: no limit).
+    event_tol : float
+        Adaptive methods locate each flag switch (touch-down, lift-off, arming) to within this
+        time [s] and end a step there (docs/integrators.md); fixed-step methods switch at step
+        boundaries.
+    features : iterable of str, optional
+        Force elements present (`pdw.core._layout.FEATURES`; default all). The absent ones are
+        switched off: a specialized generated kernel if there is one, else the general kernel
+        with their parameters zeroed (`Params.without`).
+    record_events : bool
+        Keep the list of events (False: only their counts and the online gait analysis, O(1)
+        memory however long the run).
+    record_energies : bool
+        Also return the energies at the recorded samples (needs ``record_every > 0``).
+    stop_steps : int
+        Stop after this many complete gait steps (0: no limit); status ``"walked"``,
+        ``stop_reason`` ``"steps"``.
+    periodic_steps, periodic_tol : int, float
+        With ``periodic_steps = k >= 2``: stop (status ``"periodic"``) as soon as the last k
+        steps agree, each of L, travel, P and cycle within ``periodic_tol`` relative
+        (max - min <= tol |latest|). 0: off.
+    check_step : {"warn", "error", "off"}
+        Fixed-step methods: compare dt with `pdw.sim.stepsize.step_limit` (the method's estimated
+        stability limit for these parameters) and warn (`pdw.StepSizeWarning`) or refuse
+        (`pdw.StepSizeError`) above it, naming the limit and the force that sets it. The
+        limit is calibrated on the default contact law only: runs with another normal law
+        are not checked.
+    contact : pdw.Contact, dict or str, optional
+        Normal and friction contact laws and their parameters (`pdw.Contact`,
+        docs/contact_laws.md); default the paper's Hunt-Crossley and smooth Coulomb laws.
+
+    Returns
+    -------
+    Result
+    """
+    scene_kwargs = getattr(x0, "simulate_kwargs", None)
+    if callable(scene_kwargs):                      # a pdw.Scene (duck-typed: scene.py is above)
+        given = sorted(k for k, v in locals().items()
+                       if k in _DEFAULTS and not _same(v, _DEFAULTS[k]))
+        if given:
+            raise InvalidInputError("simulate(scene) takes no other arguments (got %s): set them "
+                                    "in the scene" % ", ".join(given))
+        res = simulate(**scene_kwargs())
+        res.scene = x0
+        return res
+    params = Params.paper() if params is None else params
+    if not isinstance(params, Params):
+        raise InvalidInputError("params must be a pdw.Params, got %s" % type(params).__name__)
+    x = check_state(x0)
+    t_end = _check_positive("t_end", t_end)
+    dt = _check_positive("dt", dt)
+    if dt > t_end:
+        raise InvalidInputError("dt = %g must not exceed t_end = %g" % (dt, t_end))
+    try:
+        check_variant(variant)
+    except ValueError as e:
+        raise InvalidInputError(str(e)) from None
+    if method not in METHODS:
+        raise InvalidInputError("method must be one of %s, got %r" % (", ".join(METHODS), method))
+    if on_failure not in ("raise", "return"):
+        raise InvalidInputError("on_failure must be 'raise' or 'return', got %r" % (on_failure,))
+    f0 = tuple(int(f) for f in flags0)
+    if len(f0) != 2 or any(f not in (0, 1) for f in f0):
+        raise InvalidInputError("flags0 must be two values in {0, 1}, got %r" % (flags0,))
+    if int(record_every) != record_every or record_every < 0:
+        raise InvalidInputError("record_every must be an integer >= 0, got %r" % (record_every,))
+    n_steps = int(round(t_end / dt))
+    if n_steps > 2**40:
+        raise InvalidInputError("t_end/dt = %g steps is too many" % (t_end / dt))
+    hip = 0.5 * params.l if fall_hip_height is None else float(fall_hip_height)
+    depth = 0.25 * params.l if fall_depth is None else _check_positive("fall_depth", fall_depth)
+    max_speed = _check_positive("max_speed", max_speed)
+    rtol = _check_positive("rtol", rtol)
+    atol = _check_positive("atol", atol)
+    h_max = 0.0 if h_max is None else _check_positive("h_max", h_max)
+    event_tol = _check_positive("event_tol", event_tol)
+    feats = _check_features(features)
+    if record_energies and not record_every:
+        raise InvalidInputError("record_energies needs recorded states (record_every > 0)")
+    stop_steps = _check_count("stop_steps", stop_steps)
+    periodic_steps = _check_count("periodic_steps", periodic_steps)
+    if periodic_steps == 1 or periodic_steps > _layout.STEP_RING:
+        raise InvalidInputError("periodic_steps must be 0 (off) or in [2, %d], got %d"
+                                % (_layout.STEP_RING, periodic_steps))
+    periodic_tol = _check_positive("periodic_tol", periodic_tol)
+
+    contact = _contact.Contact.coerce(contact)
+    params = contact.parameters(params)
+    k = kernel_index(variant, feats, contact.normal)
+    if feats != _layout.FEATURES:
+        params = params.without(feats)
+    if contact.normal == "hunt_crossley":
+        _stepsize.check_step(dt, params, method, variant, check_step)
+    p = contact.vector(parameter_vector(params), feats)
+    start = time.perf_counter()
+    raw = _core.run(k, METHODS.index(method), x, p, f0[0], f0[1], dt, n_steps, int(record_every),
+                    bool(record_forces), hip, depth, max_speed, rtol, atol, h_max,
+                    event_tol=event_tol, record_events=bool(record_events), stop_steps=stop_steps,
+                    periodic_k=periodic_steps, periodic_tol=periodic_tol, t_end=t_end)
+    wall = time.perf_counter() - start
+    energies = None
+    if record_energies:
+        e = np.empty((len(raw["x"]), len(_layout.ENERGY)))
+        if len(e):
+            _core.energies_batch(k, np.ascontiguousarray(raw["x"]), p, e)
+        energies = {name: e[:, i] for i, name in enumerate(_layout.ENERGY)}
+        energies["E"] = e.sum(axis=1)
+    res = _result(raw, params, variant, method, dt, t_end, wall, on_failure, feats,
+                  bool(record_events), energies)
+    res.contact = contact
+    return res
+
+
+def _same(a, b):
+    """Is an argument its default? (for simulate(scene))"""
+    if a is None or b is None:
+        return a is b
+    try:
+        return bool(np.array_equal(np.asarray(a, dtype=object), np.asarray(b, dtype=object)))
+    except (TypeError, ValueError):
+        return False
+
+
+def _check_count(name, value):
+    try:
+        ok = not isinstance(value, bool) and int(value) == value and value >= 0
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise InvalidInputError("%s must be an integer >= 0, got %r" % (name, value))
+    return int(value)
+
+
+def _check_features(features):
+    if features is None:
+        return _layout.FEATURES
+    if isinstance(features, str):
+        raise InvalidInputError("features must be a collection of names, got the string %r"
+                                % features)
+    feats = set(features)
+    unknown = feats - set(_layout.FEATURES)
+    if unknown:
+        raise InvalidInputError("unknown feature(s) %s; allowed: %s"
+                                % (", ".join(sorted(map(str, unknown))), ", ".join(_layout.FEATURES)))
+    return tuple(f for f in _layout.FEATURES if f in feats)
+
+
+def _result(raw, params, variant, method, dt, t_end, wall, on_failure,
+            features=_layout.FEATURES, events_recorded=True, energies=None):
+    status = _STATUS[raw["status"]]
+    rc = raw["contact"]
+    ic = {n: i for i, n in enumerate(_layout.RECORD_CONTACT)}
+    if rc is not None:
+        Fn = rc[:, [ic["F_n1"], ic["F_n2"]]]
+        Ft = rc[:, [ic["F_t1"], ic["F_t2"]]]
+    else:
+        Fn = Ft = np.zeros((0, 2))
+    ie = {n: i for i, n in enumerate(_layout.EVENT)}
+    events = [Event(float(e[ie["t"]]), int(e[ie["leg"]]) + 1, _layout.EVENT_KIND[int(e[ie["kind"]])],
+                    float(e[ie["x_D"]]), float(e[ie["y_D"]])) for e in raw["events"]]
+    failure = None
+    if status in ("fell", "diverged", "singular"):
+        f = raw["failure"]
+        failure = {"t": f["t"], "x": f["x"], "reason": _REASONS[f["reason"]],
+                   "leg": None if f["leg"] < 0 else f["leg"] + 1}
+    public = {"done": "walked", "singular": "diverged"}.get(status, status)
+    stop = _layout.STOP[raw["stop_reason"]]
+    res = Result(t=raw["t"], x=raw["x"], flags=raw["flags"], Fn=Fn, Ft=Ft, events=events,
+                 status=public,
+                 failure=failure, x_final=raw["x_final"], t_final=raw["t_final"], stats=raw["stats"],
+                 params=params, variant=variant, method=method, dt=dt, t_end=t_end,
+                 n_steps=raw["n_steps"], wall_time=wall, gait=steps_from_rows(raw["gait"]),
+                 n_gait_steps=int(raw["n_gait_steps"]), event_counts=dict(raw["event_counts"]),
+                 events_recorded=events_recorded,
+                 stop_reason=stop if stop != "none" else ("t_end" if public == "walked" else public),
+                 energies=energies, features=tuple(features))
+    if res.status == "diverged" and on_failure == "raise":
+        cls = SingularSystemError if status == "singular" else DivergedError
+        raise cls("simulation diverged at t = %.6g s (step %d, dt = %g, method %s): %s; "
+                  "last good state %s. Try a smaller dt or a stiff method."
+                  % (failure["t"], raw["n_steps"], dt, method, failure["reason"],
+                     np.array2string(failure["x"], precision=5)),
+                  t=failure["t"], x=failure["x"], reason=failure["reason"], result=res)
+    return res

@@ -1,0 +1,477 @@
+"""Numerical stability of the time loops: where the step size stops being safe, and why.
+
+The explicit methods (cdm, verlet, rk4, dopri5) are stable only for steps below a limit set by
+the stiffest forces of the model (docs/stability.md has the measured maps). This module holds
+
+* the **linear stability of one step** of each method applied to the linearized model
+  x' = J x (`step_matrix`, `linear_limit`): the largest h for which the one-step map does not
+  grow faster than the exact solution;
+* the **step-size check** of `pdw.simulate` (`step_limit`, `check_step`): the smallest linear
+  limit at four representative states of the typical gait (`stance_states`: three in single
+  stance, one at the landing) for the given parameters, *without* the friction law's slope
+  (friction saturates, so its instability is a bounded chatter, not a divergence; see below),
+  times a per-variant, per-method factor calibrated on the stability maps (`CALIBRATION`);
+* the **criteria of the stability maps** (`typical_start`, `reference`, `judge`,
+  `largest_step`, `chatter`), and the **energy balance** of a run (`energy_balance`).
+
+Chatter. With the foot stuck, the friction law's slope dmu/dv ~ 0.75/v_s gives a real
+eigenvalue of about -F_n |dmu/dv| / m_eff ~ -1e6 /s at the paper's values: every explicit
+method is unstable above a step of ~2 us there. The instability does not diverge -- mu saturates
+at +-mu_s -- but the stuck foot then slides back and forth (cdm: the slip velocity reverses
+every other step) at up to 100 v_s. `check_step` does not warn about it (it happens at every
+step size anyone would use with an explicit method, including the paper's dt = 1e-4); the
+limit is reported as `StepLimit.dt_chatter` and documented. The exception: where the stuck
+foot needs most of its static friction to hold the tangential spring (`FRICTION_LOAD`),
+chatter changes the gait, and the limit is capped at a few times the chatter limit.
+"""
+from __future__ import annotations
+
+import functools
+import math
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core import _core, _layout
+from ..core.errors import InvalidInputError, StepSizeError, StepSizeWarning
+from ..core.integrators import METHODS
+from ..core.model import check_variant, contact_forces, jacobian
+from ..core.params import X0_PAPER, Params
+
+NQ = _core.NQ
+NX = _core.NX
+FIXED_STEP = ("cdm", "verlet", "rk4")
+ADAPTIVE = ("dopri5", "rodas4")
+CHECK_MODES = ("warn", "error", "off")
+#: The parameters whose force elements can set a step limit, and the forces in words.
+FORCES = {
+    "d_n": "the normal contact damping d_n delta^p delta' (Hunt-Crossley; explicit in every "
+           "fixed-step method)",
+    "k_n": "the normal contact stiffness k_n delta^m",
+    "d_t": "the tangential damper d_t |xi|^p v (Eqs. 7, 11)",
+    "k_t": "the tangential spring k_t |xi|^m (Eqs. 7, 11)",
+    "d_hip": "the hip damper d_hip",
+    "v_s": "the friction law's slope near v = 0 (|dmu/dv| ~ 0.75/v_s)",
+}
+_NO_FRICTION = tuple(f for f in _layout.FEATURES if f != "friction")
+
+#: Calibration of `step_limit`, per variant and method: the largest step at which the typical
+#: gait walks (measured, docs/stability.md) divided by the linear limit at the representative
+#: states, at its smallest over the stability maps' cells (benchmarks/stability_maps.py prints
+#: it), rounded down.
+CALIBRATION = {"paper": {"cdm": 0.1, "verlet": 0.17, "rk4": 0.22},
+               "consistent": {"cdm": 0.11, "verlet": 0.12, "rk4": 0.12}}
+#: When a stuck stance foot needs at least FRICTION_LOAD of its static friction mu_s F_n to
+#: hold the tangential spring-damper (paper variant, k_t >~ 600 at the paper's values), an
+#: explicit method's friction chatter changes the gait: the walking edge falls to a few times
+#: the chatter limit (k_t = 850 in docs/stability.md: 6-10 x). `step_limit` is then at most
+#: CHATTER_CALIBRATION x `StepLimit.dt_chatter`.
+FRICTION_LOAD = 0.8
+CHATTER_CALIBRATION = 5.0
+
+
+# --------------------------------------------------------------------------------------------
+# linear stability of one step
+# --------------------------------------------------------------------------------------------
+
+@functools.lru_cache(maxsize=None)
+def _rk(name):
+    T = _core.rk_tableau(name)
+    return np.array(T["A"]), np.array(T["b"])
+
+
+def step_matrix(method: str, J, h: float) -> np.ndarray:
+    """The one-step map of ``method`` with step ``h`` applied to the linear system x' = J x.
+
+    J is (8, 8) in the layout `pdw.STATE` (x = [q, qd]); its lower blocks A = dqdd/dq and
+    B = dqdd/dqd are what the second-order schemes see.
+
+    * rk4, dopri5: the stability function R(hJ) of the tableau (8 x 8).
+    * verlet: the map of [q_n, v_n, a_n] (12 x 12); a_n is carried between steps
+      (a_{n+1} = A q_{n+1} + B (v_{n+1/2} + h/2 a_n), pdw_verlet.c).
+    * cdm: the map of [U_n, U_{n-1}, U_{n-2}] (12 x 12): U_{n+1} = 2 U_n - U_{n-1} +
+      h^2 (A U_n + B (U_n - U_{n-2}) / 2h) -- MODEL.md section 7, whose force evaluation uses
+      Eq. 17's velocity (U_n - U_{n-2}) / 2h, lagging half a step behind. (The C q' term,
+      implicit in the scheme, is small and treated like the rest.)
+    """
+    J = np.asarray(J, dtype=float)
+    if method in ("rk4", "dopri5"):
+        A, b = _rk(method)
+        eye = np.eye(NX)
+        K = []
+        for i in range(len(b)):
+            X = eye + h * sum(A[i, j] * K[j] for j in range(i)) if i else eye
+            K.append(J @ X)
+        return eye + h * sum(b[i] * K[i] for i in range(len(b)))
+    Aq, Bv = J[NQ:, :NQ], J[NQ:, NQ:]
+    Z, E = np.zeros((NQ, NQ)), np.eye(NQ)
+    if method == "verlet":
+        vh = np.hstack([Z, E, 0.5 * h * E])
+        q1 = np.hstack([E, Z, Z]) + h * vh
+        a1 = Aq @ q1 + Bv @ (vh + np.hstack([Z, Z, 0.5 * h * E]))
+        v1 = vh + 0.5 * h * a1
+        return np.vstack([q1, v1, a1])
+    if method == "cdm":
+        Un, Um1, Um2 = np.hstack([E, Z, Z]), np.hstack([Z, E, Z]), np.hstack([Z, Z, E])
+        U1 = 2 * Un - Um1 + h * h * (Aq @ Un) + 0.5 * h * (Bv @ (Un - Um2))
+        return np.vstack([U1, Un, Um1])
+    raise InvalidInputError("no explicit step map for method %r; allowed: cdm, verlet, rk4, dopri5"
+                            % (method,))
+
+
+def _growth(method, J, h):
+    return float(np.max(np.abs(np.linalg.eigvals(step_matrix(method, J, h)))))
+
+
+def linear_limit(method: str, J, h_lo: float = 1e-10, h_hi: float = 1.0, rel: float = 1e-3) -> float:
+    """Largest step h in [h_lo, h_hi] below which ``method`` is stable on x' = J x (frozen J).
+
+    Stable means: the spectral radius rho of the one-step map (`step_matrix`) grows no faster
+    than the exact solution, ln rho <= 1.5 h max(0, max Re lambda(J)) + rel (the walker has
+    physically unstable, slow modes -- it is an inverted pendulum -- which the exact solution
+    grows too). Search: from h = 1/max|lambda(J)|, half-decade steps down until stable and up
+    until unstable, then 12 bisections in log h (0.03 % resolution). Returns h_lo if unstable
+    there, h_hi if stable everywhere up to it. rodas4 (L-stable) has no limit: inf.
+    """
+    if method == "rodas4":
+        return math.inf
+    J = np.asarray(J, dtype=float)
+    ev = np.linalg.eigvals(J)
+    lp = max(0.0, float(np.max(ev.real)))
+    scale = float(np.max(np.abs(ev)))
+
+    def unstable(h):
+        rho = _growth(method, J, h)
+        return rho > 0 and not (math.log(rho) <= 1.5 * h * lp + rel)
+
+    h = min(max(1.0 / scale if scale > 0 else h_hi, h_lo), h_hi)
+    step = math.sqrt(10.0)
+    if unstable(h):
+        b = h
+        while True:
+            if b <= h_lo:
+                return float(h_lo)
+            a = max(b / step, h_lo)
+            if not unstable(a):
+                break
+            b = a
+    else:
+        a = h
+        while True:
+            if a >= h_hi:
+                return float(h_hi)
+            b = min(a * step, h_hi)
+            if unstable(b):
+                break
+            a = b
+    for _ in range(12):
+        m = math.sqrt(a * b)
+        if unstable(m):
+            b = m
+        else:
+            a = m
+    return float(a)
+
+
+def sensitivity(params: Params, method: str, variant: str = "paper", factor: float = 2.0) -> dict:
+    """Which force sets the linear step limit of `step_limit` (friction excluded): for each
+    parameter of `FORCES` (but v_s) that is nonzero, the exponent a of limit ~ parameter^a,
+    from the limit with that parameter multiplied by ``factor``. A limit set by a damper's
+    real eigenvalue -c/m goes as c^-1, one set by a lightly damped contact oscillation as
+    k^-1/2; 0 means the element plays no part."""
+    h0 = _linear(params, method, variant)[0]
+    out = {}
+    for name in ("k_n", "d_n", "k_t", "d_t", "d_hip"):
+        v = getattr(params, name)
+        if v == 0:
+            out[name] = 0.0
+            continue
+        h1 = _linear(params.replace(**{name: v * factor}), method, variant)[0]
+        out[name] = math.log(h1 / h0) / math.log(factor)
+    return out
+
+
+def limiting_force(sens: dict) -> str:
+    """The parameter with the most negative exponent in a `sensitivity` dict."""
+    return min(sens, key=sens.get)
+
+
+# --------------------------------------------------------------------------------------------
+# representative states
+# --------------------------------------------------------------------------------------------
+
+def _set_hip_height(x, params, variant, flags=(0, 1), force=None):
+    """x with y_o such that the support feet carry ``force`` (default: the weight,
+    (m_h + 2 m_l) g cos(gamma)) in total; the normal force grows with the depth. Three batched
+    grids (geometric in the lowest foot's depth, 1e-9 m to l/4), then linear interpolation:
+    relative accuracy ~1e-6 in the depth."""
+    x = np.array(x, dtype=float)
+    W = params.weight if force is None else float(force)
+    y0 = x[1] - float(np.min(contact_forces(x, params, flags=flags, variant=variant).y_D
+                             [np.array(flags) > 0]))
+
+    def excess(depths):
+        X = np.repeat(x[None, :], len(depths), axis=0)
+        X[:, 1] = y0 - depths
+        return contact_forces(X, params, flags=flags, variant=variant).F_n.sum(axis=1) - W
+
+    d = np.geomspace(1e-9, 0.25 * params.l, 97)
+    for _ in range(3):
+        e = excess(d)
+        k = int(np.argmax(e > 0))
+        if e[k] <= 0:                       # not even l/4 deep carries the weight
+            x[1] = y0 - d[-1]
+            return x
+        if k == 0:
+            x[1] = y0 - d[0]
+            return x
+        lo, hi = d[k - 1], d[k]
+        d = np.linspace(lo, hi, 97)
+    e = excess(d)
+    k = int(np.argmax(e > 0))
+    a, b, ea, eb = d[k - 1], d[k], e[k - 1], e[k]
+    x[1] = y0 - (a - ea * (b - a) / (eb - ea))
+    return x
+
+
+def typical_start(params: Params | None = None, variant: str = "paper") -> np.ndarray:
+    """The typical gait's initial state (`pdw.X0_PAPER`, stance leg 2, flags (0, 1)) with the
+    hip height y_o set so that the stance foot carries the walker's weight under ``params``
+    and ``variant`` (for the paper's values y_o changes by 0.1 mm). On softer or stiffer
+    ground the paper's y_o would start the walker sunk or floating; this keeps the gait's
+    start comparable across the maps."""
+    params = Params.paper() if params is None else params
+    return _set_hip_height(X0_PAPER, params, variant)
+
+
+#: Early, mid and late single stance of the typical gait (`pdw.X0_PAPER` and the rodas4 run
+#: from it with `Params.paper_steady()` at t = 0.15 s and 0.30 s; leg 2 in stance, flags (0, 1)).
+STANCE_STATES = (
+    (0.0, 0.4969, -0.0582, 0.0582, 0.5092, 0.0186, 3.3338, -1.0093),
+    (0.0788, 0.4961, 0.3947, -0.0996, 0.5690, -0.0314, 2.1244, -1.1414),
+    (0.1777, 0.4847, 0.4661, -0.3000, 0.7759, -0.1382, -1.3415, -1.5946),
+)
+#: The landing 8 ms after the first touch-down of that run (t = 0.350 s): foot 1 is 3.0 mm deep
+#: and still sinking at 0.65 m/s, the feet carry 3.7 weights. In `stance_states` it is taken
+#: with foot 1 alone in support (flags (1, 0)): the trailing foot lifts off within a few ms,
+#: too soon for its tangential damper's fast mode to grow (the maps show no effect of d_t there).
+DOUBLE_SUPPORT_STATE = (0.21897, 0.4765, 0.37161, -0.38544, 0.85002, -0.099734, -1.7726, -1.7783)
+DOUBLE_SUPPORT_LOAD = 3.7
+LANDING_FLAGS = (1, 0)
+
+
+def stance_states(params: Params | None = None, variant: str = "paper") -> tuple:
+    """The representative states of `step_limit`: ``(X, flags)``, X of shape (4, 8): the three
+    `STANCE_STATES` (flags (0, 1)) and the landing, `DOUBLE_SUPPORT_STATE` with flags
+    `LANDING_FLAGS`; each with the support foot stuck (x_o' set so that its slip velocity is 0
+    -- at `pdw.X0_PAPER` it still slides at 5 mm/s), in single stance not sinking either (y_o'
+    set so that the consistent normal rate y_o' + (l - r) sin(theta2) theta2' is 0; the paper
+    variant's printed rate keeps its r theta2'), and y_o set so that it carries the weight
+    (the landing: `DOUBLE_SUPPORT_LOAD` times it) under ``params`` and ``variant``. Late in
+    stance the paper variant's tangential spring-damper acts (xi_2 < 0), early on it does not;
+    the landing holds the impact (d_n delta^p delta' at its largest)."""
+    params = Params.paper() if params is None else params
+    out, flags = [], []
+    for x0, fl, foot, load in [(x, (0, 1), 1, 1.0) for x in STANCE_STATES] + \
+            [(DOUBLE_SUPPORT_STATE, LANDING_FLAGS, 0, DOUBLE_SUPPORT_LOAD)]:
+        x = np.array(x0, dtype=float)
+        x[4] -= float(contact_forces(x, params, flags=fl, variant=variant).v_x[foot])
+        if foot == 1:       # single stance: the stance foot neither sinks nor rises
+            x[5] = -(params.l - params.r) * math.sin(x[3]) * x[7]
+        out.append(_set_hip_height(x, params, variant, fl, load * params.weight))
+        flags.append(fl)
+    return np.array(out), flags
+
+
+# --------------------------------------------------------------------------------------------
+# the step-size check of simulate
+# --------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class StepLimit:
+    """The estimated largest safe fixed step of ``method`` for given parameters.
+
+    dt_max : float
+        Steps above this are expected to make the typical gait fall or diverge spuriously
+        (inf for rodas4; for dopri5, its explicit stability bound, set by friction: the
+        adaptive controller keeps it below that by itself).
+    force : str
+        The parameter of the force element that sets it (a key of `FORCES`): the one with the
+        most negative exponent in ``sensitivity``.
+    dt_linear : float
+        The smallest linear limit at the representative states (before calibration).
+    calibration : float
+        dt_max / dt_linear (measured on the maps, `CALIBRATION`).
+    dt_chatter : float
+        Linear limit including the friction law's slope, in single stance: above it the stuck
+        foot slides spuriously or chatters (bounded; not warned about).
+    eigenvalue : complex
+        The stiffest eigenvalue of df/dx (friction excluded) at that state [1/s].
+    sensitivity : dict
+        Exponent a of dt_linear ~ parameter^a for k_n, d_n, k_t, d_t, d_hip (`sensitivity`).
+    friction_load : float
+        The largest share of the static friction mu_s F_n that a stuck stance foot needs to hold
+        the tangential spring-damper at the stance states; from `FRICTION_LOAD` on, dt_max is
+        capped by the chatter limit and ``force`` is "v_s".
+    """
+
+    method: str
+    variant: str
+    dt_max: float
+    force: str
+    dt_linear: float
+    calibration: float
+    dt_chatter: float
+    eigenvalue: complex
+    sensitivity: dict = field(default_factory=dict, compare=False)
+    friction_load: float = 0.0
+
+    @property
+    def why(self) -> str:
+        return FORCES.get(self.force, self.force)
+
+    def message(self, dt: float) -> str:
+        if self.force == "v_s" and self.method in FIXED_STEP:
+            return ("dt = %.3g s exceeds the estimated limit %.2g s of method %r for these "
+                    "parameters (variant %r): the stuck stance foot needs %.0f %% of its static "
+                    "friction to hold the tangential spring, so the friction chatter of an "
+                    "explicit method (above ~%.2g s, %s) changes the gait; limit = %.0f x that "
+                    "(docs/stability.md). Use dt <= %.2g, or method='rodas4' (L-stable, no step "
+                    "limit); check_step='off' disables this check."
+                    % (dt, self.dt_max, self.method, self.variant, 100 * self.friction_load,
+                       self.dt_chatter, FORCES["v_s"], CHATTER_CALIBRATION, self.dt_max))
+        return ("dt = %.3g s exceeds the estimated stability limit %.2g s of method %r for these "
+                "parameters (variant %r): the limit is set by %s (limit ~ %s^%.2g; stiffest "
+                "non-friction eigenvalue %.3g /s in stance; linear limit %.2g s x calibration "
+                "%.2g, docs/stability.md). Above it the typical gait falls or diverges "
+                "spuriously. Use dt <= %.2g, or method='rodas4' (L-stable, no step limit); "
+                "check_step='off' disables this check."
+                % (dt, self.dt_max, self.method, self.variant, self.why, self.force,
+                   self.sensitivity.get(self.force, float("nan")), abs(self.eigenvalue),
+                   self.dt_linear, self.calibration, self.dt_max))
+
+
+def _stiffest(J):
+    ev = np.linalg.eigvals(J)
+    return complex(ev[np.argmax(np.abs(ev))])
+
+
+def state_jacobian(x, params: Params, flags, variant: str = "paper", features=_NO_FRICTION):
+    """df/dx at a representative state, its support feet anchored where they are (the
+    consistent variant's xi = 0: a foot that has not slipped since touch-down)."""
+    s = contact_forces(x, params, flags=flags, variant=variant).s
+    anchors = tuple(float(s[i]) if flags[i] else 0.0 for i in range(2))
+    return jacobian(x, params, flags=flags, anchors=anchors, variant=variant, features=features)
+
+
+def _limits(params: Params, method: str, variant: str, features=_NO_FRICTION):
+    """Linear limits of ``method`` at each of `stance_states`."""
+    X, flags = stance_states(params, variant)
+    return [linear_limit(method, state_jacobian(x, params, fl, variant, features))
+            for x, fl in zip(X, flags)]
+
+
+@functools.lru_cache(maxsize=1024)
+def _linear(params: Params, method: str, variant: str):
+    """(linear limit without friction, index of the state that sets it) over `stance_states`."""
+    hs = _limits(params, method, variant)
+    k = int(np.argmin(hs))
+    return hs[k], k
+
+
+@functools.lru_cache(maxsize=1024)
+def _friction_load(params: Params, variant: str) -> float:
+    """Largest |F_t without friction| / (mu_s F_n) of the stuck foot at the single-stance states."""
+    X, flags = stance_states(params, variant)
+    P0 = params.replace(mu_s=0.0, mu_d=0.0)
+    load = 0.0
+    for x, fl in zip(X[:len(STANCE_STATES)], flags[:len(STANCE_STATES)]):
+        s = contact_forces(x, params, flags=fl, variant=variant).s
+        anchors = tuple(float(s[i]) if fl[i] else 0.0 for i in range(2))
+        cs = contact_forces(x, P0, flags=fl, anchors=anchors, variant=variant)
+        i = fl.index(1)
+        need, cap = abs(float(cs.F_t[i])), params.mu_s * float(cs.F_n[i])
+        load = max(load, need / cap if cap > 0 else (math.inf if need > 0 else 0.0))
+    return load
+
+
+@functools.lru_cache(maxsize=1024)
+def _chatter_limit(params: Params, method: str, variant: str) -> float:
+    return min(_limits(params, method, variant, features=None)[:len(STANCE_STATES)])
+
+
+def _dt_max(params, method, variant):
+    dt = CALIBRATION[variant][method] * _linear(params, method, variant)[0]
+    if _friction_load(params, variant) >= FRICTION_LOAD:
+        dt = min(dt, CHATTER_CALIBRATION * _chatter_limit(params, method, variant))
+    return dt
+
+
+@functools.lru_cache(maxsize=256)
+def _step_limit(params: Params, method: str, variant: str) -> StepLimit:
+    if method == "rodas4":
+        return StepLimit(method, variant, math.inf, "none", math.inf, 1.0, math.inf, 0j)
+    X, flags = stance_states(params, variant)
+    dt_chatter = _chatter_limit(params, method, variant)
+    Jf = [state_jacobian(x, params, fl, variant, None) for x, fl in zip(X, flags)]
+    if method == "dopri5":
+        # adaptive: the controller keeps the step below its explicit bound by itself
+        return StepLimit(method, variant, dt_chatter, "v_s", dt_chatter, 1.0, dt_chatter,
+                         max((_stiffest(J) for J in Jf[:len(STANCE_STATES)]), key=abs))
+    h, k = _linear(params, method, variant)
+    sens = sensitivity(params, method, variant)
+    J = state_jacobian(X[k], params, flags[k], variant)
+    c = CALIBRATION[variant][method]
+    load = _friction_load(params, variant)
+    dt_max = _dt_max(params, method, variant)
+    force = "v_s" if dt_max < c * h else limiting_force(sens)
+    return StepLimit(method, variant, dt_max, force, h, c, dt_chatter, _stiffest(J), sens, load)
+
+
+def step_limit(params: Params | None = None, method: str = "cdm", variant: str = "paper") -> StepLimit:
+    """Estimate the largest fixed step ``method`` can take on the walker with ``params``.
+
+    The smallest linear stability limit (`linear_limit`) of the method on df/dx without the
+    friction slope at the representative states (`stance_states`), times the calibration
+    factor `CALIBRATION[variant][method]` (the smallest ratio of the measured walking limit to
+    this linear limit over the stability maps, docs/stability.md); capped at
+    `CHATTER_CALIBRATION` x the chatter limit where the stuck foot needs `FRICTION_LOAD` of its
+    static friction. For dopri5: its explicit bound with friction (the step its controller
+    keeps below by itself); for rodas4: inf. Cached per
+    (params, method, variant); about 40 ms the first time (the force's exponents take five
+    more linear limits).
+    """
+    params = Params.paper() if params is None else params
+    if not isinstance(params, Params):
+        raise InvalidInputError("params must be a pdw.Params, got %s" % type(params).__name__)
+    if method not in METHODS:
+        raise InvalidInputError("method must be one of %s, got %r" % (", ".join(METHODS), method))
+    try:
+        check_variant(variant)
+    except ValueError as e:
+        raise InvalidInputError(str(e)) from None
+    return _step_limit(params, method, variant)
+
+
+def check_step(dt: float, params: Params, method: str, variant: str, mode: str = "warn"):
+    """The check `pdw.simulate` runs before a fixed-step run (``check_step`` argument).
+
+    ``mode``: "warn" (a `pdw.StepSizeWarning` when dt > `step_limit`), "error" (raise
+    `pdw.StepSizeError` instead), "off". Adaptive methods are not checked (their dt is only
+    the first trial step). Returns the `StepLimit` when dt exceeds it, else None. Costs ~7 ms
+    per new (params, method, variant), nothing after (cached).
+    """
+    if mode not in CHECK_MODES:
+        raise InvalidInputError("check_step must be one of %s, got %r"
+                                % (", ".join(map(repr, CHECK_MODES)), mode))
+    if mode == "off" or method not in FIXED_STEP:
+        return None
+    if not dt > _dt_max(params, method, variant):
+        return None
+    lim = step_limit(params, method, variant)
+    msg = lim.message(dt)
+    if mode == "error":
+        raise StepSizeError(msg, dt=dt, limit=lim.dt_max, force=lim.force)
+    warnings.warn(StepSizeWarning(msg, dt=dt, limit=lim.dt_max, force=lim.force), stacklevel=3)
+    return lim

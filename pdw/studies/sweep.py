@@ -1,0 +1,420 @@
+"""Parameter studies at scale: ``pdw sweep study.toml`` (docs/studies.md).
+
+A *study* (a TOML file, `load_study`) sweeps one or two `Params` fields over ranges, the others
+fixed (a preset plus overrides), with one contact variant and one integrator. Every point gets
+a steady gait, either
+
+* ``mode = "simulate"`` (default): one simulation of ``t_end`` seconds from ``x0`` (default the
+  paper's initial condition), the steady descriptors being the mean of the last ``steady`` steps
+  (`pdw.steps(...).steady`), classified period-1 / period-2 / none from the step-to-step
+  spread; or
+* ``mode = "newton"``: `pdw.find_gait` (Newton shooting on the touch-down map) with its
+  Floquet multipliers.
+
+`run_study` writes, in the output folder, ``<name>.csv`` (one row per point, with its status),
+``<name>.json`` (provenance: the study, the base parameters, versions, pdw.INPUT_HASH, git
+describe, timings, executor) and, given a figure function (``pdw sweep`` passes
+`pdw.present.study_plots.plot_study`), ``<name>.png`` (L, P, v and double support against the first
+axis, one line per value of the second, the paper's reported end points as markers).
+
+Scale
+-----
+Points are independent tasks of the module-level worker `run_point` (a small dict in, a small
+dict out), submitted to any ``concurrent.futures``-style executor: by default a thread pool over
+the local cores (the compiled loop releases the GIL, so threads run in parallel), or a process
+pool (``backend="process"``), or a Dask cluster unchanged (``executor=client.get_executor()``).
+Each finished point is appended to the CSV at once (flushed), so an interrupted sweep resumes
+from its CSV: rerunning skips the points already there and computes only the others
+(``resume=False`` starts afresh). A progress bar is written to stderr (no dependency).
+"""
+from __future__ import annotations
+
+import concurrent.futures as cf
+import csv
+import dataclasses
+import datetime
+import io
+import json
+import math
+import os
+import pathlib
+import platform
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+from ..core.errors import InvalidInputError, PdwError
+from ..core.params import Params
+from .study import COLUMNS, Study, load_study, parse_study  # noqa: F401 (pdw.sweep.parse_study)
+
+# --- the worker -------------------------------------------------------------------------------
+
+def _classify(table, steady, tol):
+    """'period-1', 'period-2' or 'none' from the last steps' L and cycle."""
+    L, T = table["L"], table["cycle"]
+    ok = np.isfinite(L) & np.isfinite(T)
+    L, T = L[ok], T[ok]
+    n = max(steady, 2)
+    if len(L) >= n and max(np.ptp(L[-n:]), np.ptp(T[-n:])) < tol:
+        return "period-1"
+    if len(L) >= 2 * n and max(np.max(np.abs(L[-n:] - L[-n - 2:-2])),
+                               np.max(np.abs(T[-n:] - T[-n - 2:-2]))) < tol:
+        return "period-2"
+    return "none"
+
+
+def run_point(task) -> dict:
+    """Compute one point of a study (module-level, so that process pools and Dask workers can
+    import it). ``task``: `Study.task`. Returns the CSV row (a flat dict of numbers and short
+    strings); an invalid point gives ``status = "error"`` instead of raising."""
+    from ..sim.gait import steps
+    from ..sim.simulation import simulate
+    t0 = time.perf_counter()
+    row = {"index": int(task["index"]), **task["values"]}
+    row.update({c: "" for c in COLUMNS})
+    run = task["run"]
+    try:
+        params = Params(**task["params"])
+        if run["mode"] == "simulate":
+            res = simulate(run["x0"], t_end=run["t_end"], dt=run["dt"], params=params,
+                           variant=task["variant"], method=task["method"],
+                           flags0=tuple(run["flags0"]), record_every=0, record_forces=False,
+                           on_failure="return", rtol=run["rtol"], atol=run["atol"])
+            st = steps(res)
+            s = st.steady(run["steady"])
+            row.update(status=res.status, n_steps=len(st), t_final=res.t_final, source="simulate",
+                       gait=_classify(st.table, run["steady"], run["period_tol"])
+                       if res.status == "walked" else "")
+            if res.status == "walked" and len(st) >= run["steady"]:
+                row.update({k: s[k] for k in ("L", "P", "v", "cycle", "double_support",
+                                              "ds_fraction", "travel")},
+                           spread_L=s["spread_L"], spread_cycle=s["spread_cycle"])
+        if run["mode"] == "newton" or (run["fallback"] and row["gait"] != "period-1"):
+            _newton_point(row, params, task)
+    except (PdwError, ValueError) as e:
+        row.update(status="error", error=str(e)[:300])
+    row["wall_s"] = time.perf_counter() - t0
+    return row
+
+
+def _newton_point(row, params, task):
+    """Fill ``row`` from `pdw.find_gait` (default guesses); keeps ``row`` if none is found."""
+    from ..analysis.gait_types import GaitNotFoundError
+    from ..analysis.limit_cycle import find_gait
+    try:
+        g = find_gait(params, variant=task["variant"], method=task["method"], workers=1,
+                      max_iter=12)
+    except GaitNotFoundError as e:
+        if row["status"] == "":
+            row.update(status="no_gait", source="newton", error=str(e)[:200])
+        return
+    sp = g.details["swing_period"]
+    mu = float(np.max(np.abs(g.multipliers)))
+    row.update(status="walked" if mu < 1 else "unstable", source="newton",
+               gait="period-1" if mu < 1 else "unstable", L=g.step_length, P=sp,
+               v=g.step_length / sp, cycle=g.period, double_support=g.double_support,
+               ds_fraction=g.double_support / g.period, travel=g.details["travel"],
+               spread_L=g.details["residual"], spread_cycle="", max_multiplier=mu, error="")
+
+
+# --- CSV (resumable) ------------------------------------------------------------------------------
+
+def _header(study):
+    return ["index"] + study.axis_names + list(COLUMNS)
+
+
+def _fmt(v):
+    if isinstance(v, float):
+        return repr(v) if math.isfinite(v) else ("nan" if math.isnan(v) else repr(v))
+    if isinstance(v, (np.floating,)):
+        return repr(float(v))
+    return str(v)
+
+
+def _parse(v):
+    try:
+        return float(v) if v not in ("",) else ""
+    except ValueError:
+        return v
+
+
+def read_rows(path, study) -> dict:
+    """Rows already in a study's CSV, by index; checks that they belong to ``study`` (same
+    columns, same axis values). Malformed lines (a write cut by a kill) are dropped."""
+    path = pathlib.Path(path)
+    if not path.exists():
+        return {}
+    text = path.read_text()
+    lines = text.splitlines()
+    if not lines:
+        return {}
+    header = next(csv.reader([lines[0]]))
+    if header != _header(study):
+        raise PdwError("%s: its columns %s are not this study's %s; use a fresh output folder "
+                       "or resume=False (--fresh)" % (path, header, _header(study)))
+    pts = dict(study.points())
+    rows = {}
+    for line in lines[1:]:
+        rec = next(csv.reader([line]), None)
+        if rec is None or len(rec) != len(header):
+            continue                                   # torn line
+        row = dict(zip(header, rec))
+        try:
+            k = int(row["index"])
+        except ValueError:
+            continue
+        if k not in pts or any(not np.isclose(float(row[a]), pts[k][a], rtol=1e-12, atol=0)
+                               for a in study.axis_names):
+            raise PdwError("%s: row %s does not match this study's point %s; use a fresh output "
+                           "folder or resume=False (--fresh)" % (path, row["index"], pts.get(k)))
+        if row["status"] == "":
+            continue
+        rows[k] = {c: (int(row[c]) if c == "index" else _parse(row[c])) for c in header}
+    return rows
+
+
+def _csv_line(row, header):
+    buf = io.StringIO()
+    csv.writer(buf, lineterminator="\n").writerow([_fmt(row.get(c, "")) for c in header])
+    return buf.getvalue()
+
+
+# --- progress -------------------------------------------------------------------------------------
+
+class Progress:
+    """A plain progress bar on stderr: redrawn in place on a terminal, a line every 10 %
+    otherwise. ``enabled=False`` prints nothing."""
+
+    def __init__(self, total, done=0, label="sweep", stream=None, enabled=True):
+        self.total, self.done, self.label = total, done, label
+        self.start_done = done
+        self.stream = sys.stderr if stream is None else stream
+        self.enabled = enabled and total > 0
+        self.t0 = time.perf_counter()
+        self._last = 0.0
+        self._decile = -1
+        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
+        self.update(0)
+
+    def update(self, n=1):
+        self.done += n
+        if not self.enabled:
+            return
+        now = time.perf_counter()
+        el = now - self.t0
+        new = self.done - self.start_done
+        left = self.total - self.done
+        eta = el / new * left if new > 0 else float("nan")
+        frac = self.done / self.total
+        text = "%s: [%-30s] %d/%d (%3.0f%%) %.1f s, ETA %s" % (
+            self.label, "#" * int(30 * frac), self.done, self.total, 100 * frac, el,
+            "%.1f s" % eta if math.isfinite(eta) else "?")
+        if self.tty:
+            if now - self._last > 0.1 or self.done >= self.total:
+                self.stream.write("\r" + text)
+                if self.done >= self.total:
+                    self.stream.write("\n")
+                self.stream.flush()
+                self._last = now
+        else:
+            dec = int(10 * frac)
+            if dec != self._decile:
+                self._decile = dec
+                self.stream.write(text + "\n")
+                self.stream.flush()
+
+
+# --- provenance -----------------------------------------------------------------------------------
+
+def git_describe(path=None):
+    """``git describe --always --dirty --tags`` of the repository holding ``path`` (default:
+    this package), or None."""
+    where = pathlib.Path(path or __file__).resolve().parent
+    try:
+        out = subprocess.run(["git", "-C", str(where), "describe", "--always", "--dirty",
+                              "--tags"], capture_output=True, text=True, timeout=10)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return out.stdout.strip() or None if out.returncode == 0 else None
+
+
+def provenance(study, **extra) -> dict:
+    from ..core import __version__
+    from ..core._layout import INPUT_HASH
+    return {
+        "study": {"name": study.name, "title": study.title, "path": study.path,
+                  "sha256": study.digest(), "toml": study.source},
+        "preset": study.preset, "variant": study.variant, "method": study.method,
+        "base_params": study.base_params().as_dict(),
+        "axes": {a: v.tolist() for a, v in study.axes},
+        "run": study.run,
+        "code": {"pdw_version": __version__, "input_hash": INPUT_HASH,
+                 "git_describe": git_describe()},
+        "python": sys.version.split()[0], "numpy": np.__version__,
+        "platform": platform.platform(), "cpu_count": os.cpu_count(),
+        **extra,
+    }
+
+
+# --- running ----------------------------------------------------------------------------------
+
+@dataclasses.dataclass
+class StudyResult:
+    """Outcome of `run_study`: ``rows`` (list of dicts sorted by index), ``paths`` written,
+    ``computed`` (indices computed in this call), ``resumed`` (indices read from the CSV)."""
+
+    study: Study
+    rows: list
+    paths: dict
+    computed: list
+    resumed: list
+    wall_s: float
+
+    def column(self, name):
+        return np.array([np.nan if r[name] == "" else r[name] for r in self.rows], dtype=float) \
+            if name not in ("status", "gait", "error") else [r[name] for r in self.rows]
+
+
+def _make_executor(backend, workers):
+    n = max(1, int(workers or os.cpu_count() or 1))
+    if backend == "thread":
+        return cf.ThreadPoolExecutor(n), n
+    if backend == "process":
+        return cf.ProcessPoolExecutor(n), n
+    raise InvalidInputError("backend must be 'thread', 'process' or 'serial', got %r" % (backend,))
+
+
+def run_study(study, out=None, *, executor=None, workers=None, backend="thread", resume=True,
+              progress=True, figures=None) -> StudyResult:
+    """Run a study (a `Study` or a path to its TOML file).
+
+    Parameters
+    ----------
+    out : path, optional
+        Output folder (default ``out/studies/<name>``); holds ``<name>.csv``, ``.json``, ``.png``.
+    executor : concurrent.futures.Executor-like, optional
+        Anything with ``submit(fn, *args) -> concurrent.futures.Future``, e.g. a
+        ``ThreadPoolExecutor``, a ``ProcessPoolExecutor`` or Dask's ``client.get_executor()``.
+        It is not shut down here. Default: a new pool of ``backend``.
+    workers : int
+        Size of the default pool (default: all cores).
+    backend : {"thread", "process", "serial"}
+        The default pool's kind; "serial" computes in this thread, no pool.
+    resume : bool
+        Keep the points already in the CSV and compute only the others (default). False
+        starts afresh (the CSV is overwritten).
+    progress : bool
+        Progress bar on stderr.
+    figures : callable, optional
+        ``figures(study, rows, path) -> path`` draws the study's figure into ``path``
+        (``<name>.png``); `pdw.present.study_plots.plot_study` is the standard one (``pdw sweep``
+        passes it). None or False: no figure. The figure belongs to the presentation layer, so it is
+        passed in rather than imported here (docs/architecture.md).
+
+    If a point's task fails in the executor (a killed worker, an interrupt), the points finished
+    so far are already in the CSV; the error is re-raised, and a rerun resumes.
+    """
+    if figures and not callable(figures):
+        raise InvalidInputError("figures must be a function (study, rows, path) -> path, e.g. "
+                                "pdw.present.study_plots.plot_study, or None; got %r" % (figures,))
+    if not isinstance(study, Study):
+        study = load_study(study)
+    out = pathlib.Path(out or pathlib.Path("out") / "studies" / study.name)
+    out.mkdir(parents=True, exist_ok=True)
+    csv_path, json_path = out / (study.name + ".csv"), out / (study.name + ".json")
+    header = _header(study)
+    t_start = time.perf_counter()
+    started = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+    done = read_rows(csv_path, study) if resume else {}
+    points = study.points()
+    todo = [(k, v) for k, v in points if k not in done]
+    # rewrite the CSV with what is kept (drops torn lines), then append as points finish
+    tmp = csv_path.with_suffix(".csv.tmp")
+    with open(tmp, "w", newline="") as f:
+        f.write(",".join(header) + "\n")
+        for k in sorted(done):
+            f.write(_csv_line(done[k], header))
+    os.replace(tmp, csv_path)
+
+    own = None
+    if executor is None and backend != "serial" and todo:
+        own, nw = _make_executor(backend, workers)
+        exec_desc = "%s pool, %d workers" % (backend, nw)
+    elif executor is not None:
+        exec_desc = "%s.%s" % (type(executor).__module__, type(executor).__qualname__)
+    else:
+        exec_desc = "serial"
+    bar = Progress(len(points), len(done), label=study.name, enabled=progress)
+    computed = []
+    error = None
+    with open(csv_path, "a", newline="") as f:
+        def record(row):
+            f.write(_csv_line(row, header))
+            f.flush()
+            done[row["index"]] = row
+            computed.append(row["index"])
+            bar.update(1)
+        try:
+            if executor is None and own is None:
+                for k, v in todo:
+                    record(run_point(study.task(k, v)))
+            else:
+                ex = executor if executor is not None else own
+                futs = [ex.submit(run_point, study.task(k, v)) for k, v in todo]
+                try:
+                    for fut in cf.as_completed(futs):
+                        record(fut.result())
+                except BaseException:
+                    for fut in futs:
+                        fut.cancel()
+                    # keep what finished meanwhile
+                    for fut in futs:
+                        if fut.done() and not fut.cancelled() and fut.exception() is None:
+                            row = fut.result()
+                            if row["index"] not in done:
+                                record(row)
+                    raise
+        except BaseException as e:      # noqa: BLE001 - re-raised below after bookkeeping
+            error = e
+        finally:
+            if own is not None:
+                own.shutdown(wait=error is None, cancel_futures=True)
+    if error is not None:
+        raise error
+    rows = [done[k] for k, _ in points]
+    # final CSV in index order (atomic)
+    with open(tmp, "w", newline="") as f:
+        f.write(",".join(header) + "\n")
+        for r in rows:
+            f.write(_csv_line(r, header))
+    os.replace(tmp, csv_path)
+    wall = time.perf_counter() - t_start
+    statuses = {}
+    for r in rows:
+        statuses[r["status"]] = statuses.get(r["status"], 0) + 1
+    meta = provenance(study, started=started,
+                      finished=datetime.datetime.now(datetime.timezone.utc).isoformat(
+                          timespec="seconds"),
+                      wall_s=wall, executor=exec_desc, n_points=len(points),
+                      n_resumed=len(points) - len(computed), n_computed=len(computed),
+                      cpu_s_points=float(sum(r["wall_s"] for r in rows if r["wall_s"] != "")),
+                      status_counts=statuses, csv=csv_path.name)
+    paths = {"csv": csv_path, "json": json_path}
+    if figures:
+        try:
+            paths["png"] = figures(study, rows, out / (study.name + ".png"))
+        except ImportError:
+            meta["figure"] = "not written: matplotlib is not installed"
+    json_path.write_text(json.dumps(meta, indent=2, default=_jsonable) + "\n")
+    return StudyResult(study=study, rows=rows, paths=paths, computed=sorted(computed),
+                       resumed=sorted(set(done) - set(computed)), wall_s=wall)
+
+
+def _jsonable(o):
+    if isinstance(o, (np.floating, np.integer)):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    return str(o)
