@@ -180,3 +180,30 @@ def test_calibration_matches_sink_and_restitution():
     assert not cal.reachable["lankarani_nikravesh"] and cal.e_drop["lankarani_nikravesh"] > 0.6
     e = cal.contacts["flores"].e
     assert P.k_n * 8 * (1 - e) / (5 * e) / 0.7 == pytest.approx(P.d_n, rel=1e-5)
+
+
+def test_approach_speed_is_captured_at_touch_down():
+    """cdm with Flores: at each touch-down the foot's -v_y is stored; the recorded normal force
+    through the following stance is the Flores formula with that v_in (and none other)."""
+    P = pdw.Params.paper_steady()
+    c = Contact("flores", e=0.3)
+    r = pdw.simulate(params=P, contact=c, t_end=1.2, dt=1e-4, method="cdm")
+    tds = [ev for ev in r.events if ev.kind == "touch_down"]
+    assert len(tds) >= 2
+    chi = 8 * (1 - 0.3) / (5 * 0.3)
+    for ev in tds:
+        n = int(round(ev.t / r.dt))
+        assert r.t[n] == pytest.approx(ev.t)
+        j = ev.leg - 1
+        v_in = -pdw.contact_forces(r.x[n], P, flags=(1, 1)).v_y[j]
+        assert v_in > 0.01
+        # samples n+1 .. n+200 of this stance, the foot penetrating
+        idx = np.arange(n + 1, n + 200)
+        cs = pdw.contact_forces(r.x[idx], P, flags=(1, 1))
+        delta, deltad = -cs.y_D[:, j], -cs.v_y[:, j]
+        pen = (delta > 0) & (r.flags[idx, j] == 1)
+        want = np.maximum(P.k_n * delta ** 1.5 * (1 + chi * deltad / v_in), 0.0)
+        assert pen.sum() > 50
+        assert np.allclose(r.Fn[idx[pen], j], want[pen], rtol=1e-10, atol=1e-9)
+        other = np.maximum(P.k_n * delta ** 1.5 * (1 + chi * deltad / (1.2 * v_in)), 0.0)
+        assert not np.allclose(r.Fn[idx[pen], j], other[pen], rtol=1e-3)
