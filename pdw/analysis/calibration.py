@@ -160,11 +160,12 @@ def typical_landing(params: Params | None = None, variant: str = "paper", t_end:
         x, j = r.x[i], ev.leg - 1
         cs = contact_forces(x, params, flags=(1, 1), variant=variant)
         speeds.append(-cs.v_y[j])
-        th = x[2 + j]
-        J = np.zeros(4)
-        J[1] = 1.0
-        J[2 + j] = (params.l - params.r) * math.sin(th) + (params.r if variant == "paper" else 0.0)
-        masses.append(1.0 / float(J @ np.linalg.solve(mass_matrix(x[:4], params), J)))
+        th = _layout.STATE.index("theta%d" % (j + 1))
+        J = np.zeros(_layout.NQ)        # dv_y/dq' of foot j (Eq. 5 of the variant)
+        J[_layout.STATE.index("y_o")] = 1.0
+        J[th] = (params.l - params.r) * math.sin(x[th]) + (params.r if variant == "paper" else 0.0)
+        M = mass_matrix(x[:_layout.NQ], params)
+        masses.append(1.0 / float(J @ np.linalg.solve(M, J)))
     if not speeds:
         raise RuntimeError("no touch-down after the first %d in %g s" % (skip, t_end))
     return Landing(float(np.median(speeds)), float(np.median(masses)), len(speeds))

@@ -16,7 +16,7 @@ cdef extern from "pdw_model.h":
         PDW_NKERNELS, PDW_NEVENT, PDW_NREC
         PDW_WORK_TRIG, PDW_WORK_KIN, PDW_WORK_CONTACT, PDW_WORK_M, PDW_WORK_F, PDW_WORK_QDD
         PDW_STATUS_RUNNING, PDW_STATUS_EVENTS_FULL
-        PDW_NSTEP, PDW_STEP_RING, PDW_NANCHOR
+        PDW_NSTEP, PDW_STEP_RING, PDW_NANCHOR, PDW_ANCHOR_V_IN1, PDW_ANCHOR_V_IN2
     ctypedef struct pdw_kernel:
         const char *name
         int variant
@@ -247,11 +247,13 @@ def bench(int k, str what, const double[::1] x, const double[::1] p, int f1, int
     """Mean ns per evaluation of `what` ("rhs" or "jacobian") over n calls in a C loop."""
     cdef const pdw_kernel *kern = _kernel(k)
     cdef int flags[2]
-    cdef double anchors[4]
+    cdef double anchors[PDW_NANCHOR]
     cdef double work[PDW_NWORK]
     cdef double sink = 0.0, ns
-    flags[0] = f1; flags[1] = f2; anchors[0] = a1; anchors[1] = a2; anchors[2] = 0.0
-    anchors[3] = 0.0
+    cdef int j
+    for j in range(PDW_NANCHOR):
+        anchors[j] = 0.0
+    flags[0] = f1; flags[1] = f2; anchors[0] = a1; anchors[1] = a2
     if what == "rhs":
         with nogil:
             ns = pdw_bench_rhs(kern, &x[0], &p[0], flags, anchors, n, work, &sink)
@@ -441,7 +443,8 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         "x_final": np.array(<double[:PDW_NX]> s.x),
         "flags_final": (s.disc.flags[0], s.disc.flags[1]),
         "anchors_final": (s.disc.anchors[0], s.disc.anchors[1]),
-        "approach_speeds_final": (s.disc.anchors[2], s.disc.anchors[3]),
+        "approach_speeds_final": (s.disc.anchors[PDW_ANCHOR_V_IN1],
+                                  s.disc.anchors[PDW_ANCHOR_V_IN2]),
         "failure": {"t": s.failure.t, "x": np.array(<double[:PDW_NX]> s.failure.x),
                     "leg": s.failure.leg, "reason": s.failure.reason},
     }
