@@ -4,8 +4,11 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 PIP    := $(PY) -m pip
 OUT    ?= out/typical_gait
+BUILT  := $(VENV)/.pdw-built
 STAMP  := $(VENV)/.pdw-installed
 SOURCES := $(wildcard generated/*.c generated/*.h pdw/core/*.pyx pdw/core/csrc/*.c pdw/core/csrc/*.h) setup.py pyproject.toml
+# an extra's requirements, read from pyproject.toml (installed without rebuilding pdw)
+EXTRA_REQS = $(PY) -c "import sys, tomllib; print('\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies'][sys.argv[1]]))"
 
 .PHONY: all run test lint test-all derive check-generated bench study clean distclean
 
@@ -13,16 +16,22 @@ all: $(STAMP)
 
 $(VENV)/bin/python:
 	$(PYTHON) -m venv $(VENV)
-	$(PIP) install --quiet --upgrade pip
 
-# Build dependencies first, then the package (editable, compiled in place), with test extras.
-$(STAMP): $(VENV)/bin/python $(SOURCES)
-	$(PIP) install --quiet "setuptools>=68" wheel "Cython>=3.0" "numpy>=1.23"
-	$(PIP) install --quiet --no-build-isolation -e ".[test]"
+# What running needs: the build tools, then the package (editable, compiled in place) with the
+# plot extra (the figures of `make run`).
+$(BUILT): $(VENV)/bin/python $(SOURCES)
+	$(PIP) install --quiet --disable-pip-version-check "setuptools>=77" wheel "Cython>=3.0"
+	PYTHONWARNINGS=ignore $(PIP) install --quiet --disable-pip-version-check --no-build-isolation -e ".[plot]"
+	@touch $(BUILT)
+
+# What testing needs on top: the test extra.
+$(STAMP): $(BUILT)
+	$(EXTRA_REQS) test > $(VENV)/requirements-test.txt
+	$(PIP) install --quiet --disable-pip-version-check -r $(VENV)/requirements-test.txt
 	@touch $(STAMP)
 
 ## run: the main job -- the paper's typical gait, its step table and figures (in $(OUT))
-run: $(STAMP)
+run: $(BUILT)
 	$(PY) -m pdw walk --out $(OUT)
 
 ## test: build everything, check generated/ against derive/, lint, the layer contract, the tests
@@ -42,27 +51,32 @@ test-all: $(STAMP)
 
 ## derive: regenerate generated/ and pdw/core/_layout.py from the symbolic derivation
 derive: $(VENV)/bin/python
-	$(PIP) install --quiet "sympy>=1.12"
+	$(EXTRA_REQS) derive > $(VENV)/requirements-derive.txt
+	$(PIP) install --quiet --disable-pip-version-check -r $(VENV)/requirements-derive.txt
 	$(PY) -m derive
 
 check-generated: $(STAMP)
 	$(PY) -m derive --check
 
-## bench: micro-benchmarks and the run-time benchmarks (writes docs/benchmarks.md data)
+## bench: micro-benchmarks and the run-time benchmarks, written to out/benchmarks/;
+## `make bench UPDATE_DOCS=--update-docs` writes the committed benchmarks/results/ and docs/figures/
+UPDATE_DOCS ?=
 bench: $(STAMP)
-	$(PY) benchmarks/bench_model.py
-	$(PY) benchmarks/bench_simulate.py
-	$(PY) benchmarks/bench_integrators.py
-	$(PY) benchmarks/bench_scenes.py
-	$(PY) benchmarks/work_precision.py
+	$(PY) benchmarks/bench_model.py $(UPDATE_DOCS)
+	$(PY) benchmarks/bench_simulate.py $(UPDATE_DOCS)
+	$(PY) benchmarks/bench_integrators.py $(UPDATE_DOCS)
+	$(PY) benchmarks/bench_scenes.py $(UPDATE_DOCS)
+	$(PY) benchmarks/work_precision.py $(UPDATE_DOCS)
 
-## study: slow studies (marked slow in tests/)
+## study: slow studies (marked slow in tests/), written to out/ (UPDATE_DOCS as for bench)
 study: $(STAMP)
-	$(PY) -m pytest -q -m slow
-	$(PY) benchmarks/stability_maps.py
+	PDW_UPDATE_DOCS=$(if $(UPDATE_DOCS),1,0) $(PY) -m pytest -q -m slow
+	$(PY) benchmarks/stability_maps.py $(UPDATE_DOCS)
+	$(PY) benchmarks/step_edge_grid.py $(UPDATE_DOCS)
 
 clean:
-	rm -rf build pdw/core/_core.c pdw/core/_hybrid.c pdw/core/*.so out
+	rm -rf build out
+	find pdw \( -name '*.so' -o -name '_core.c' -o -name '_hybrid.c' \) -delete
 
 distclean: clean
 	rm -rf $(VENV) *.egg-info

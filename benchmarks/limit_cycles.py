@@ -12,14 +12,13 @@ import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "benchmarks"))
-from _results import publish  # noqa: E402
+from _results import FIGURES, publish  # noqa: E402
 
 import pdw  # noqa: E402
 from pdw import cell_mapping as CM  # noqa: E402
 from pdw import hybrid as H  # noqa: E402
 from pdw import limit_cycle as LC  # noqa: E402
 
-FIGURES = ROOT / "docs" / "figures"
 P = pdw.Params.paper_steady()
 
 

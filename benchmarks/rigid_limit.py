@@ -21,13 +21,12 @@ import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "benchmarks"))
-from _results import publish  # noqa: E402
+from _results import FIGURES, publish  # noqa: E402
 
 import pdw  # noqa: E402
 from pdw import hybrid as H  # noqa: E402
 from pdw import limit_cycle as LC  # noqa: E402
 
-FIGURES = ROOT / "docs" / "figures"
 P0 = pdw.Params.paper_steady()
 K_N = (1e5, 3e5, 1e6, 3e6, 1e7, 3e7, 1e8, 3e8, 1e9)
 
@@ -192,8 +191,8 @@ def main():
     fig8(gh)
     plot_rigid(gh, rows, cycles)
     lines.append("")
-    lines.append("figures: docs/figures/fig8.png, docs/figures/rigid_limit.png (%.0f s)"
-                 % (time.perf_counter() - t0))
+    lines.append("figures: %s, %s (%.0f s)" % (FIGURES / "fig8.png", FIGURES / "rigid_limit.png",
+                                               time.perf_counter() - t0))
     publish("rigid_limit.txt", lines)
 
 

@@ -1,7 +1,7 @@
 """Drive scipy's ``solve_ivp`` (LSODA, Radau, DOP853, ...) with pdw's compiled model.
 
 The walker is a hybrid system: its right-hand side f depends on a discrete state (support
-flags, the arming of the scuffing guard, the tangential anchors; MODEL.md sections 5-6) that
+flags, the arming of the scuffing guard, the tangential anchors; docs/model.md sections 5-6) that
 changes only at flag switches. pdw's adaptive loops locate each switch inside a step and
 restart there (pdw/core/csrc/pdw_ode.c); this module does the same with scipy:
 

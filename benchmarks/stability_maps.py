@@ -22,13 +22,12 @@ import numpy as np
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from _results import RESULTS, publish  # noqa: E402
+from _results import FIGURES, RESULTS, publish  # noqa: E402
 
 import pdw  # noqa: E402
 from pdw.analysis import stability_maps as S  # noqa: E402
 from pdw.sim import stepsize as SL  # noqa: E402
 
-FIGURES = ROOT / "docs" / "figures"
 FIXED = SL.FIXED_STEP
 #: swept parameters: values (the paper's range is marked) -- a decade beyond each end
 SWEEPS = {
@@ -461,7 +460,7 @@ def main(argv=None):
     if "energy" in a.only:
         data["energy"] = energy_table()
     data["calibration"] = calibration(data.get("cells", []))
-    RESULTS.mkdir(exist_ok=True)
+    RESULTS.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(data, indent=1, default=float))
     lines = report(data.get("cells", []), data.get("chatter", []), data.get("claims", {}),
                    data.get("energy", []))

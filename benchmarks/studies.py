@@ -1,4 +1,4 @@
-"""Run every study of docs/studies/*.toml (the paper's Table 5 and Figs. 11-14), copy the
+"""Run every study of pdw/examples/studies/*.toml (the paper's Table 5 and Figs. 11-14), copy the
 figures to docs/figures/study_<name>.png and print the trends (first -> last point of each
 line) next to the paper's (benchmarks/results/studies.txt). `make study` runs it through
 tests/test_sweep.py::test_all_studies (slow).
@@ -12,13 +12,12 @@ import sys
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "benchmarks"))
-from _results import publish  # noqa: E402
+from _results import FIGURES, publish  # noqa: E402
 
 from pdw import sweep  # noqa: E402
 from pdw.present.study_plots import plot_study  # noqa: E402
 
-STUDIES = ROOT / "docs" / "studies"
-FIGURES = ROOT / "docs" / "figures"
+STUDIES = ROOT / "pdw" / "examples" / "studies"
 
 
 def trend_lines(res):
@@ -64,7 +63,7 @@ def main(argv=None):
     if args.names:
         files = [f for f in files if f.stem in args.names]
     FIGURES.mkdir(parents=True, exist_ok=True)
-    lines = ["Studies (docs/studies/*.toml): first -> last period-one point of each line", ""]
+    lines = ["Studies (pdw/examples/studies/*.toml): first -> last period-one point of each line", ""]
     total = 0.0
     for f in files:
         res = sweep.run_study(f, pathlib.Path(args.out) / f.stem, workers=args.workers,

@@ -22,7 +22,9 @@ from pdw import sweep  # noqa: E402
 STUDY = """
 name = "speedup"
 title = "speed-up benchmark: k_n x k_hip"
+[scene]
 preset = "paper_steady"
+stop = { t_end = 20.0 }
 [[axes]]
 name = "k_n"
 start = 0.5e5
@@ -32,7 +34,6 @@ num = 40
 name = "k_hip"
 values = [0.9, 0.95, 1.0]
 [run]
-t_end = 20.0
 fallback = false
 """
 

@@ -32,13 +32,13 @@ import sys
 import time
 
 import numpy as np
-from _results import RESULTS
+from _results import FIGURES, RESULTS
 from scipy_driver import simulate_scipy
 
 import pdw
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-FIGURE = ROOT / "docs" / "figures" / "work_precision.png"
+FIGURE = FIGURES / "work_precision.png"
 CSV = RESULTS / "work_precision.csv"
 TARGET = 1e-6                     # headline: error of q(3.5 s)
 
@@ -323,7 +323,7 @@ COLUMNS = ("problem", "kind", "method", "setting", "param", "value", "t_end", "s
 
 
 def write_csv(rows):
-    RESULTS.mkdir(exist_ok=True)
+    RESULTS.mkdir(parents=True, exist_ok=True)
     with open(CSV, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=COLUMNS)
         w.writeheader()

@@ -1,7 +1,7 @@
-"""The hybrid (impact-momentum) walker of MODEL.md section 9, from the same Lagrangian.
+"""The hybrid (impact-momentum) walker of docs/model.md section 9, from the same Lagrangian.
 
 Rigid ground; the stance foot rolls without slip: the velocity of its material contact point is
-zero (v_x = v_y = 0, the *consistent* normal rate of MODEL.md section 6). For the stance leg i
+zero (v_x = v_y = 0, the *consistent* normal rate of docs/model.md section 6). For the stance leg i
 the constraint J_i(q) qd = 0, with J_i the 2x4 Jacobian of `model.material_velocity(i)`, is
 holonomic (for the arc foot as for the point foot r = 0)::
 
@@ -153,6 +153,52 @@ def impact_terms():
     return list(M) + J
 
 
+# --- variational equations and saltation (continuation, exact monodromy) ----------------------
+
+def stance_jacobian_terms():
+    """The pieces of d(ydot)/dy (4x4) of the stance phase, without inverting M_r symbolically.
+
+    ydot = [phid, phidd] with M_r(phi) phidd = f_r(y), so for each y_k
+    d phidd / d y_k = M_r^{-1} (d f_r / d y_k - (d M_r / d y_k) phidd), and M_r depends on phi
+    only. Returns [dM_r/dtheta_st (4, row-major), dM_r/dtheta_sw (4), df_r/dy (2x4 row-major)].
+    """
+    Mr, fr = reduced_dynamics("projection")
+    out = []
+    for k in range(2):
+        out += [sp.simplify(sp.diff(e, PHI[k])) for e in Mr]
+    for i in range(2):
+        out += [sp.simplify(sp.diff(fr[i], Y[k])) for k in range(4)]
+    return out
+
+
+def swing_foot_gradient():
+    """d y_sw / d y (4): the gradient of the heel-strike event function (swing foot height)."""
+    y_sw = swing_foot()[0]
+    return [sp.simplify(sp.diff(y_sw, s)) for s in Y]
+
+
+def impact_jacobian_terms():
+    """Derivatives of the impact's KKT data along the stance embedding q = Phi(phi), qd = B phid.
+
+    Returns [dM/dtheta_st (16), dM/dtheta_sw (16), dJ_2/dtheta_st (8), dJ_2/dtheta_sw (8),
+    d qd / d y (4x4 row-major)], M the full mass matrix, J_2 the swing foot's material-point
+    Jacobian (2x4, row-major), qd = B(phi) phid the full velocities: with them the impact map's
+    derivative follows from differentiating K s = b (`pdw_hybrid_impact_jac`).
+    """
+    Phi, B = embedding()
+    qsub = dict(zip(mdl.Q, Phi))
+    M = mdl.mechanics().M.xreplace(qsub)
+    J2 = mdl.material_velocity(1).jacobian(sp.Matrix(mdl.QD)).xreplace(qsub)
+    out = []
+    for k in range(2):
+        out += [sp.simplify(sp.diff(e, PHI[k])) for e in M]
+    for k in range(2):
+        out += [sp.simplify(sp.diff(e, PHI[k])) for e in J2]
+    qd = B * sp.Matrix(PHID)
+    out += [sp.simplify(sp.diff(qd[i], Y[k])) for i in range(4) for k in range(4)]
+    return out
+
+
 # --- emission --------------------------------------------------------------------------------
 
 def _names():
@@ -191,7 +237,13 @@ void pdw_hybrid_energies(const double *y, const double *p, double *e);
 /* full-model state x (PDW_NX) with the stance leg as leg 1, s0 = 0 */
 void pdw_hybrid_full_state(const double *y, const double *p, double *x);
 /* M(q) (16) then J_1, J_2 (8 each: 2x4 row-major) of the feet's material-point velocities */
-void pdw_hybrid_impact_terms(const double *q, const double *p, double *MJ);"""
+void pdw_hybrid_impact_terms(const double *q, const double *p, double *MJ);
+/* dM_r/dtheta_st (4), dM_r/dtheta_sw (4), df_r/dy (8: 2x4 row-major) of the stance phase */
+void pdw_hybrid_stance_jac_terms(const double *y, const double *p, double *dMf);
+/* gradient d y_sw / d y (4) of the swing foot's height (the heel-strike event function) */
+void pdw_hybrid_swing_foot_grad(const double *y, const double *p, double *g);
+/* dM/dphi (2 x 16), dJ_2/dphi (2 x 8), d qd / d y (16: 4x4 row-major) along q = Phi(phi) */
+void pdw_hybrid_impact_jac_terms(const double *y, const double *p, double *dK);"""
 
 RHS = """\
 int pdw_hybrid_rhs(const double *restrict y, const double *restrict p, double *restrict ydot)
@@ -214,7 +266,7 @@ def header(h, banner):
         "#ifndef PDW_HYBRID_H\n#define PDW_HYBRID_H\n",
         '#include "pdw_model.h"\n',
         '#define PDW_HYBRID_INPUT_HASH "%s"\n' % h,
-        "/* reduced state of the stance phase (MODEL.md section 9): stance leg, swing leg */",
+        "/* reduced state of the stance phase (docs/model.md section 9): stance leg, swing leg */",
         _enum("HY", STATE), "",
         "/* swing-foot quantities (pdw_hybrid_swing_foot) */",
         _enum("HYFOOT", FOOT), "",
@@ -249,6 +301,18 @@ def source(banner):
     parts.append(_function("void pdw_hybrid_impact_terms(const double *restrict q, "
                            "const double *restrict p, double *restrict MJ)",
                            "    (void)q; (void)p;\n" + code))
+    code, _ = c_block(stance_jacobian_terms(), ["dMf[%d]" % i for i in range(16)], names)
+    parts.append(_function("void pdw_hybrid_stance_jac_terms(const double *restrict y, "
+                           "const double *restrict p,\n    double *restrict dMf)",
+                           "    (void)y; (void)p;\n" + code))
+    code, _ = c_block(swing_foot_gradient(), ["g[%d]" % i for i in range(4)], names)
+    parts.append(_function("void pdw_hybrid_swing_foot_grad(const double *restrict y, "
+                           "const double *restrict p,\n    double *restrict g)",
+                           "    (void)y; (void)p;\n" + code))
+    code, _ = c_block(impact_jacobian_terms(), ["dK[%d]" % i for i in range(64)], names)
+    parts.append(_function("void pdw_hybrid_impact_jac_terms(const double *restrict y, "
+                           "const double *restrict p,\n    double *restrict dK)",
+                           "    (void)y; (void)p;\n" + code))
     return "\n".join(parts)
 
 

@@ -9,7 +9,7 @@ the Python module ``pdw/core/_layout.py``. No other file may hard-code an index.
 STATE = ("x_o", "y_o", "theta1", "theta2", "xd_o", "yd_o", "thetad1", "thetad2")
 NQ = 4
 
-# Physical parameters (paper Tables 1-3, MODEL.md section 1), in this order.
+# Physical parameters (paper Tables 1-3, docs/model.md section 1), in this order.
 PARAMS = (
     "l", "c", "w", "r", "J_l", "m_h", "m_l", "k_hip", "d_hip", "gamma", "g",
     "k_n", "d_n", "k_t", "d_t", "v_s", "v_d", "mu_s", "mu_d",
@@ -30,7 +30,7 @@ CONTACT_PARAMS = (
 # Lankarani-Nikravesh and Flores damping), foot-major within each kind.
 ANCHORS = ("s0_1", "s0_2", "v_in1", "v_in2")
 
-# Per-foot contact kinematics (MODEL.md section 2, Eqs. 4, 5, 8, 9), for the kernel's variant.
+# Per-foot contact kinematics (docs/model.md section 2, Eqs. 4, 5, 8, 9), for the kernel's variant.
 KIN = (
     "x_D",    # contact point, along the slope [m] (Eq. 4)
     "y_D",    # contact point height above the slope [m]; depth delta = -y_D (Eq. 4)
@@ -41,7 +41,7 @@ KIN = (
     "v_in",   # approach speed -v_y captured at the foot's touch-down [m/s] (anchors)
 )
 
-# Per-foot contact forces and their partial derivatives (MODEL.md section 4, Eqs. 3, 6, 7, 10, 11).
+# Per-foot contact forces and their partial derivatives (docs/model.md section 4, Eqs. 3, 6, 7, 10, 11).
 CONTACT = (
     "F_n",          # normal force, +Y [N]
     "F_t",          # tangential force, +X [N] (spring-damper + friction)
@@ -52,7 +52,7 @@ CONTACT = (
     "dFt_dv",       # partial F_t / partial v_x (includes F_n dmu/dv)
 )
 
-# Energies (MODEL.md section 3).
+# Energies (docs/model.md section 3).
 ENERGY = ("T", "V_gravity", "V_hip")
 
 # Contact flags carried as discrete state by every simulation.
@@ -60,7 +60,7 @@ FLAGS = ("leg1", "leg2")
 
 
 # --- simulation records (the compiled time loops) -------------------------------------------
-# One contact event (a support-flag change, MODEL.md section 5), a row of doubles.
+# One contact event (a support-flag change, docs/model.md section 5), a row of doubles.
 EVENT = ("t", "leg", "kind", "x_D", "y_D")
 EVENT_KIND = ("lift_off", "touch_down")
 # Contact forces recorded per sample: foot-major.
@@ -82,7 +82,7 @@ STOP = (
     "periodic",     # the last k steps agreed within the tolerance
 )
 
-# Per-step gait descriptors (MODEL.md section 8), computed online in the compiled loop as the
+# Per-step gait descriptors (docs/model.md section 8), computed online in the compiled loop as the
 # events happen, with the definitions of pdw/sim/gait.py; one row of doubles per complete step.
 STEP = (
     "leg",              # swing leg of the step (0 or 1, as in EVENT)

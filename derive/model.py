@@ -1,6 +1,6 @@
 """Symbolic model of the flexible planar passive walker on compliant ground.
 
-Everything here follows ``shared/MODEL.md`` (the specification); equation numbers
+Everything here follows docs/model.md (the specification); equation numbers
 are the paper's. The functions return SymPy expressions built deterministically
 (no dict/set iteration order leaks into them), so that `derive.emit` produces the
 same bytes on every run.
@@ -11,7 +11,7 @@ Stages, in data-flow order:
    and the Christoffel matrix C printed in the appendix (used by the central
    difference method, whose result depends on C itself).
 2. `contact_kinematics` -- contact point, depth, normal rate, slip velocity,
-   tangential deformation of one foot (Eqs. 4, 5, 8, 9), per variant (MODEL.md section 6).
+   tangential deformation of one foot (Eqs. 4, 5, 8, 9), per variant (docs/model.md section 6).
 3. `contact_laws` -- Hunt-Crossley normal force (Eqs. 3, 6, clamped at 0), the
    friction coefficient of Eq. 10, the tangential spring-damper plus friction
    (Eqs. 7, 11), and their partial derivatives.
@@ -72,7 +72,7 @@ class Mechanics:
 
 
 def points():
-    """Hip H, leg centres of mass G_i and foot-arc centres A_i (MODEL.md section 2)."""
+    """Hip H, leg centres of mass G_i and foot-arc centres A_i (docs/model.md section 2)."""
     l, c, w, r = P["l"], P["c"], P["w"], P["r"]
     xo, yo = Q[0], Q[1]
     H = sp.Matrix([xo, yo])
@@ -91,7 +91,7 @@ def _time_derivative(expr):
 
 @functools.lru_cache(maxsize=None)
 def mechanics() -> Mechanics:
-    """Lagrange's equations from T and V of MODEL.md section 3 (computed once, cached: treat
+    """Lagrange's equations from T and V of docs/model.md section 3 (computed once, cached: treat
     the returned matrices as read-only)."""
     m_h, m_l, J_l, g, k_hip = P["m_h"], P["m_l"], P["J_l"], P["g"], P["k_hip"]
     sg, cg = P["sin_gamma"], P["cos_gamma"]
@@ -120,7 +120,7 @@ def mechanics() -> Mechanics:
 
 
 def contact_kinematics(foot: int, variant: str) -> dict:
-    """Contact quantities of foot ``foot`` (0 or 1) for ``variant`` (MODEL.md sections 2, 6).
+    """Contact quantities of foot ``foot`` (0 or 1) for ``variant`` (docs/model.md sections 2, 6).
 
     Returns a dict keyed by `layout.KIN` field names (all functions of x and,
     for the ``consistent`` xi, of the anchor symbol s0_i).
@@ -160,7 +160,7 @@ def cubic_step(x, x0, h0, x1, h1):
 
 
 def friction_coefficient(v):
-    """Smooth odd friction coefficient mu(v) of Eq. 10 (MODEL.md section 4); opposes slip."""
+    """Smooth odd friction coefficient mu(v) of Eq. 10 (docs/model.md section 4); opposes slip."""
     vs, vd, ms, md = P["v_s"], P["v_d"], P["mu_s"], P["mu_d"]
     return sp.Piecewise(
         (md, v <= -vd),
@@ -178,7 +178,7 @@ def contact_laws(variant: str, features=FEATURES, normal: str = "hunt_crossley")
     Parameters
     ----------
     variant : {"paper", "consistent"}
-        Selects the tangential deformation's gate (MODEL.md section 6).
+        Selects the tangential deformation's gate (docs/model.md section 6).
     features : iterable of str
         Force elements present; those absent are folded to zero.
     normal : str

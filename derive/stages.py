@@ -1,6 +1,6 @@
 """Per-kernel stage expressions, ready for C emission.
 
-A *kernel* is one specialization of the model: a contact variant (MODEL.md
+A *kernel* is one specialization of the model: a contact variant (docs/model.md
 section 6) and the set of force elements present. Absent elements are folded to
 zero here, before common-subexpression elimination, so that a kernel never
 evaluates a force its scene switched off.
@@ -135,6 +135,6 @@ def dynamics_jacobian(spec: KernelSpec):
 
 
 def energies(spec: KernelSpec):
-    """T, V_gravity, V_hip (MODEL.md section 3)."""
+    """T, V_gravity, V_hip (docs/model.md section 3)."""
     mech = mdl.mechanics()
     return [_trig(e) for e in (mech.T, mech.V_gravity, mdl.fold_parameters(mech.V_hip, spec.features))]

@@ -20,13 +20,20 @@ hybrid                  the rigid-ground impact-momentum model (docs/model.md se
 find_gait               period-one gait of the continuous model: Newton shooting on the touch-down
                         Poincare map, Floquet multipliers (pdw.limit_cycle; cell mapping:
                         pdw.cell_mapping)
+continue_gait, Branch   continuation of gaits in one parameter: branches, Floquet multipliers,
+                        folds, period doublings, Neimark-Sacker, ends (pdw.analysis.continuation;
+                        ``pdw continue``)
 sweep                   parameter studies from TOML files: run_study, load_study (``pdw sweep``)
+examples                the scenes and studies shipped with pdw (``pdw run --list-examples``)
 PdwError, SimulationError, DivergedError, InvalidInputError   the error hierarchy
 STATE, VARIANTS         the state layout and the contact variants (docs/model.md section 6)
 """
 import sys as _sys
 
+from . import examples  # package data: the shipped scenes and studies
 from .analysis import cell_mapping, hybrid, limit_cycle
+from .analysis.branch import Bifurcation, Branch
+from .analysis.continuation import continue_gait
 from .analysis.gait_types import Gait
 from .analysis.limit_cycle import find_gait
 from .core import __version__  # noqa: F401 (pdw.__version__)
@@ -73,5 +80,6 @@ __all__ = [
     "X0_DISTURBED", "steps", "Steps", "PdwError", "SimulationError", "DivergedError",
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait", "Scene", "run",
     "limit_cycle", "cell_mapping", "find_gait", "sweep",
-    "StepSizeWarning", "StepSizeError", "Contact",
+    "StepSizeWarning", "StepSizeError", "examples", "continue_gait", "Branch", "Bifurcation",
+    "Contact",
 ]

@@ -2,7 +2,8 @@
 
 The symbolic derivation (`derive/`) lives at the repository root and is not part of the
 installed package: put the root on sys.path so that ``import derive`` works however pytest
-is started.
+is started. It goes at the *end* of sys.path, so that an installed pdw (a wheel, with its
+compiled modules) wins over the uncompiled sources of an unpacked sdist.
 """
 import pathlib
 import sys
@@ -11,7 +12,7 @@ import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+    sys.path.append(str(ROOT))
 
 
 @pytest.fixture(scope="session")

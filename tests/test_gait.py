@@ -1,4 +1,4 @@
-"""Gait descriptors on hand-built event sequences (MODEL.md section 8 definitions)."""
+"""Gait descriptors on hand-built event sequences (docs/model.md section 8 definitions)."""
 import math
 
 import numpy as np
@@ -63,7 +63,7 @@ def test_text_table_lists_every_step():
 
 
 def test_typical_gait_descriptors_are_close_to_the_paper():
-    """paper_steady (MODEL.md section 8): footprint L and P within about 10 % of the paper's."""
+    """paper_steady (docs/model.md section 8): footprint L and P within about 10 % of the paper's."""
     r = pdw.simulate(t_end=12.0, params=pdw.Params.paper_steady(), record_every=0)
     sd = pdw.steps(r).steady(4)
     assert sd["L"] == pytest.approx(0.397, rel=0.12)

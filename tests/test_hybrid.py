@@ -1,4 +1,4 @@
-"""The hybrid (impact-momentum) walker of MODEL.md section 9 (pdw.hybrid, derive/hybrid.py)."""
+"""The hybrid (impact-momentum) walker of docs/model.md section 9 (pdw.hybrid, derive/hybrid.py)."""
 import pathlib
 import sys
 
@@ -97,7 +97,7 @@ def test_projection_and_lagrangian_routes_agree_symbolically():
 
 
 def _constraint(x, params, foot):
-    """J (2x4) and Jdot qd (2,) of the foot's material-point velocity (MODEL.md section 2)."""
+    """J (2x4) and Jdot qd (2,) of the foot's material-point velocity (docs/model.md section 2)."""
     l, r = params.l, params.r
     th, thd = x[2 + foot], x[6 + foot]
     J = np.zeros((2, 4))
@@ -283,7 +283,7 @@ def test_paper_steady_hybrid_gait(steady_gait):
 
 def test_paper_params_have_no_hybrid_gait():
     """With the paper's d_hip = 0.018 no period-one hybrid gait is found either (as for the
-    compliant model, MODEL.md section 8)."""
+    compliant model, docs/model.md section 8)."""
     with pytest.raises(GaitNotFoundError) as info:
         H.find_gait(pdw.Params.paper(), settle_steps=15)
     assert info.value.attempts

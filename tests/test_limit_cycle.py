@@ -95,7 +95,7 @@ def test_period_two_search_finds_the_period_one_gait(gait):
 
 
 def test_paper_damping_has_no_gait():
-    """MODEL.md section 8: with the paper's d_hip = 0.018 the walker falls; no period-one gait."""
+    """docs/model.md section 8: with the paper's d_hip = 0.018 the walker falls; no period-one gait."""
     Pp = pdw.Params.paper()
     d = LC.detect_period(Pp)
     assert d["kind"] == "fell"

@@ -2,7 +2,7 @@
 
 Only the public API is used (pdw.rhs, pdw.mass_matrix, pdw.contact_forces, pdw.energies),
 together with this module's own formulas for the centre of mass and the feet's material-point
-velocities (MODEL.md section 2): M is symmetric positive definite; energy is conserved without
+velocities (docs/model.md section 2): M is symmetric positive definite; energy is conserved without
 contact and dissipation, and its rate equals the power of the contact forces and the hip damper;
 the centre of mass obeys Newton's law with the contact forces; a free leg hangs at theta = gamma
 - atan(w / c).
@@ -22,7 +22,7 @@ PARAM_SETS = {
                           d_hip=0.07, gamma=0.09, g=9.81, k_n=3e4, d_n=2e5, k_t=40.0, d_t=300.0,
                           v_s=2e-4, v_d=3e-3, mu_s=0.7, mu_d=0.45),
 }
-X0_PAPER = np.array([0, 0.4969, -0.0582, 0.0582, 0.5092, 0.0186, 3.3338, -1.0093])   # MODEL.md 8
+X0_PAPER = np.array([0, 0.4969, -0.0582, 0.0582, 0.5092, 0.0186, 3.3338, -1.0093])   # docs/model.md 8
 
 
 def E_total(x, p):
@@ -30,7 +30,7 @@ def E_total(x, p):
 
 
 def com(x, p):
-    """Centre of mass position of the walker, our own formula (MODEL.md section 2)."""
+    """Centre of mass position of the walker, our own formula (docs/model.md section 2)."""
     x = np.atleast_2d(x)
     m = p.m_h + 2 * p.m_l
     pos = p.m_h * x[:, :2].copy()
@@ -262,7 +262,7 @@ def test_gravity_torque_from_rhs_equals_energy_gradient():
 
 # --- contact forces -------------------------------------------------------------------------------
 def test_static_sink_under_the_walkers_weight_is_about_5_mm():
-    """MODEL.md section 1: k_n = 1e5 gives a static sink of about 5 mm under the walker's weight."""
+    """docs/model.md section 1: k_n = 1e5 gives a static sink of about 5 mm under the walker's weight."""
     p = P_PAPER
     lo, hi = 0.0, 0.02
     for _ in range(60):                                      # bisection on the depth, leg vertical
@@ -275,7 +275,7 @@ def test_static_sink_under_the_walkers_weight_is_about_5_mm():
 
 
 def test_paper_initial_state_stance_force_is_the_weight_only_with_printed_eq5():
-    """MODEL.md section 6: at the paper's initial state the stance force equals the walker's weight
+    """docs/model.md section 6: at the paper's initial state the stance force equals the walker's weight
     under the printed Eq. 5 (variant paper), not under the consistent rate."""
     p = P_PAPER
     paper = pdw.contact_forces(X0_PAPER, p, flags=(0, 1), variant="paper")

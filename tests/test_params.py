@@ -1,4 +1,4 @@
-"""pdw.Params: presets (MODEL.md sections 1 and 8) and validation (the error names the field and
+"""pdw.Params: presets (docs/model.md sections 1 and 8) and validation (the error names the field and
 its allowed range)."""
 import dataclasses
 import math
@@ -10,7 +10,7 @@ import pytest
 import pdw
 from pdw import Params
 
-# MODEL.md section 1, typed in from the table
+# docs/model.md section 1, typed in from the table
 MODEL_MD_TABLE = dict(
     l=0.5, c=0.1, w=-0.0025, r=0.2, J_l=0.0398, m_h=2.0, m_l=1.0, k_hip=0.95, d_hip=0.018,
     gamma=0.02, g=9.8, k_n=1e5, d_n=1e6, k_t=90.0, d_t=900.0, v_s=1e-4, v_d=1e-3, mu_s=0.5, mu_d=0.4,

@@ -37,9 +37,11 @@ def _events_double_supports(result):
     return pairs
 
 
-def test_import_does_not_need_matplotlib():
+def test_import_does_not_need_matplotlib(tmp_path):
     code = "import sys, pdw, pdw.present.plots; print('matplotlib' in sys.modules)"
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    # cwd: a neutral folder, so that the pdw under test is imported (not sources in the cwd)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         cwd=tmp_path)
     assert out.stdout.strip() == "False"
 
 

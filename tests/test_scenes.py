@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import pdw
+import pdw.examples
 from pdw import METHODS
 from pdw.core import _layout
 from pdw.present import cli
@@ -118,7 +119,7 @@ def test_stop_when_periodic_stops_as_soon_as_the_last_k_steps_agree(k, tol, full
 
 
 def test_a_gait_that_does_not_converge_is_not_stopped():
-    """The paper's d_hip = 0.018 gait decays and falls (MODEL.md section 8): no periodic stop."""
+    """The paper's d_hip = 0.018 gait decays and falls (docs/model.md section 8): no periodic stop."""
     r = pdw.simulate(t_end=8.0, record_every=0, periodic_steps=4, periodic_tol=1e-4)
     assert r.status == "fell" and r.stop_reason == "fell"
 
@@ -324,7 +325,7 @@ def test_invalid_toml_is_reported(tmp_path):
 # ------------------------------------------------------------------ the shipped example, CLI
 
 def test_shipped_example_runs_with_pdw_run(tmp_path, capsys):
-    example = ROOT / "docs" / "examples" / "typical_gait.toml"
+    example = pdw.examples.scene_path("typical_gait")
     sc = Scene.load(example)
     assert sc == Scene.from_toml(sc.to_toml())
     rc = cli.main(["run", str(example), "--out", str(tmp_path)])
@@ -340,7 +341,8 @@ def test_shipped_example_runs_with_pdw_run(tmp_path, capsys):
 def test_pdw_run_reports_a_fall_with_code_3(tmp_path, capsys):
     path = Scene(stop={"t_end": 8.0}, record=Record.events_only()).save(tmp_path / "f.toml")
     assert cli.main(["run", str(path)]) == 3
-    assert "fell" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "fell" in out and "no steady values: the run fell" in out and "steady (mean" not in out
 
 
 def test_pdw_walk_still_works(tmp_path, capsys):

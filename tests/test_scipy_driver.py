@@ -1,5 +1,5 @@
 """The scipy driver of the work-precision benchmark (benchmarks/scipy_driver.py): scipy's
-solve_ivp on pdw's compiled f and Jacobian, the flag switches of MODEL.md section 5 as terminal
+solve_ivp on pdw's compiled f and Jacobian, the flag switches of docs/model.md section 5 as terminal
 events. The comparison in docs/work_precision.md is fair only if the driver integrates the same
 hybrid system as pdw's loops: same switch rules, same event times."""
 import numpy as np

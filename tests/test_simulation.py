@@ -3,7 +3,6 @@ import math
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
 
 import pdw
 from pdw import X0_PAPER
@@ -14,6 +13,7 @@ FLIGHT_X0 = np.array([0.0, 10.0, -0.2, 0.3, 0.5, 0.0, 2.0, -1.0])  # feet ~9.5 m
 
 
 def _reference_flight(params, t_end):
+    solve_ivp = pytest.importorskip("scipy.integrate").solve_ivp     # the test extra
     sol = solve_ivp(lambda t, x: pdw.rhs(x, params, flags=(0, 0)), (0, t_end), FLIGHT_X0,
                     method="DOP853", rtol=1e-13, atol=1e-13)
     return sol.y[:, -1]
@@ -43,7 +43,7 @@ def test_typical_gait_walks_3_5_s_with_the_paper_variant():
     assert len(td) >= 5 and len(lo) >= 5
     # legs alternate: touch-downs by 1, 2, 1, 2 ...
     assert all(a.leg != b.leg for a, b in zip(td, td[1:]))
-    # the stance force settles near the weight (MODEL.md section 8)
+    # the stance force settles near the weight (docs/model.md section 8)
     i2 = (r.t > 1.1) & (r.t < 1.3)            # mid-stance of leg 2
     assert np.all(r.flags[i2, 1] == 1)
     assert r.Fn[i2, 1].mean() == pytest.approx(r.params.weight, rel=0.1)
@@ -77,7 +77,7 @@ def test_a_foot_touching_down_ahead_is_caught():
 
 
 def test_paper_params_fall_after_a_few_steps_paper_steady_walks():
-    """MODEL.md section 8: with d_hip = 0.018 the gait decays and falls after 6-9 steps (4-6 s)."""
+    """docs/model.md section 8: with d_hip = 0.018 the gait decays and falls after 6-9 steps (4-6 s)."""
     for variant in ("paper", "consistent"):
         r = pdw.simulate(t_end=20.0, variant=variant, record_every=0)
         assert r.status == "fell", variant

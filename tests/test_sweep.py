@@ -10,19 +10,22 @@ import numpy as np
 import pytest
 
 import pdw
+import pdw.examples
 import pdw.present.cli
 from pdw import sweep as S
 from pdw.present.study_plots import plot_study
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-STUDY_FILES = sorted((ROOT / "docs" / "studies").glob("*.toml"))
+STUDY_FILES = [pdw.examples.study_path(n) for n in pdw.examples.studies()]
 
 TINY = """
 name = "tiny"
 title = "tiny k_n study"
+[scene]
 preset = "paper_steady"
 variant = "paper"
-method = "rodas4"
+integrator = { method = "rodas4" }
+stop = { t_end = 6.0 }
 [[axes]]
 name = "k_n"
 values = [0.8e5, 1.0e5, 1.2e5]
@@ -30,7 +33,6 @@ values = [0.8e5, 1.0e5, 1.2e5]
 name = "k_hip"
 values = [0.95, 1.0]
 [run]
-t_end = 6.0
 steady = 3
 period_tol = 1e-3
 fallback = false
@@ -72,10 +74,14 @@ def test_study_files_parse():
     ("[[axes]]\nname='k_x'\nvalues=[1e5]", "Params field"),
     ("[[axes]]\nname='k_n'\nstart=1\nstop=2", "missing num"),
     ("[[axes]]\nname='k_n'\nvalues=[-1.0]", "k_n"),
-    ("variant='other'\n[[axes]]\nname='k_n'\nvalues=[1e5]", "variant"),
+    ("[scene]\nvariant='other'\n[[axes]]\nname='k_n'\nvalues=[1e5]", "scene.*variant"),
     ("[run]\nmode='guess'\n[[axes]]\nname='k_n'\nvalues=[1e5]", "mode"),
-    ("[run]\nt_end='long'\n[[axes]]\nname='k_n'\nvalues=[1e5]", "t_end"),
-    ("[params]\nk_n=2e5\n[[axes]]\nname='k_n'\nvalues=[1e5]", "swept and also fixed"),
+    ("[scene.stop]\nt_end='long'\n[[axes]]\nname='k_n'\nvalues=[1e5]", "stop.t_end"),
+    ("[scene.integrator]\nmthod='cdm'\n[[axes]]\nname='k_n'\nvalues=[1e5]", "integrator.mthod"),
+    ("[scene.params]\nk_n=2e5\n[[axes]]\nname='k_n'\nvalues=[1e5]", "swept and also fixed"),
+    # the earlier format: the key's new place is named
+    ("variant='consistent'\n[[axes]]\nname='k_n'\nvalues=[1e5]", "scene.variant"),
+    ("[run]\nt_end=6.0\n[[axes]]\nname='k_n'\nvalues=[1e5]", "scene.stop.t_end"),
     ("title='no axes'", "one or two"),
 ])
 def test_bad_study_files_name_the_key(text, match):
@@ -233,10 +239,11 @@ def test_run_point_reports_bad_points_as_rows(tiny):
 
 @pytest.mark.slow
 def test_all_studies():
-    """The paper's Table 5 and Figs. 11-14 (docs/studies/*.toml): figures in docs/figures/,
+    """The paper's Table 5 and Figs. 11-14 (pdw/examples/studies/*.toml): figures in docs/figures/,
     trends in benchmarks/results/studies.txt (a few tens of seconds)."""
     sys.path.insert(0, str(ROOT / "benchmarks"))
+    import _results
     import studies
     studies.main([])
-    text = (ROOT / "benchmarks" / "results" / "studies.txt").read_text()
+    text = (_results.RESULTS / "studies.txt").read_text()
     assert "fig11_k_n" in text and "table5_r" in text

@@ -1,6 +1,6 @@
-"""Symbolic tests: the derivation in derive/ reproduces MODEL.md sections 2-4 and 6 exactly.
+"""Symbolic tests: the derivation in derive/ reproduces docs/model.md sections 2-4 and 6 exactly.
 
-Everything MODEL.md prints is TRANSCRIBED HERE by hand, with this module's own SymPy symbols
+Everything docs/model.md prints is TRANSCRIBED HERE by hand, with this module's own SymPy symbols
 (same names and assumptions as derive/, so that they compare equal); from derive/ only the
 derived side is taken: `mechanics()`, `generalized_forces()`, `contact_kinematics()`,
 `material_velocity()`, `friction_coefficient()` and `contact_laws()`. Equality is shown with
@@ -17,7 +17,7 @@ def R(name):
     return sp.Symbol(name, real=True)
 
 
-# --- our own symbols (MODEL.md notation, derive/layout.py spelling) ---------------------------
+# --- our own symbols (docs/model.md notation, derive/layout.py spelling) ---------------------------
 x_o, y_o, th1, th2 = R("x_o"), R("y_o"), R("theta1"), R("theta2")
 xd_o, yd_o, thd1, thd2 = R("xd_o"), R("yd_o"), R("thetad1"), R("thetad2")
 l, c, w, r, J_l = R("l"), R("c"), R("w"), R("r"), R("J_l")
@@ -37,7 +37,7 @@ s1, c1, s2, c2 = sp.sin(th1), sp.cos(th1), sp.sin(th2), sp.cos(th2)
 m = m_h + 2 * m_l
 UNGAMMA = {sin_gamma: sp.sin(gamma), cos_gamma: sp.cos(gamma)}
 
-# --- MODEL.md section 3, transcribed ---------------------------------------------------------
+# --- docs/model.md section 3, transcribed ---------------------------------------------------------
 M_T = sp.Matrix([
     [m, 0, m_l * (c * c1 - w * s1), m_l * (c * c2 - w * s2)],
     [0, m, m_l * (c * s1 + w * c1), m_l * (c * s2 + w * c2)],
@@ -70,7 +70,7 @@ def _ddt(expr):
 
 
 def _points():
-    """Hip H and leg centres of mass G_i of MODEL.md section 2, our own transcription."""
+    """Hip H and leg centres of mass G_i of docs/model.md section 2, our own transcription."""
     H = sp.Matrix([x_o, y_o])
     Gs = []
     for th in TH:
@@ -111,7 +111,7 @@ def test_coriolis_product_matches_model_md(mech):
 
 
 def test_christoffel_matrix_is_the_printed_appendix_c(mech):
-    # the central difference method (MODEL.md section 7) depends on C itself, not only on C qd
+    # the central difference method (docs/model.md section 7) depends on C itself, not only on C qd
     assert is_zero_matrix(mech.C - C_T)
     assert is_zero_matrix(mech.C * qd - mech.Cqd)
 
@@ -146,7 +146,7 @@ def test_energies_match_model_md(mech):
 
 
 def test_model_md_matrices_are_lagranges_equations():
-    """MODEL.md's M, C, G follow from its own T and V (independent of derive/)."""
+    """docs/model.md's M, C, G follow from its own T and V (independent of derive/)."""
     T, Vg, Vh = _T_V()
     L = T - Vg - Vh
     eqs = []
@@ -221,7 +221,7 @@ def _step(x, x0, h0, x1, h1):
     return h0 + (h1 - h0) * D**2 * (3 - 2 * D)
 
 
-MU_BRANCHES = [   # (expression, lower end, upper end), in the order of MODEL.md section 4
+MU_BRANCHES = [   # (expression, lower end, upper end), in the order of docs/model.md section 4
     (mu_d, None, -v_d),
     (_step(v_t, -v_d, mu_d, -v_s, mu_s), -v_d, -v_s),
     (_step(v_t, -v_s, mu_s, v_s, -mu_s), -v_s, v_s),
@@ -271,11 +271,11 @@ def test_friction_is_odd(mu_pieces):
 
 
 def test_friction_slope_at_zero_is_steep(mu_pieces):
-    # |dmu/dv| at 0 = 3 mu_s / (2 v_s) (MODEL.md: about 0.75 / v_s)
+    # |dmu/dv| at 0 = 3 mu_s / (2 v_s) (docs/model.md: about 0.75 / v_s)
     assert is_zero(sp.diff(mu_pieces[2], v_t).subs(v_t, 0) + 3 * mu_s / (2 * v_s))
 
 
-# exact rational parameter sets: MODEL.md section 1 and an unrelated one
+# exact rational parameter sets: docs/model.md section 1 and an unrelated one
 PARAM_SETS = [
     {k_n: 10**5, d_n: 10**6, k_t: 90, d_t: 900, v_s: sp.Rational(1, 10**4), v_d: sp.Rational(1, 10**3),
      mu_s: sp.Rational(1, 2), mu_d: sp.Rational(2, 5)},
@@ -309,7 +309,7 @@ def test_friction_piecewise_conditions_exact(pset):
 
 # --- section 4: normal and tangential laws (Eqs. 3, 6, 7, 11) ---------------------------------
 def _laws_transcribed(variant, P):
-    """F_n, F_t of one penetrating support foot at exact values (MODEL.md section 4)."""
+    """F_n, F_t of one penetrating support foot at exact values (docs/model.md section 4)."""
     def laws(dl, dld, vt, x):
         fn = P[k_n] * dl**sp.Rational(3, 2) + P[d_n] * dl**sp.Rational(3, 2) * dld
         fn = max(fn, 0)                                            # the ground cannot pull

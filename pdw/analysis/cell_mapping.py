@@ -54,7 +54,7 @@ def cell_state(a, b, rest, params):
     """Section point z of grid coordinates (phi, thetad2) and the four other coordinates
     ``rest`` = (mean angle m, trailing foot's velocity v_x1, v_y1, thetad1): theta1 = m - phi/2,
     theta2 = m + phi/2, and the hip velocity follows from the trailing foot's material-point
-    velocity (MODEL.md section 2, consistent rate): xd_o = v_x1 - ((l - r) cos theta1 + r)
+    velocity (docs/model.md section 2, consistent rate): xd_o = v_x1 - ((l - r) cos theta1 + r)
     thetad1, yd_o = v_y1 - (l - r) sin theta1 thetad1."""
     m, vx, vy, w1 = rest
     th1, th2 = m - 0.5 * a, m + 0.5 * a

@@ -23,12 +23,12 @@ class Gait:
     state : ndarray
         The state on the Poincaré section. For ``model == "hybrid"`` (`pdw.hybrid`): the
         reduced state just after heel strike, after relabelling, [theta_st, theta_sw,
-        thetad_st, thetad_sw] (rad, rad/s; angles from the slope normal, MODEL.md section 2),
+        thetad_st, thetad_sw] (rad, rad/s; angles from the slope normal, docs/model.md section 2),
         with theta_sw = -theta_st (both feet on the ground).
     period : float
         Touch-down to touch-down [s].
     step_length : float
-        Footprint spacing along the slope [m] (MODEL.md section 8: the swing foot's contact
+        Footprint spacing along the slope [m] (docs/model.md section 8: the swing foot's contact
         point at touch-down minus the other foot's contact point at its own touch-down).
     double_support : float
         Double-support time per step [s]; 0 for the hybrid model.

@@ -1,4 +1,4 @@
-"""The hybrid (impact-momentum) walker of MODEL.md section 9, for comparison with the compliant one.
+"""The hybrid (impact-momentum) walker of docs/model.md section 9, for comparison with the compliant one.
 
 Rigid ground; the stance foot rolls without slip (its material contact point has zero
 velocity), so the stance phase is a 2-DOF system in the reduced state
@@ -13,7 +13,7 @@ A *step* (`step_map`, compiled, GIL released): integrate the stance (Dormand-Pri
 control rtol/atol) until heel strike -- the armed swing foot reaching the ground moving down,
 located by regula falsi to ``event_tol`` -- then the inelastic impact
 M (qd+ - qd-) = J_sw^T Lambda, J_sw qd+ = 0 (a 6x6 KKT system), then relabel the legs
-(the old swing leg becomes the stance leg). The swing foot is armed as in MODEL.md section 5
+(the old swing leg becomes the stance leg). The swing foot is armed as in docs/model.md section 5
 (above the ground while downhill of the stance foot), which ignores mid-stance scuffing.
 
 Poincaré section: just after heel strike, after relabelling. On it theta_sw = -theta_st (both
@@ -108,7 +108,7 @@ def swing_foot(y, params=None) -> dict:
 
 
 def full_state(y, params=None, s0=0.0, stance_leg=1) -> np.ndarray:
-    """Full-model state(s) [x_o, y_o, theta1, theta2, ...] (MODEL.md section 2) of reduced
+    """Full-model state(s) [x_o, y_o, theta1, theta2, ...] (docs/model.md section 2) of reduced
     state(s) y, shape (4,) or (N, 4); ``s0`` the stance foot's rolling coordinate, and
     ``stance_leg`` (1 or 2, scalar or per row) which leg is in stance."""
     Y = np.ascontiguousarray(np.atleast_2d(np.asarray(y, dtype=float)))
@@ -344,7 +344,7 @@ class HybridTrajectory:
     y : ndarray (N, 4)
         Reduced states, `STATE` (stance / swing leg of that sample's step).
     x : ndarray (N, 8)
-        Full-model states in the slope frame, the model's legs 1 and 2 (MODEL.md section 2).
+        Full-model states in the slope frame, the model's legs 1 and 2 (docs/model.md section 2).
     stance_leg : ndarray (N,)
         1 or 2: the leg in stance at each sample.
     step : ndarray (N,)
@@ -379,7 +379,7 @@ def simulate_hybrid(params=None, state0=None, n_steps=10, *, dt_out=0.002, stanc
     """Walk ``n_steps`` steps of the hybrid model from ``state0`` (reduced, `STATE`).
 
     ``state0`` defaults to the gait of `find_gait`. ``stance_leg`` is the full model's leg
-    in stance at the start (2: as at the paper's initial condition, MODEL.md section 5), ``s0``
+    in stance at the start (2: as at the paper's initial condition, docs/model.md section 5), ``s0``
     its rolling coordinate. Samples every ``dt_out`` seconds (0: every integrator step),
     plus each step's start and its pre-impact state. Does not raise when the walker falls:
     ``status`` and ``steps`` say what happened.

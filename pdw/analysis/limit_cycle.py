@@ -4,7 +4,7 @@ Floquet multipliers, period-n detection (issue 7; docs/studies.md, "Limit cycles
 Poincaré section
 ----------------
 The section is the **touch-down of the swing foot**: the instant its support flag turns on
-(MODEL.md section 5, Eq. 18b), with both flags then 1 (the old stance foot is still on the
+(docs/model.md section 5, Eq. 18b), with both flags then 1 (the old stance foot is still on the
 ground: double support begins). The state is taken just after the flag change, i.e. the
 recorded sample at the event time; with ``rodas4``/``dopri5`` the event is located to
 ``event_tol`` (default here 1e-12 s), so the new stance foot's height is 0 to ~1e-12 m.
@@ -38,7 +38,7 @@ thousand samples) and Python picks the one at the event. The simulation runs to
 has not happened by then, again to ``t_max``.
 
 *Restarting the discrete state.* At the section both legs are support, so nobody is armed
-(MODEL.md section 5) and the restart's discrete state equals the running one, except for the
+(docs/model.md section 5) and the restart's discrete state equals the running one, except for the
 `consistent` variant's tangential anchors: `simulate` anchors a support leg at its initial
 state, which is right for the new stance leg (it has just touched down) but resets the
 trailing leg's accumulated slip since its own touch-down (micrometres; it lifts off ~16-50 ms
@@ -404,7 +404,7 @@ def find_gait(params=None, variant="paper", guess=None, method="rodas4", *, peri
     params : Params
         Default `Params.paper_steady()`.
     variant : {"paper", "consistent"}
-        Contact reading (MODEL.md section 6).
+        Contact reading (docs/model.md section 6).
     guess : array_like (6,) section point, (8,) full state at a touch-down, or a `Gait`
         (hybrid or continuous), optional. Default: `default_guesses` in turn. A guess is used
         as it is (no settling walk).

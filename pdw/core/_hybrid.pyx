@@ -54,6 +54,11 @@ cdef extern from "pdw_hybrid_sim.h":
                          const pdw_hybrid_opts *o, pdw_hybrid_result *results,
                          double *rec_t, double *rec_y, long *rec_step, long rec_cap) noexcept nogil
     int pdw_hybrid_solve(int n, double *A, double *b, double *x) noexcept nogil
+    int pdw_hybrid_rhs_jac(const double *y, const double *p, double *ydot, double *A) noexcept nogil
+    int pdw_hybrid_impact_jac(const double *p, const double *ym, double *D) noexcept nogil
+    int pdw_hybrid_step_jac(const double *p, const double *y0, const pdw_hybrid_opts *o,
+                            pdw_hybrid_result *r, double *DP) noexcept nogil
+    void pdw_hybrid_swing_foot_grad(const double *y, const double *p, double *g) noexcept nogil
 
 
 NY = PDW_NHY
@@ -245,3 +250,63 @@ def walk(const double[::1] p, const double[::1] y0, double s0, long n_steps, dic
         out.append(_result_dict(&res[k]))
         n_rec += res[k].n_rec
     return out, rec_t[:n_rec], rec_y[:n_rec], rec_step[:n_rec]
+
+
+def rhs_jac(const double[::1] p, const double[::1] y):
+    """(ydot (4,), A = d ydot / d y (4, 4)) of the stance phase (symbolic Jacobian)."""
+    yd = np.empty(PDW_NHY)
+    A = np.empty((PDW_NHY, PDW_NHY))
+    cdef double[::1] vy = yd
+    cdef double[:, ::1] vA = A
+    if pdw_hybrid_rhs_jac(&y[0], &p[0], &vy[0], &vA[0, 0]):
+        raise ArithmeticError("singular reduced mass matrix at y = %r" % (np.asarray(y),))
+    return yd, A
+
+
+def swing_foot_grad(const double[::1] p, const double[::1] y):
+    """d y_sw / d y (4,)."""
+    g = np.empty(PDW_NHY)
+    cdef double[::1] v = g
+    pdw_hybrid_swing_foot_grad(&y[0], &p[0], &v[0])
+    return g
+
+
+def impact_jac(const double[::1] p, const double[::1] y_minus):
+    """d y+ / d y- (4, 4) of the impact-and-relabel map."""
+    D = np.empty((PDW_NHY, PDW_NHY))
+    cdef double[:, ::1] v = D
+    if pdw_hybrid_impact_jac(&p[0], &y_minus[0], &v[0, 0]):
+        raise ArithmeticError("singular impact system at y- = %r" % (np.asarray(y_minus),))
+    return D
+
+
+def step_jac_batch(const double[::1] p, const double[:, ::1] y0, dict opts,
+                   double[:, ::1] y_plus, double[:, :, ::1] DP, int[::1] status):
+    """The step map of each row of y0 (N, 4) and its exact Jacobian DP (N, 4, 4)."""
+    cdef pdw_hybrid_opts o
+    cdef pdw_hybrid_result r
+    cdef Py_ssize_t i, j, n = y0.shape[0]
+    _fill_opts(&o, opts)
+    assert y_plus.shape[0] == n and status.shape[0] == n and DP.shape[0] == n
+    with nogil:
+        for i in range(n):
+            status[i] = pdw_hybrid_step_jac(&p[0], &y0[i, 0], &o, &r, &DP[i, 0, 0])
+            for j in range(PDW_NHY):
+                y_plus[i, j] = r.y_plus[j]
+
+
+def step_jac(const double[::1] p, const double[::1] y0, dict opts):
+    """One step and its exact Jacobian: (result dict, DP (4, 4)); DP is NaN unless ok."""
+    cdef pdw_hybrid_opts o
+    cdef pdw_hybrid_result r
+    cdef int st
+    _fill_opts(&o, opts)
+    DP = np.full((PDW_NHY, PDW_NHY), np.nan)
+    cdef double[:, ::1] v = DP
+    with nogil:
+        st = pdw_hybrid_step_jac(&p[0], &y0[0], &o, &r, &v[0, 0])
+    d = _result_dict(&r)
+    if st != 0:
+        d["status"] = STATUS[st] if 0 <= st < len(STATUS) else str(st)
+        DP[:] = np.nan
+    return d, DP

@@ -6,8 +6,8 @@ table. This module describes each method for users and tests; `name`, `order` an
 are checked against the C table at import, so the two cannot drift apart.
 
 The common contract (pdw/core/csrc/pdw_sim.h, pdw/core/csrc/pdw_ode.h): a method advances the 8-state ODE
-x' = f(x; flags, anchors) of MODEL.md section 3 with the discrete state (support flags, arming,
-anchors of MODEL.md sections 5-6) held fixed during a step and updated between steps by
+x' = f(x; flags, anchors) of docs/model.md section 3 with the discrete state (support flags, arming,
+anchors of docs/model.md sections 5-6) held fixed during a step and updated between steps by
 `pdw_update_flags`, which records every touch-down and lift-off as an event. Fixed-step methods
 take ``round(t_end/dt)`` steps of ``dt`` and update the flags once per step from the state at
 the step's start (the paper's Fig. 3). Adaptive methods integrate to ``t_end`` from a first step
@@ -37,7 +37,7 @@ class Integrator:
 
 INTEGRATORS = {i.name: i for i in (
     Integrator("cdm", 1, False, False, False, 1,
-               "The paper's central difference method, MODEL.md section 7 (Eqs. 13-17), as "
+               "The paper's central difference method, docs/model.md section 7 (Eqs. 13-17), as "
                "printed: U_{n+1} from (M/dt^2 + C/2dt) U_{n+1} = ..., velocity (U_{n+1} - "
                "U_{n-1})/2dt, i.e. the centred velocity at t_n used at t_{n+1}: first order. "
                "Explicit: with the foot stuck the friction law's eigenvalue near -1e6 /s makes "

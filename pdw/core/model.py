@@ -108,12 +108,12 @@ def rhs(x, params=None, flags=(0, 1), anchors=(0.0, 0.0), variant="paper", featu
     params : Params, optional
         Default `Params.paper()`.
     flags : (int, int)
-        Support flags of legs 1 and 2 (1 support, 0 swing; MODEL.md section 5).
+        Support flags of legs 1 and 2 (1 support, 0 swing; docs/model.md section 5).
     anchors : (float, float)
         Rolling coordinate s_i at the last touch-down of each foot [m]; only the
         ``consistent`` variant's tangential deformation uses them.
     variant : {"paper", "consistent"}
-        MODEL.md section 6.
+        docs/model.md section 6.
 
     Returns
     -------
@@ -140,7 +140,7 @@ def jacobian(x, params=None, flags=(0, 1), anchors=(0.0, 0.0), variant="paper", 
 
 
 def mass_matrix(q, params=None):
-    """Mass matrix M(q) of Eq. 2 (MODEL.md section 3), shape (4, 4) or (N, 4, 4).
+    """Mass matrix M(q) of Eq. 2 (docs/model.md section 3), shape (4, 4) or (N, 4, 4).
 
     ``q`` may be a configuration (4,) / (N, 4) or a full state (8,) / (N, 8).
     """
@@ -197,7 +197,7 @@ def contact_forces(x, params=None, flags=(0, 1), anchors=(0.0, 0.0), variant="pa
 
 def energies(x, params=None) -> dict:
     """Kinetic energy T, gravitational potential V_gravity, hip-spring energy V_hip and their
-    sum E [J] (MODEL.md section 3; V_gravity is zero at the slope-frame origin)."""
+    sum E [J] (docs/model.md section 3; V_gravity is zero at the slope-frame origin)."""
     X, single = _states(x)
     e = np.empty((len(X), len(_layout.ENERGY)))
     _core.energies_batch(kernel_index("paper"), X, parameter_vector(params), e)

@@ -1,4 +1,4 @@
-"""Model parameters (paper Tables 1-3, MODEL.md section 1) with validation."""
+"""Model parameters (paper Tables 1-3, docs/model.md section 1) with validation."""
 from __future__ import annotations
 
 import dataclasses
@@ -24,7 +24,7 @@ def _f(default, unit, doc, lo=None, hi=None, lo_open=True, hi_open=True):
 class Params:
     """Parameters of the walker and the ground, SI units, named after the paper's symbols.
 
-    The defaults are `Params.paper()` (MODEL.md section 1). Every field is checked on
+    The defaults are `Params.paper()` (docs/model.md section 1). Every field is checked on
     construction: a NaN, a non-positive mass or length, ``r >= l``, or ``v_s >= v_d``
     raises `ValueError` naming the field and its allowed range.
 
@@ -85,12 +85,12 @@ class Params:
     # --- presets ---------------------------------------------------------------------------
     @classmethod
     def paper(cls, **overrides) -> "Params":
-        """The paper's Tables 1-3 as read in MODEL.md section 1 (d_hip = 0.018)."""
+        """The paper's Tables 1-3 as read in docs/model.md section 1 (d_hip = 0.018)."""
         return cls(**overrides)
 
     @classmethod
     def paper_steady(cls, **overrides) -> "Params":
-        """`paper` with d_hip = 0.010: the preset with a stable period-one gait (MODEL.md section 8)."""
+        """`paper` with d_hip = 0.010: the preset with a stable period-one gait (docs/model.md section 8)."""
         return cls(**{"d_hip": 0.010, **overrides})
 
     @classmethod

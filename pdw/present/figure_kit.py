@@ -110,7 +110,7 @@ def _smooth_window(t, window):
 
 
 def _contact_points(result, x=None):
-    """Contact points D_i (MODEL.md section 2) of both legs: arrays (N, 2) of x_D and y_D."""
+    """Contact points D_i (docs/model.md section 2) of both legs: arrays (N, 2) of x_D and y_D."""
     p = result.params
     x = np.asarray(result.x if x is None else x)
     th = x[:, 2:4]

@@ -1,4 +1,4 @@
-"""Figures of a simulated walk, after the paper's Figs. 4-7 (MODEL.md section 8).
+"""Figures of a simulated walk, after the paper's Figs. 4-7 (docs/model.md section 8).
 
 Every ``fig_*`` function takes a `pdw.sim.simulation.Result` and returns a new
 `matplotlib.figure.Figure` drawn on an Agg canvas (no pyplot state, no GUI); `animate`
@@ -7,11 +7,11 @@ writes an animated GIF and `save_all` writes everything to a folder.
 matplotlib (and Pillow, for the GIF) are imported inside the functions, so ``import pdw``
 and ``import pdw.present.plots`` do not need them: install the ``plot`` extra to use this module.
 
-Conventions (MODEL.md section 2): the state is in the slope frame (X downhill along the
+Conventions (docs/model.md section 2): the state is in the slope frame (X downhill along the
 slope, Y normal to it, up); leg angles are measured from the slope normal pointing down,
 counter-clockwise positive. Leg 1 starts as the rear (swing) leg, leg 2 as the stance leg.
 Leg 1 is drawn in blue, leg 2 in orange in every figure. A *double support* is an interval
-during which both support flags are 1 (MODEL.md section 5).
+during which both support flags are 1 (docs/model.md section 5).
 
 Functions
 ---------
@@ -326,7 +326,7 @@ def fig_double_support(result, which=-1, margin=None):
     duration annotated in ms, with its share of the walking cycle (time between successive
     touch-downs) and the paper's numbers for comparison; the title also gives how long both
     normal forces are positive (the flags can outlast the force: a foot may stop pushing
-    before its lift-off condition, MODEL.md Eq. 18a, is met).
+    before its lift-off condition, docs/model.md Eq. 18a, is met).
 
     Parameters
     ----------

@@ -5,7 +5,7 @@ import numpy as np
 
 from ..sim.gait import steps
 
-#: The paper's typical gait (Sec. 3.2, Figs. 4-7, MODEL.md section 8). L, P and v are read
+#: The paper's typical gait (Sec. 3.2, Figs. 4-7, docs/model.md section 8). L, P and v are read
 #: at k_n = 1e5 from the k_n study (Fig. 11), the cycle and double support from Sec. 3.2.
 PAPER_TYPICAL = {"L": 0.397, "P": 0.621, "v": 0.639, "cycle": 0.6275, "double_support": 0.017,
                  "ds_fraction": 0.0271}
@@ -66,11 +66,13 @@ def walk_report(result, last=4) -> str:
     lines = ["pdw walk: %s, variant %s, dt = %g s, t_end = %g s" % (
         result.method, result.variant, result.dt, result.t_end),
         "status: %s (%s); wall time %.1f ms" % (result.status, result.summary(), 1e3 * result.wall_time),
-        "", "Steps (MODEL.md section 8 definitions):", st.to_text(), ""]
+        "", "Steps (docs/model.md section 8 definitions):", st.to_text(), ""]
     if len(st):
         sd = st.steady(last)
         lines.append("Last %d steps (mean, largest change between successive steps) vs the paper:"
-                     % sd["last"])
+                     % sd["last"] if result.walked else
+                     "Last %d steps before the run %s (mean, largest change; not a steady gait):"
+                     % (sd["last"], result.status))
         lines.append("%-22s %10s %10s %10s" % ("", "pdw", "change", "paper"))
         for name, label, scale in (("L", "step length L [m]", 1), ("travel", "swing travel [m]", 1),
                                    ("P", "step period P [s]", 1), ("v", "velocity v [m/s]", 1),

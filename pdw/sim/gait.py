@@ -1,4 +1,4 @@
-"""Gait descriptors per step (MODEL.md section 8, paper Sec. 4.1) from a simulation's events.
+"""Gait descriptors per step (docs/model.md section 8, paper Sec. 4.1) from a simulation's events.
 
 A *step* ends at a touch-down of the swing leg j (time t_td, contact point x_td):
 

@@ -14,7 +14,7 @@ TOML layout (every key optional; defaults are `Scene()`'s)::
 
     name = "typical gait"
     preset = "paper_steady"          # Params preset: "paper" or "paper_steady"
-    variant = "paper"                # MODEL.md section 6: "paper" or "consistent"
+    variant = "paper"                # docs/model.md section 6: "paper" or "consistent"
     x0 = [0.0, 0.4969, -0.0582, 0.0582, 0.5092, 0.0186, 3.3338, -1.0093]
     flags0 = [0, 1]
 
@@ -63,10 +63,9 @@ from __future__ import annotations
 import dataclasses
 import math
 import pathlib
-import tomllib
 from dataclasses import dataclass, field
 
-from ..core import _layout
+from ..core import _layout, _toml
 from ..core.contact import Contact
 from ..core.errors import InvalidInputError
 from ..core.integrators import METHODS
@@ -265,7 +264,7 @@ class Integrator(_Section):
 
 @dataclass(frozen=True)
 class Forces(_Section):
-    """Which force elements are present (MODEL.md sections 3-4). Absent ones are switched off
+    """Which force elements are present (docs/model.md sections 3-4). Absent ones are switched off
     in a specialized kernel, or by zeroing their parameters (`Params.without`)."""
 
     SECTION = "forces"
@@ -385,7 +384,7 @@ class Scene(_Section):
     name: str = _f("", "str", "a label")
     preset: str = _f("paper", "str", "parameter preset (pdw.Params.preset)", _one_of(PRESETS))
     params: dict = _f({}, "params", "overrides of the preset's parameters")
-    variant: str = _f("paper", "str", "contact variant (MODEL.md section 6)",
+    variant: str = _f("paper", "str", "contact variant (docs/model.md section 6)",
                       _one_of(_layout.VARIANTS))
     x0: tuple = _f(X0_PAPER, "state", "initial state [x_o, y_o, theta1, theta2, rates]")
     flags0: tuple = _f((0, 1), "flags", "initial support flags of legs 1, 2")
@@ -447,8 +446,8 @@ class Scene(_Section):
         """Read a scene from TOML text. Unknown keys, wrong types and invalid values are
         `pdw.InvalidInputError` naming the key."""
         try:
-            data = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as e:
+            data = _toml.loads(text)
+        except _toml.TOMLDecodeError as e:
             raise InvalidInputError("%s: not valid TOML: %s" % (source, e)) from None
         try:
             return cls.from_dict(data)
@@ -467,50 +466,13 @@ class Scene(_Section):
 
     def to_toml(self) -> str:
         """TOML text of the scene; `Scene.from_toml` reads it back to an equal scene."""
-        d = self.to_dict()
-        lines = ["# pdw scene (docs/scenes.md); run it with `pdw run FILE`"]
-        for key in ("name", "preset", "variant", "x0", "flags0"):
-            lines.append("%s = %s" % (key, _toml_value(d[key])))
-        for section in ("params",) + tuple(SECTION_TYPES):
-            table = d[section]
-            if section == "params" and not table:
-                continue
-            lines += ["", "[%s]" % section]
-            lines += ["%s = %s" % (k, _toml_value(v)) for k, v in table.items()]
-        return "\n".join(lines) + "\n"
+        return _toml.dumps(self.to_dict(), "pdw scene (docs/scenes.md); run it with `pdw run FILE`")
 
     def save(self, path) -> pathlib.Path:
         """Write the scene as a TOML file."""
         path = pathlib.Path(path)
         path.write_text(self.to_toml())
         return path
-
-
-def _toml_value(v) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        return repr(v)          # 0.0001, 1e-08, inf, nan: all TOML floats
-    if isinstance(v, str):
-        return _toml_string(v)
-    if isinstance(v, (list, tuple)):
-        return "[%s]" % ", ".join(_toml_value(x) for x in v)
-    raise TypeError("no TOML form for %r" % (v,))
-
-
-def _toml_string(s: str) -> str:
-    out = ['"']
-    for ch in s:
-        if ch in '"\\':
-            out.append("\\" + ch)
-        elif ord(ch) < 0x20 or ord(ch) == 0x7F:
-            out.append("\\u%04X" % ord(ch))
-        else:
-            out.append(ch)
-    out.append('"')
-    return "".join(out)
 
 
 def run(scene):

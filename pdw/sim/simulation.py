@@ -2,7 +2,7 @@
 
 The loop (C, GIL released) carries the support flags, the arming of the scuffing
 guard and the tangential anchors as discrete state, updated once per step (paper
-Fig. 3, MODEL.md sections 5-7). Python is entered once per simulation.
+Fig. 3, docs/model.md sections 5-7). Python is entered once per simulation.
 """
 from __future__ import annotations
 
@@ -35,7 +35,7 @@ _REASONS = {
 
 
 class Event(NamedTuple):
-    """A support-flag change (MODEL.md section 5) at time t [s] of leg 1 or 2."""
+    """A support-flag change (docs/model.md section 5) at time t [s] of leg 1 or 2."""
 
     t: float
     leg: int          # 1 or 2 (the paper's numbering)
@@ -70,7 +70,7 @@ class Result:
         The parameters simulated: with the parameters of absent force elements zeroed
         (`Params.without`) when ``features`` was given.
     gait : Steps
-        The gait descriptors computed online in the compiled loop (MODEL.md section 8, the
+        The gait descriptors computed online in the compiled loop (docs/model.md section 8, the
         definitions of `pdw.steps`): the last ``min(n_gait_steps, pdw.core._layout.STEP_RING)``
         complete steps. A run stopped by a stop condition ends at a touch-down, so its last
         step's double support is NaN (not known yet).
@@ -199,10 +199,10 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     params : Params, optional
         Default `Params.paper()`.
     variant : {"paper", "consistent"}
-        Contact reading of MODEL.md section 6.
+        Contact reading of docs/model.md section 6.
     method : str
         Integrator (`pdw.core.integrators.INTEGRATORS`, docs/integrators.md): ``"cdm"`` is the
-        paper's central difference method (MODEL.md section 7); ``"verlet"``, ``"rk4"`` are
+        paper's central difference method (docs/model.md section 7); ``"verlet"``, ``"rk4"`` are
         fixed-step, ``"dopri5"`` and ``"rodas4"`` (stiff, recommended) adaptive.
     flags0 : (int, int)
         Initial support flags of legs 1, 2 (the paper's start: leg 1 swing, leg 2 support).

@@ -91,7 +91,7 @@ def step_matrix(method: str, J, h: float) -> np.ndarray:
     * verlet: the map of [q_n, v_n, a_n] (12 x 12); a_n is carried between steps
       (a_{n+1} = A q_{n+1} + B (v_{n+1/2} + h/2 a_n), pdw_verlet.c).
     * cdm: the map of [U_n, U_{n-1}, U_{n-2}] (12 x 12): U_{n+1} = 2 U_n - U_{n-1} +
-      h^2 (A U_n + B (U_n - U_{n-2}) / 2h) -- MODEL.md section 7, whose force evaluation uses
+      h^2 (A U_n + B (U_n - U_{n-2}) / 2h) -- docs/model.md section 7, whose force evaluation uses
       Eq. 17's velocity (U_n - U_{n-2}) / 2h, lagging half a step behind. (The C q' term,
       implicit in the scheme, is small and treated like the rest.)
     """

@@ -1,8 +1,10 @@
 """A parameter study, as data: the TOML file format of ``pdw sweep`` and its validation
 (docs/studies.md).
 
-A study sweeps one or two `Params` fields over ranges (``[[axes]]``), the others fixed (a
-preset plus ``[params]`` overrides), with one contact variant and one integrator (``[run]``).
+A study sweeps one or two `Params` fields over ranges (``[[axes]]``); everything else is one
+`pdw.Scene`, the ``[scene]`` table (the schema of ``pdw run`` and ``pdw walk --scene``: preset,
+parameter overrides, variant, x0, flags0, integrator, stop), on top of `SCENE_DEFAULTS`;
+``[run]`` says how each point's steady gait is found.
 `load_study` / `parse_study` check every key and value and name the key in the error;
 `Study.points` lists the parameter sets. Running a study is `pdw.studies.sweep.run_study`.
 """
@@ -12,25 +14,31 @@ import dataclasses
 import hashlib
 import itertools
 import pathlib
-import tomllib
 
 import numpy as np
 
-from ..core import _layout
+from ..core import _layout, _toml
 from ..core.errors import InvalidInputError
-from ..core.integrators import METHODS
-from ..core.params import X0_PAPER, Params
+from ..core.params import Params
+from ..sim.scene import Scene
 
-STUDY_KEYS = {"name": str, "title": str, "preset": str, "variant": str, "method": str,
-              "params": dict, "axes": list, "run": dict, "paper": dict, "description": str}
+STUDY_KEYS = {"name": str, "title": str, "description": str, "scene": dict, "axes": list,
+              "run": dict, "paper": dict}
 AXIS_KEYS = {"name": str, "values": list, "start": (int, float), "stop": (int, float),
              "num": int, "log": bool}
-RUN_KEYS = {"mode": str, "t_end": (int, float), "dt": (int, float), "steady": int,
-            "rtol": (int, float), "atol": (int, float), "x0": list, "flags0": list,
-            "period_tol": (int, float), "fallback": bool}
-RUN_DEFAULTS = {"mode": "simulate", "t_end": 16.0, "dt": 1e-4, "steady": 4, "rtol": 1e-7,
-                "atol": 1e-9, "x0": list(X0_PAPER), "flags0": [0, 1], "period_tol": 1e-4,
-                "fallback": True}
+RUN_KEYS = {"mode": str, "steady": int, "period_tol": (int, float), "fallback": bool}
+RUN_DEFAULTS = {"mode": "simulate", "steady": 4, "period_tol": 1e-4, "fallback": True}
+#: The scene of a study before its ``[scene]`` table: the steady preset, rodas4 at tight
+#: tolerances, 16 s, events and descriptors only, a diverged point returned as a row.
+SCENE_DEFAULTS = {"preset": "paper_steady",
+                  "integrator": {"method": "rodas4", "rtol": 1e-7, "atol": 1e-9},
+                  "record": {"every": 0, "forces": False, "energies": False, "events": True},
+                  "stop": {"t_end": 16.0, "on_failure": "return"}}
+#: Keys of the earlier study format and where they live now.
+MOVED = {"preset": "scene.preset", "variant": "scene.variant", "method": "scene.integrator.method",
+         "params": "scene.params", "run.t_end": "scene.stop.t_end", "run.dt": "scene.integrator.dt",
+         "run.rtol": "scene.integrator.rtol", "run.atol": "scene.integrator.atol",
+         "run.x0": "scene.x0", "run.flags0": "scene.flags0"}
 #: Result columns of a point (after the index and the axis values).
 COLUMNS = ("status", "gait", "source", "L", "P", "v", "cycle", "double_support", "ds_fraction", "travel",
            "spread_L", "spread_cycle", "n_steps", "max_multiplier", "t_final", "wall_s", "error")
@@ -44,22 +52,36 @@ class Study:
 
     name: str
     title: str
-    preset: str
-    variant: str
-    method: str
-    params: dict
+    scene: Scene               # everything but the swept parameters
     axes: list                 # [(name, values ndarray), ...] (1 or 2)
-    run: dict
+    run: dict                  # mode, steady, period_tol, fallback
     paper: dict
     source: str = ""           # the TOML text
     path: str = ""
+
+    @property
+    def preset(self) -> str:
+        return self.scene.preset
+
+    @property
+    def variant(self) -> str:
+        return self.scene.variant
+
+    @property
+    def method(self) -> str:
+        return self.scene.integrator.method
+
+    @property
+    def params(self) -> dict:
+        """The scene's overrides of its preset (fixed for every point)."""
+        return dict(self.scene.params)
 
     @property
     def axis_names(self):
         return [a for a, _ in self.axes]
 
     def base_params(self) -> Params:
-        return Params.preset(self.preset, **self.params)
+        return self.scene.parameters()
 
     def points(self):
         """List of (index, {axis: value}) in a fixed order (first axis fastest)."""
@@ -71,11 +93,12 @@ class Study:
         return out
 
     def task(self, index, values) -> dict:
-        """The worker's input for one point (plain data: picklable, small)."""
+        """The worker's input for one point (plain data: picklable, small): the scene as a
+        dict and the point's full parameter set."""
         p = self.base_params().as_dict()
         p.update(values)
-        return {"index": index, "values": dict(values), "params": p, "variant": self.variant,
-                "method": self.method, "run": dict(self.run)}
+        return {"index": index, "values": dict(values), "params": p,
+                "scene": self.scene.to_dict(), "run": dict(self.run)}
 
     def digest(self) -> str:
         return hashlib.sha256(self.source.encode()).hexdigest()
@@ -89,34 +112,40 @@ def _typecheck(where, key, value, typ):
         raise InvalidInputError("%s: key %r must be of type %s, got %r" % (where, key, names, value))
 
 
+def _moved(where, key):
+    raise InvalidInputError("%s: key %r is now %r: a study's walker, start, integrator and "
+                            "duration are its [scene] table, a pdw.Scene (docs/studies.md)"
+                            % (where, key, MOVED[key]))
+
+
+def study_scene(table: dict | None = None) -> Scene:
+    """The scene of a study: `SCENE_DEFAULTS` updated by the study's ``[scene]`` table (a
+    `pdw.Scene` in TOML form; a table given there updates that table of the defaults)."""
+    base = Scene.from_dict({k: dict(v) if isinstance(v, dict) else v
+                            for k, v in SCENE_DEFAULTS.items()})
+    return base.replace(**(table or {}))
+
+
 def parse_study(text, name="study", path="") -> Study:
     """Parse and validate a study from TOML text. Errors name the offending key."""
     where = path or name
     try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
+        data = _toml.loads(text)
+    except _toml.TOMLDecodeError as e:
         raise InvalidInputError("%s: not valid TOML: %s" % (where, e)) from None
     for k, v in data.items():
+        if k in MOVED:
+            _moved(where, k)
         if k not in STUDY_KEYS:
             raise InvalidInputError("%s: unknown key %r; allowed: %s"
                                     % (where, k, ", ".join(STUDY_KEYS)))
         _typecheck(where, k, v, STUDY_KEYS[k])
-    preset = data.get("preset", "paper_steady")
-    variant = data.get("variant", "paper")
-    method = data.get("method", "rodas4")
-    if variant not in _layout.VARIANTS:
-        raise InvalidInputError("%s: variant must be one of %s, got %r"
-                                % (where, ", ".join(_layout.VARIANTS), variant))
-    if method not in METHODS:
-        raise InvalidInputError("%s: method must be one of %s, got %r"
-                                % (where, ", ".join(METHODS), method))
+    try:
+        scene = study_scene(data.get("scene"))
+    except InvalidInputError as e:
+        raise InvalidInputError("%s: [scene]: %s" % (where, e)) from None
     fields = set(_layout.PARAMS)
-    params = dict(data.get("params", {}))
-    for k, v in params.items():
-        if k not in fields:
-            raise InvalidInputError("%s: [params] has unknown field %r; allowed: %s"
-                                    % (where, k, ", ".join(_layout.PARAMS)))
-        _typecheck(where + " [params]", k, v, (int, float))
+    params = scene.params
     axes_in = data.get("axes", [])
     if not 1 <= len(axes_in) <= 2:
         raise InvalidInputError("%s: need one or two [[axes]], got %d" % (where, len(axes_in)))
@@ -159,6 +188,8 @@ def parse_study(text, name="study", path="") -> Study:
         axes.append((an, vals))
     run = dict(RUN_DEFAULTS)
     for k, v in data.get("run", {}).items():
+        if "run." + k in MOVED:
+            _moved(where + " [run]", "run." + k)
         if k not in RUN_KEYS:
             raise InvalidInputError("%s [run]: unknown key %r; allowed: %s"
                                     % (where, k, ", ".join(RUN_KEYS)))
@@ -167,13 +198,11 @@ def parse_study(text, name="study", path="") -> Study:
     if run["mode"] not in ("simulate", "newton"):
         raise InvalidInputError("%s [run]: mode must be 'simulate' or 'newton', got %r"
                                 % (where, run["mode"]))
-    if len(run["x0"]) != 8 or len(run["flags0"]) != 2:
-        raise InvalidInputError("%s [run]: x0 needs 8 numbers and flags0 two" % where)
-    if run["steady"] < 1 or run["t_end"] <= 0 or run["dt"] <= 0:
-        raise InvalidInputError("%s [run]: steady >= 1, t_end > 0, dt > 0 required" % where)
+    if run["steady"] < 1:
+        raise InvalidInputError("%s [run]: steady must be >= 1, got %r" % (where, run["steady"]))
     study = Study(name=data.get("name", name), title=data.get("title", data.get("name", name)),
-                  preset=preset, variant=variant, method=method, params=params, axes=axes,
-                  run=run, paper=dict(data.get("paper", {})), source=text, path=str(path))
+                  scene=scene, axes=axes, run=run, paper=dict(data.get("paper", {})),
+                  source=text, path=str(path))
     try:                                   # every point's parameters must be valid
         base = study.base_params()
         for _, values in study.points():

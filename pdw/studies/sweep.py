@@ -70,6 +70,7 @@ def run_point(task) -> dict:
     import it). ``task``: `Study.task`. Returns the CSV row (a flat dict of numbers and short
     strings); an invalid point gives ``status = "error"`` instead of raising."""
     from ..sim.gait import steps
+    from ..sim.scene import Scene
     from ..sim.simulation import simulate
     t0 = time.perf_counter()
     row = {"index": int(task["index"]), **task["values"]}
@@ -77,11 +78,9 @@ def run_point(task) -> dict:
     run = task["run"]
     try:
         params = Params(**task["params"])
+        scene = Scene.from_dict(task["scene"])
         if run["mode"] == "simulate":
-            res = simulate(run["x0"], t_end=run["t_end"], dt=run["dt"], params=params,
-                           variant=task["variant"], method=task["method"],
-                           flags0=tuple(run["flags0"]), record_every=0, record_forces=False,
-                           on_failure="return", rtol=run["rtol"], atol=run["atol"])
+            res = simulate(**{**scene.simulate_kwargs(), "params": params})
             st = steps(res)
             s = st.steady(run["steady"])
             row.update(status=res.status, n_steps=len(st), t_final=res.t_final, source="simulate",
@@ -92,19 +91,19 @@ def run_point(task) -> dict:
                                               "ds_fraction", "travel")},
                            spread_L=s["spread_L"], spread_cycle=s["spread_cycle"])
         if run["mode"] == "newton" or (run["fallback"] and row["gait"] != "period-1"):
-            _newton_point(row, params, task)
+            _newton_point(row, params, scene)
     except (PdwError, ValueError) as e:
         row.update(status="error", error=str(e)[:300])
     row["wall_s"] = time.perf_counter() - t0
     return row
 
 
-def _newton_point(row, params, task):
+def _newton_point(row, params, scene):
     """Fill ``row`` from `pdw.find_gait` (default guesses); keeps ``row`` if none is found."""
     from ..analysis.gait_types import GaitNotFoundError
     from ..analysis.limit_cycle import find_gait
     try:
-        g = find_gait(params, variant=task["variant"], method=task["method"], workers=1,
+        g = find_gait(params, variant=scene.variant, method=scene.integrator.method, workers=1,
                       max_iter=12)
     except GaitNotFoundError as e:
         if row["status"] == "":
@@ -246,6 +245,7 @@ def provenance(study, **extra) -> dict:
     return {
         "study": {"name": study.name, "title": study.title, "path": study.path,
                   "sha256": study.digest(), "toml": study.source},
+        "scene": study.scene.to_dict(),
         "preset": study.preset, "variant": study.variant, "method": study.method,
         "base_params": study.base_params().as_dict(),
         "axes": {a: v.tolist() for a, v in study.axes},

@@ -1,4 +1,4 @@
-/* The paper's central difference method, exactly as MODEL.md section 7 prints it (Eqs. 13-17).
+/* The paper's central difference method, exactly as docs/model.md section 7 prints it (Eqs. 13-17).
  *
  *   start:    U_-1 = U_0 - dt U'_0 + dt^2/2 U''_0
  *   step:     (M/dt^2 + C/(2dt)) U_{n+1} = Q_f - G + (2/dt^2) M U_n - (M/dt^2 - C/(2dt)) U_{n-1}

@@ -1,4 +1,4 @@
-/* Discrete state of the walker: support flags, arming, anchors (MODEL.md sections 5, 6),
+/* Discrete state of the walker: support flags, arming, anchors (docs/model.md sections 5, 6),
  * recording and stop checks shared by every time loop. */
 #include <math.h>
 #include <string.h>

@@ -1,4 +1,4 @@
-/* The hybrid walker's step map (MODEL.md section 9); see pdw_hybrid_sim.h for the contract.
+/* The hybrid walker's step map (docs/model.md section 9); see pdw_hybrid_sim.h for the contract.
  *
  * Integrator: Dormand-Prince 5(4) (the RK45 of Hairer-Norsett-Wanner, FSAL), local
  * extrapolation (the 5th-order solution is propagated), RMS error norm with

@@ -1,4 +1,4 @@
-/* The hybrid (impact-momentum) walker of MODEL.md section 9: compiled step map.
+/* The hybrid (impact-momentum) walker of docs/model.md section 9: compiled step map.
  *
  * One step = the stance phase of the reduced 2-DOF system (generated/pdw_hybrid.c; state
  * y = [theta_st, theta_sw, thetad_st, thetad_sw]) integrated by Dormand-Prince 5(4) with error
@@ -6,7 +6,7 @@
  * relabelling of the legs. The caller allocates everything; nothing here allocates.
  *
  * Heel strike: the *armed* swing foot reaches the ground (y_sw = 0) moving down. As in
- * MODEL.md section 5, the swing foot is armed once it has been above the ground (y_sw > 0)
+ * docs/model.md section 5, the swing foot is armed once it has been above the ground (y_sw > 0)
  * while downhill of the stance foot (x_sw > x_st) and, here also, with the inter-leg angle
  * theta_sw - theta_st >= min_step_angle; it is disarmed whenever it is uphill again
  * (x_sw <= x_st); a strike also needs the foot downhill (x_sw > x_st) at the step's end.
@@ -97,5 +97,15 @@ long pdw_hybrid_walk(const double *p, const double *y0, double s0, long n_steps,
 /* Solve the n x n system A x = b (row-major, overwritten) by Gaussian elimination with partial
  * pivoting; returns 0, or -1 when singular. n <= 8. */
 int pdw_hybrid_solve(int n, double *A, double *b, double *x);
+
+/* Exact derivatives (pdw_hybrid_var.c): ydot and A = d ydot / d y (4x4 row-major) of the
+ * stance phase (-1 on a singular M_r); the impact-and-relabel map's derivative D (4x4) at a
+ * pre-impact state; and one step of the map (as pdw_hybrid_step from t0 = s0 = 0, filling r)
+ * with its Jacobian DP = D S Phi(T) (4x4 row-major): the variational equations integrated to
+ * the strike time with the saltation matrix S of the heel-strike event. Return PDW_HYBRID_*. */
+int pdw_hybrid_rhs_jac(const double *y, const double *p, double *ydot, double *A);
+int pdw_hybrid_impact_jac(const double *p, const double *ym, double *D);
+int pdw_hybrid_step_jac(const double *p, const double *y0, const pdw_hybrid_opts *o,
+                        pdw_hybrid_result *r, double *DP);
 
 #endif /* PDW_HYBRID_SIM_H */

@@ -4,7 +4,7 @@
  *
  *   pdw_fixed_advance     fixed step dt, n_steps steps; the discrete state is updated once per
  *                         step from x_n before the step (as the paper's loop, Fig. 3);
- *   pdw_adaptive_advance  error-controlled steps to t_end; flag switches (MODEL.md section 5)
+ *   pdw_adaptive_advance  error-controlled steps to t_end; flag switches (docs/model.md section 5)
  *                         are located inside a step to within event_tol and applied between
  *                         steps.
  *

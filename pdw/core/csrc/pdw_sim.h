@@ -9,7 +9,7 @@
 
 #include "pdw_model.h"
 
-/* Discrete state carried by every loop (MODEL.md sections 5 and 6). */
+/* Discrete state carried by every loop (docs/model.md sections 5 and 6). */
 typedef struct pdw_discrete {
     int flags[2];       /* 1 = support, 0 = swing */
     int armed[2];       /* swing foot has been above ground while ahead of the other foot */
@@ -36,7 +36,7 @@ enum {
     PDW_REASON_STEP_SIZE = 6      /* adaptive step size underflow (error test never passed) */
 };
 
-/* Online gait analysis (MODEL.md section 8): the per-step descriptors of pdw/sim/gait.py, computed
+/* Online gait analysis (docs/model.md section 8): the per-step descriptors of pdw/sim/gait.py, computed
  * as the events happen, in O(1) memory: the latest touch-down and lift-off of each leg, counts,
  * and the last PDW_STEP_RING complete steps (layout PDW_STEP_*) in a ring buffer. */
 typedef struct pdw_gait {
@@ -115,7 +115,7 @@ typedef struct pdw_sim {
 void pdw_discrete_init(const pdw_kernel *k, const double *p, const double *x,
                        const int flags0[2], pdw_discrete *d, double *work);
 
-/* Update flags and arming once from s->x (MODEL.md section 5); each flag change is an event:
+/* Update flags and arming once from s->x (docs/model.md section 5); each flag change is an event:
  * stored in s->events (if record_events), counted, and fed to the online gait analysis
  * (s->gait), which checks the stop conditions (stop_steps, periodic_k) at each complete step.
  * Leaves the trig and kinematics of s->x (with the new anchors) in s->work. Returns 0; -1 when
@@ -178,7 +178,7 @@ typedef struct pdw_method {
 extern const pdw_method pdw_methods[];
 extern const int pdw_nmethods;
 
-/* The paper's central difference method (MODEL.md section 7). Returns s->status. */
+/* The paper's central difference method (docs/model.md section 7). Returns s->status. */
 int pdw_cdm_advance(pdw_sim *s);
 
 /* Integrators beyond the paper's (docs/integrators.md); one module each. */

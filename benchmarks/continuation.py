@@ -1,0 +1,217 @@
+"""Continuation studies (docs/continuation.md): writes benchmarks/results/continuation_<part>.txt
+and docs/figures/continuation_*.png.
+
+    python benchmarks/continuation.py hybrid    # compass cascade + simplest walker (seconds)
+    python benchmarks/continuation.py dhip      # continuous model, d_hip from 0.010 to the end
+    python benchmarks/continuation.py rigid     # k_n 1e5 -> 1e9, consistent, d_n ~ k_n^(4/3)
+    python benchmarks/continuation.py rigid_paper  # the same in the paper variant: its end
+    python benchmarks/continuation.py fig11     # Fig. 11 (k_n): continuation vs the sweep
+"""
+from __future__ import annotations
+
+import os
+import pathlib
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+import pdw  # noqa: E402
+from pdw import hybrid as H  # noqa: E402
+from pdw.analysis.continuation import continue_gait, follow_cascade  # noqa: E402
+from pdw.present.cli_continue import preset  # noqa: E402
+from pdw.present.plots_continuation import plot_branches  # noqa: E402
+
+RESULTS = ROOT / "benchmarks" / "results"
+FIGS = ROOT / "docs" / "figures"
+DEG = np.pi / 180
+OUT = []
+
+
+def say(*a):
+    line = " ".join(str(x) for x in a)
+    print(line, flush=True)
+    OUT.append(line)
+
+
+def _bifs(b, scale=1.0, unit=""):
+    for f in b.bifurcations:
+        say("  %-16s at %s = %.10g%s (bracket %.2g): %s"
+            % (f.kind, b.parameter, f.value * scale, unit, f.tolerance * scale, f.reason))
+
+
+def _branch_line(b):
+    say("period %d: %d points, %s in [%.8g, %.8g], %d map evaluations (steps), %.2f s; stop: %s"
+        % (b.period_n, len(b), b.parameter, b.values.min(), b.values.max(), b.n_maps,
+           b.wall_time, b.stop_reason))
+
+
+def part_hybrid():
+    say("== compass gait (Goswami et al. 1998), hybrid model, exact monodromy ==")
+    bs = follow_cascade(H.compass_gait_params(), "gamma", 5.3 * DEG, depth=3, model="hybrid",
+                        step=0.05 * DEG)
+    for b in bs:
+        _branch_line(b)
+        _bifs(b, 1 / DEG, " deg")
+    pd = [b.of_kind("period_doubling")[0].value / DEG for b in bs if b.of_kind("period_doubling")]
+    if len(pd) >= 3:
+        say("Feigenbaum ratios (g_{k}-g_{k-1})/(g_{k+1}-g_k): %s"
+            % ", ".join("%.3f" % ((pd[k] - pd[k - 1]) / (pd[k + 1] - pd[k]))
+                        for k in range(1, len(pd) - 1)))
+    ax = plot_branches(bs, y="z0", x_scale=1 / DEG, x_label="slope gamma [deg]",
+                       title="Compass gait: period-doubling cascade (hybrid model)",
+                       path=FIGS / "continuation_compass.png")
+    import matplotlib.pyplot as plt
+    plt.close(ax.figure)
+    say("== simplest walker (Garcia et al. 1998): m_l = 1e-4 m_h, r = 0, g = l = 1 ==")
+    for ml in (1e-3, 1e-4, 1e-5):
+        b = continue_gait(preset("simplest", m_l=ml), "gamma", 0.0185, model="hybrid")
+        say("m_l/m_h = %g:" % ml)
+        _branch_line(b)
+        _bifs(b)
+
+
+def part_dhip():
+    say("== continuous model (paper_steady, paper variant): d_hip from 0.010 upwards ==")
+    b = continue_gait(pdw.Params.paper_steady(d_hip=0.010), "d_hip", 0.03, max_points=60)
+    _branch_line(b)
+    _bifs(b)
+    for i in range(0, len(b), max(1, len(b) // 12)):
+        m = np.abs(b.multipliers[i])
+        say("  d_hip %.6f  period %.6f s  L %.6f m  DS %.3f ms  |mu| %s  %s"
+            % (b.values[i], b.period[i], b.step_length[i], 1e3 * b.double_support[i],
+               " ".join("%.4f" % v for v in m[:3]), "stable" if b.stable[i] else "UNSTABLE"))
+    ax = plot_branches([b], y="step_length", x_label="hip damping d_hip [N m s/rad]",
+                       title="Continuous walker (paper_steady): d_hip",
+                       path=FIGS / "continuation_d_hip.png")
+    import matplotlib.pyplot as plt
+    plt.close(ax.figure)
+
+
+RIGID_TABLE = {  # docs/studies.md section 3 (benchmarks/rigid_limit.py), consistent variant
+    1e5: (0.574051, 0.300107), 3e5: (0.567910, 0.324148), 1e6: (0.566191, 0.333655),
+    3e6: (0.565439, 0.337214), 1e7: (0.564938, 0.338931), 3e7: (0.564633, 0.339629),
+    1e8: (0.564415, 0.339977), 3e8: (0.564285, 0.340119), 1e9: (0.564193, 0.340188)}
+
+
+STEADY = pdw.Params.paper_steady()
+
+
+def _rigid_params_of(k):
+    return STEADY.replace(k_n=k, d_n=1e6 * (k / 1e5) ** (4 / 3))
+
+
+def part_rigid_paper():
+    say("== k_n 1e5 -> 1e9 (log), PAPER variant, d_n = 1e6 (k_n/1e5)^(4/3): where does it end? ==")
+    b = continue_gait(pdw.Params.paper_steady(), "k_n", 1e9, variant="paper",
+                      params_of=_rigid_params_of, value=1e5, log=True, max_points=80)
+    _branch_line(b)
+    _bifs(b)
+    for i in range(len(b)):
+        say("  k_n %.4g  period %.6f  L %.6f  DS %.3f ms  |mu| %s %s"
+            % (b.values[i], b.period[i], b.step_length[i], 1e3 * b.double_support[i],
+               " ".join("%.4f" % v for v in np.abs(b.multipliers[i])[:3]),
+               "stable" if b.stable[i] else "UNSTABLE"))
+    ax = plot_branches([b], y="max_multiplier", x_label="k_n [N/m^1.5] (d_n ~ k_n^(4/3))",
+                       title="paper variant towards rigid ground",
+                       path=FIGS / "continuation_k_n_paper.png")
+    import matplotlib.pyplot as plt
+    plt.close(ax.figure)
+
+
+def part_rigid():
+    say("== rigid limit: k_n 1e5 -> 1e9 (log), consistent, d_n = 1e6 (k_n/1e5)^(4/3) ==")
+    p0 = pdw.Params.paper_steady()
+    b = continue_gait(p0, "k_n", 1e9, variant="consistent", params_of=_rigid_params_of,
+                      value=1e5, log=True, max_points=80, at=list(RIGID_TABLE))
+    _branch_line(b)
+    _bifs(b)
+    say("k_n | period (branch) | table | L (branch) | table | largest abs(mu)")
+    for k, (P, L) in RIGID_TABLE.items():
+        i = int(np.argmin(np.abs(np.log(b.values / k))))
+        say("%.0e | %.6f | %.6f | %.6f | %.6f | %.4f (branch point at %.6g)"
+            % (k, b.period[i], P, b.step_length[i], L, np.abs(b.multipliers[i]).max(),
+               b.values[i]))
+    ax = plot_branches([b], y="step_length", x_label="k_n [N/m^1.5] (d_n ~ k_n^(4/3))",
+                       title="Rigid limit (consistent variant)",
+                       path=FIGS / "continuation_rigid_limit.png")
+    import matplotlib.pyplot as plt
+    plt.close(ax.figure)
+
+
+SWEEP = """
+name = "fig11_k_n_095"
+preset = "paper_steady"
+variant = "paper"
+method = "rodas4"
+[params]
+k_hip = 0.95
+[[axes]]
+name = "k_n"
+start = 0.5e5
+stop = 2.5e5
+num = 9
+[run]
+mode = "simulate"
+t_end = 16.0
+steady = 4
+rtol = 1e-7
+atol = 1e-9
+"""
+
+
+def part_fig11(rounds=2):
+    from pdw import limit_cycle as LC
+    from pdw import sweep
+    say("== Fig. 11 (k_n, k_hip = 0.95): continuation against the brute-force sweep ==")
+    say("sweep: 9 points, 16 s of walking each (rodas4 rtol 1e-7), 2 threads; continuation: "
+        "tight = rodas4 rtol 1e-10, Newton tol 1e-8, fd 1e-5 (default); loose = rtol 1e-7, "
+        "atol 1e-9, event_tol 1e-10, Newton tol 1e-6, fd 1e-4; both 2 threads, a point at "
+        "each of the sweep's k_n; rounds interleaved")
+    say("load average before: %s" % (os.getloadavg(),))
+    study = sweep.parse_study(SWEEP)
+    base = pdw.Params.paper_steady(k_hip=0.95, k_n=0.5e5)
+    ks = list(np.linspace(0.5e5, 2.5e5, 9))
+    runs = {"tight": {}, "loose": dict(options=dict(LC.LOOSE), tol=1e-6, fd_step=1e-4)}
+    for r in range(rounds):
+        with tempfile.TemporaryDirectory() as tmp:
+            t0 = time.perf_counter()
+            res = sweep.run_study(study, tmp, workers=2, progress=False, figures=False,
+                                  resume=False)
+            t_sweep = time.perf_counter() - t0
+        n_sweep = sum(int(row.get("n_steps") or 0) for row in res.rows)
+        say("round %d: sweep %d points, %d steps walked, %.2f s" % (r, len(res.rows), n_sweep,
+                                                                   t_sweep))
+        for name, kw in runs.items():
+            t0 = time.perf_counter()
+            b = continue_gait(base, "k_n", 2.5e5, workers=2, at=ks, **kw)
+            t = time.perf_counter() - t0
+            say("round %d: continuation (%s) %d points, %d map evaluations (steps), %.2f s; "
+                "wall ratio continuation/sweep %.1f; bifurcations %s"
+                % (r, name, len(b), b.n_maps, t, t / t_sweep, b.bifurcations))
+            if r == rounds - 1:
+                for row in res.rows:
+                    k = row["k_n"]
+                    i = int(np.argmin(np.abs(b.values - k)))
+                    say("  k_n %.4g: sweep L %.6f P %.6f | continuation (%s, at %.6g) L %.6f "
+                        "P %.6f (swing = period - double support) |mu| %.4f"
+                        % (k, row["L"], row["P"], name, b.values[i], b.step_length[i],
+                           b.period[i] - b.double_support[i], np.abs(b.multipliers[i]).max()))
+    say("load average after: %s" % (os.getloadavg(),))
+
+
+if __name__ == "__main__":
+    parts = sys.argv[1:] or ["hybrid"]
+    for part in parts:
+        OUT.clear()
+        t0 = time.perf_counter()
+        {"hybrid": part_hybrid, "dhip": part_dhip, "rigid": part_rigid,
+         "rigid_paper": part_rigid_paper, "fig11": part_fig11}[part]()
+        say("(%s: %.1f s wall; python benchmarks/continuation.py %s)"
+            % (part, time.perf_counter() - t0, part))
+        RESULTS.mkdir(exist_ok=True)
+        (RESULTS / ("continuation_%s.txt" % part)).write_text("\n".join(OUT) + "\n")

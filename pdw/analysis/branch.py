@@ -1,0 +1,193 @@
+"""Branches of gaits and their bifurcations: the data a continuation returns (`pdw.analysis.continuation`).
+
+A `Branch` holds one family of period-n gaits followed in one parameter: per-point arrays
+(``values``, ``period``, ``step_length``, ``double_support``, ``multipliers``, ``stable``,
+``state``, the section coordinates ``z`` and the unit ``tangents`` of the curve) and the list of
+located `Bifurcation` s. It writes itself as CSV (`Branch.to_csv`) and JSON (`Branch.to_json`),
+plots itself (`Branch.plot`, a bifurcation diagram: stable solid, unstable dashed) and switches
+onto the period-2 branch at a period doubling (`Branch.switch`, i.e.
+`pdw.analysis.continuation.switch_branch`).
+"""
+from __future__ import annotations
+
+import csv
+import json
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .gait_types import Gait
+
+#: bifurcation kinds
+KINDS = ("fold", "period_doubling", "neimark_sacker", "end")
+
+
+@dataclass(eq=False)
+class Bifurcation:
+    """A located bifurcation (or the end of the family) on a branch.
+
+    Attributes
+    ----------
+    kind : str
+        ``"fold"`` (turning point: the tangent's parameter component through 0, a multiplier
+        at +1), ``"period_doubling"`` (a real multiplier through -1), ``"neimark_sacker"`` (a
+        complex pair through the unit circle) or ``"end"`` (the family stops existing as
+        modelled; ``reason`` says why).
+    value : float
+        The parameter there, located to ``tolerance`` (parameter units; relative for a log
+        continuation).
+    gait : Gait or None
+        The gait at ``value`` (None for an end found by a failing step map).
+    index : int
+        The bifurcation lies between branch points ``index`` and ``index + 1``.
+    tolerance : float
+        Width of the final bracket in the parameter.
+    reason : str
+        What crossed: the test function, or for an end the physical reason.
+    z, mu, tangent, eigenvector, multipliers : ndarray
+        Section point, internal parameter coordinate, unit tangent (z, u) of the branch,
+        the critical eigenvector (real part, for a period doubling), multipliers.
+    """
+
+    kind: str
+    value: float
+    gait: Gait | None
+    index: int
+    tolerance: float
+    reason: str = ""
+    z: Any = None
+    mu: float = float("nan")
+    tangent: Any = None
+    eigenvector: Any = None
+    multipliers: Any = None
+    details: dict = field(default_factory=dict)
+
+    def __repr__(self):
+        return "Bifurcation(%s at %.8g (+-%.2g), %s)" % (self.kind, self.value, self.tolerance,
+                                                        self.reason)
+
+    def as_dict(self) -> dict:
+        m = [] if self.multipliers is None else np.asarray(self.multipliers)
+        return {"kind": self.kind, "value": self.value, "tolerance": self.tolerance,
+                "index": self.index, "reason": self.reason,
+                "z": None if self.z is None else np.asarray(self.z).tolist(),
+                "multipliers_re": [float(np.real(v)) for v in m],
+                "multipliers_im": [float(np.imag(v)) for v in m]}
+
+
+@dataclass(eq=False)
+class Branch:
+    """A continued family of period-``period_n`` gaits (see the module docstring).
+
+    Per-point arrays have length N (the number of points): ``values`` (parameter), ``period``
+    (touch-down to touch-down of the whole n-step cycle [s]), ``step_length`` [m] (mean),
+    ``double_support`` [s] (mean; 0 for the hybrid model), ``multipliers`` (N, dim) complex,
+    sorted by decreasing modulus, ``stable`` (all |multiplier| < 1), ``state`` (N, 4 hybrid /
+    8 continuous: the `Gait.state` of each point), ``z`` (N, dim) section coordinates,
+    ``orbit`` (N, n, dim) the n section points of each period-n gait (``orbit[:, 0] == z``),
+    ``tangents`` (N, dim + 1), ``step_size`` (N: the arclength step that reached the point;
+    0 for the first), ``newton_iterations`` (N).
+    """
+
+    parameter: str
+    model: str
+    period_n: int
+    values: np.ndarray
+    period: np.ndarray
+    step_length: np.ndarray
+    double_support: np.ndarray
+    multipliers: np.ndarray
+    stable: np.ndarray
+    state: np.ndarray
+    z: np.ndarray
+    orbit: np.ndarray
+    tangents: np.ndarray
+    step_size: np.ndarray
+    newton_iterations: np.ndarray
+    bifurcations: list = field(default_factory=list)
+    stop_reason: str = ""
+    n_maps: int = 0
+    wall_time: float = 0.0
+    settings: dict = field(default_factory=dict)
+    problem: Any = field(default=None, repr=False)
+    switcher: Any = field(default=None, repr=False)
+
+    def __len__(self):
+        return len(self.values)
+
+    def __repr__(self):
+        return ("Branch(%s, %s model, period %d, %d points, %s in [%.6g, %.6g], "
+                "bifurcations=%r, stop: %s)"
+                % (self.parameter, self.model, self.period_n, len(self), self.parameter,
+                   np.min(self.values), np.max(self.values), self.bifurcations, self.stop_reason))
+
+    def of_kind(self, kind) -> list:
+        """The bifurcations of one kind."""
+        return [b for b in self.bifurcations if b.kind == kind]
+
+    def switch(self, bifurcation, amplitude=0.005, **kw) -> Gait:
+        """The first gait of the period-2n branch born at a period doubling (see
+        `pdw.analysis.continuation.switch_branch`)."""
+        return self.switcher(self, bifurcation, amplitude=amplitude, **kw)
+
+    # --- output -------------------------------------------------------------------------------
+
+    COLUMNS = ("value", "period_n", "period", "step_length", "double_support", "stable",
+               "max_abs_multiplier")
+
+    def rows(self):
+        """One dict per point (the CSV's rows): the descriptors, |multipliers| and z."""
+        out = []
+        for i in range(len(self)):
+            m = self.multipliers[i]
+            r = {"value": self.values[i], "period_n": self.period_n, "period": self.period[i],
+                 "step_length": self.step_length[i], "double_support": self.double_support[i],
+                 "stable": int(self.stable[i]), "max_abs_multiplier": float(np.max(np.abs(m)))}
+            for k, v in enumerate(m):
+                r["mult%d_re" % k], r["mult%d_im" % k] = float(v.real), float(v.imag)
+            for k, v in enumerate(self.z[i]):
+                r["z%d" % k] = float(v)
+            out.append(r)
+        return out
+
+    def to_csv(self, path):
+        """Write the per-point table (`rows`) to ``path``; returns the path."""
+        rows = self.rows()
+        with open(path, "w", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=list(rows[0]) if rows else list(self.COLUMNS))
+            w.writeheader()
+            for r in rows:
+                w.writerow({k: ("%.17g" % v if isinstance(v, float) else v) for k, v in r.items()})
+        return path
+
+    def summary(self) -> dict:
+        """JSON-able summary: settings, counts, stop reason, bifurcations."""
+        return {"parameter": self.parameter, "model": self.model, "period_n": self.period_n,
+                "points": len(self), "range": [float(np.min(self.values)),
+                                               float(np.max(self.values))],
+                "stop_reason": self.stop_reason, "map_evaluations": self.n_maps,
+                "wall_time_s": self.wall_time, "settings": self.settings,
+                "bifurcations": [b.as_dict() for b in self.bifurcations]}
+
+    def to_json(self, path, **extra):
+        """Write `summary` (plus ``extra``) as JSON to ``path``; returns the path."""
+        with open(path, "w") as fh:
+            json.dump({**self.summary(), **extra}, fh, indent=2, default=_jsonable)
+        return path
+
+    def plot(self, ax=None, y="step_length", **kw):
+        """Bifurcation diagram of this branch: `pdw.present.plots_continuation.plot_branches`,
+        looked up when called (a convenience; the analysis layer does not import the present
+        layer's plotting code)."""
+        import importlib
+        plots = importlib.import_module("pdw.present.plots_continuation")
+        return plots.plot_branches([self], ax=ax, y=y, **kw)
+
+
+def _jsonable(o):
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, (np.floating, np.integer, np.bool_)):
+        return o.item()
+    return str(o)

@@ -1,0 +1,541 @@
+"""Continuation of gaits in one parameter: branches, stability, bifurcations (docs/continuation.md).
+
+The problem: fixed points of the period-n step map, G(z, u) = P^n(z; lambda(u)) - z = 0, with z
+the section coordinates (`pdw.analysis.gait_maps`) and u the parameter coordinate, scaled so that the
+requested range is one unit: u = (mu - mu_0) / |mu_stop - mu_0|, mu = lambda (or log lambda
+with ``log=True``). A branch is a curve x(s) = (z, u)(s) of solutions.
+
+Pseudo-arclength (default): from a point x_i with unit tangent t_i (the null vector of
+DG = [M - I, dP/du], oriented by t_{i-1}), predict x_i + ds t_i and correct by Newton's method on
+[G(x); t_i . (x - x_i - ds t_i)] = 0 (the bordered Jacobian [DG; t_i^T]). Natural continuation
+(``method="natural"``) replaces the arclength row by u = u_i + ds (it cannot pass a fold). The
+step ds adapts: x 1.5 after a correction in <= 2 iterations, x 0.7 after >= 5, halved and retried
+when the corrector fails, down to ``step_min`` (then the family ends). Newton converges when
+max|G| < ``tol``.
+
+Test functions, evaluated at every point, a sign change between points i and i+1 marking a
+bifurcation there: fold: the tangent's u component (natural: det(M - I)); period doubling:
+det(M + I); Neimark-Sacker: prod_{j<k} (mu_j mu_k - 1) (a complex pair with |mu| = 1 makes a
+factor vanish; a real pair with mu_j mu_k = 1, a neutral saddle, is rejected after location);
+the end of the family: an admissibility function of the model through 0
+(`pdw.analysis.gait_maps.HybridProblem.ADMISSIBLE`, ...), or the step map failing (the walker falls, no
+heel strike, ...) where the corrector cannot go on. Each crossing is located by the Illinois
+(regula falsi) method on the arclength s along the predictor from x_i, every trial point
+corrected onto the branch, until the bracket in the parameter is narrower than ``locate_tol``.
+
+Branch switching at a period doubling (`switch_branch`): the period-2n fixed point near the
+bifurcation x* = (z*, u*) is found by Newton's method on P^{2n} in the hyperplane
+w . (x - x*) = a, w the critical eigenvector (v, 0) made orthogonal to the period-n tangent,
+which the period-n branch does not cross (it stays near w . (x - x*) = 0) and the period-2n
+branch, tangent to (v, 0), does.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from ..core.errors import InvalidInputError
+from . import hybrid as H
+from . import limit_cycle as LC
+from .branch import Bifurcation, Branch
+from .gait_maps import ContinuousProblem, Evaluation, HybridProblem
+from .gait_types import Gait, GaitNotFoundError
+
+MODELS = ("continuous", "hybrid")
+
+
+class _Point:
+    __slots__ = ("x", "ev", "tangent", "mult", "tests", "iters", "ds")
+
+    def __init__(self, x, ev, tangent, iters, ds):
+        self.x, self.ev, self.tangent, self.iters, self.ds = x, ev, tangent, iters, ds
+        m = np.linalg.eigvals(ev.M)
+        self.mult = m[np.argsort(-np.abs(m))]
+        self.tests = {}
+
+
+class _Engine:
+    """Predictor-corrector machinery on one problem, in the scaled coordinates x = (z, u)."""
+
+    def __init__(self, prob, mu0, scale, tol, max_newton, natural):
+        self.prob, self.mu0, self.scale = prob, mu0, scale
+        self.tol, self.max_newton, self.natural = tol, max_newton, natural
+        self.n = prob.dim
+
+    def mu(self, x):
+        return self.mu0 + x[-1] * self.scale
+
+    def value(self, x):
+        return self.prob.value(self.mu(x))
+
+    def evaluate(self, x, jac=True) -> Evaluation:
+        return self.prob.evaluate(x[:-1], self.mu(x), jac)
+
+    def dG(self, ev):
+        return np.hstack([ev.M - np.eye(self.n), (ev.P_lam * self.scale)[:, None]])
+
+    def tangent(self, ev, ref):
+        """Unit null vector of DG with ref . t > 0."""
+        A = np.vstack([self.dG(ev), ref[None, :]])
+        b = np.zeros(self.n + 1)
+        b[-1] = 1.0
+        try:
+            t = np.linalg.solve(A, b)
+        except np.linalg.LinAlgError:
+            t = np.linalg.lstsq(A, b, rcond=None)[0]
+        return t / np.linalg.norm(t)
+
+    def correct(self, x_pred, c):
+        """Newton on [G; c . (x - x_pred)] = 0: (x, ev, iterations) or (None, reason, its)."""
+        x = x_pred.copy()
+        last = "no convergence"
+        for it in range(self.max_newton + 1):
+            ev = self.evaluate(x)
+            if not ev.ok:
+                return None, ev.status, it
+            G = ev.Pz - x[:-1]
+            if np.max(np.abs(G)) < self.tol and it > 0:
+                return x, ev, it
+            if it == self.max_newton:
+                last = "no convergence in %d Newton iterations (residual %.2g)" % (
+                    it, np.max(np.abs(G)))
+                break
+            J = np.vstack([self.dG(ev), c[None, :]])
+            r = np.concatenate([G, [c @ (x - x_pred)]])
+            try:
+                dx = np.linalg.solve(J, -r)
+            except np.linalg.LinAlgError:
+                return None, "singular corrector matrix", it
+            if not np.isfinite(dx).all():
+                return None, "non-finite Newton step", it
+            x = x + dx
+            if np.max(np.abs(G)) < self.tol:      # converged at the predictor already
+                continue
+        return None, last, self.max_newton
+
+    def step_from(self, pt, ds):
+        """The next point at arclength ds from pt (natural: ds in u)."""
+        if self.natural:
+            e = np.zeros(self.n + 1)
+            e[-1] = 1.0
+            d = pt.tangent / pt.tangent[-1] if abs(pt.tangent[-1]) > 1e-12 else e
+            x_pred = pt.x + ds * d
+            c = e
+        else:
+            x_pred = pt.x + ds * pt.tangent
+            c = pt.tangent
+        x, ev, its = self.correct(x_pred, c)
+        if x is None:
+            return None, ev, its
+        ref = c if self.natural else pt.tangent
+        return _Point(x, ev, self.tangent(ev, ref), its, ds), None, its
+
+
+# --- test functions ---------------------------------------------------------------------------
+
+def _tests(engine, pt):
+    m = pt.mult
+    n = len(m)
+    ns = np.prod([m[j] * m[k] - 1.0 for j in range(n) for k in range(j + 1, n)])
+    t = {"period_doubling": float(np.real(np.prod(m + 1.0))),
+         "neimark_sacker": float(np.real(ns))}
+    if engine.natural:
+        t["fold"] = float(np.real(np.prod(m - 1.0)))
+    else:
+        t["fold"] = float(pt.tangent[-1])
+    for k, v in pt.ev.admissible.items():
+        t["end:" + k] = float(v)
+    return t
+
+
+def _locate(engine, a, b, name, locate_tol, max_iter=40):
+    """Illinois on s in (0, b.ds) along a's predictor for the test ``name``: (the point there,
+    the width of the final bracket in the parameter coordinate mu)."""
+    lo, hi = 0.0, b.ds
+    flo, fhi = a.tests[name], b.tests[name]
+    p_lo, p_hi = a, b
+    side = 0
+    for _ in range(max_iter):
+        if abs(engine.mu(p_lo.x) - engine.mu(p_hi.x)) < locate_tol:
+            break
+        s = (lo * fhi - hi * flo) / (fhi - flo) if fhi != flo else 0.5 * (lo + hi)
+        if not (lo < s < hi):
+            s = 0.5 * (lo + hi)
+        pt, _, _ = engine.step_from(a, s)
+        if pt is None:
+            s = 0.5 * (lo + hi)
+            pt, _, _ = engine.step_from(a, s)
+            if pt is None:
+                break
+        pt.tests = _tests(engine, pt)
+        f = pt.tests[name]
+        if np.sign(f) == np.sign(flo):
+            lo, flo, p_lo = s, f, pt
+            if side == -1:
+                fhi *= 0.5
+            side = -1
+        else:
+            hi, fhi, p_hi = s, f, pt
+            if side == 1:
+                flo *= 0.5
+            side = 1
+    best = p_lo if abs(p_lo.tests[name]) < abs(p_hi.tests[name]) else p_hi
+    return best, abs(engine.mu(p_lo.x) - engine.mu(p_hi.x))
+
+
+def _bifurcation(engine, kind, pt, index, width, reason, eigvec=None):
+    prob = engine.prob
+    gait = prob.gait(pt.x[:-1], engine.mu(pt.x), pt.ev, pt.mult)
+    return Bifurcation(kind=kind, value=engine.value(pt.x), gait=gait, index=index,
+                       tolerance=width, reason=reason, z=pt.x[:-1].copy(),
+                       mu=engine.mu(pt.x), tangent=pt.tangent.copy(), eigenvector=eigvec,
+                       multipliers=pt.mult.copy(), details={"orbit": pt.ev.info["orbit"]})
+
+
+def _check_crossings(engine, a, b, index, locate_tol, detect):
+    out = []
+    for name in a.tests:
+        kind = "end" if name.startswith("end:") else name
+        if kind not in detect:
+            continue
+        fa = a.tests[name]
+        fb = b.tests.get(name, fa)
+        if kind == "end":
+            crossed = fa > 0.0 >= fb
+        else:
+            crossed = np.sign(fa) != np.sign(fb) and fa != 0.0
+        if not crossed:
+            continue
+        pt, width = _locate(engine, a, b, name, locate_tol)
+        if kind == "end":
+            adm = name[4:]
+            out.append(_bifurcation(engine, "end", pt, index, width,
+                                    "%s -> 0: %s" % (adm, engine.prob.ADMISSIBLE.get(adm, adm))))
+            continue
+        m = pt.mult
+        if kind == "period_doubling":
+            j = int(np.argmin(np.abs(m + 1.0)))
+            w, V = np.linalg.eig(pt.ev.M)
+            v = np.real(V[:, int(np.argmin(np.abs(w - m[j])))])
+            out.append(_bifurcation(engine, kind, pt, index, width,
+                                    "a multiplier through -1 (%.6g)" % np.real(m[j]),
+                                    v / np.linalg.norm(v)))
+        elif kind == "neimark_sacker":
+            cx = [v for v in m if abs(v.imag) > 1e-8 and abs(abs(v) - 1.0) < 1e-3]
+            if cx:
+                out.append(_bifurcation(engine, kind, pt, index, width,
+                                        "a complex pair through the unit circle (|mu| = %.6g, "
+                                        "arg %.4g rad)" % (abs(cx[0]), abs(np.angle(cx[0])))))
+        else:
+            out.append(_bifurcation(engine, "fold", pt, index, width,
+                                    "turning point: the branch reverses in %s" % (
+                                        engine.prob.parameter)))
+    return out
+
+
+# --- the driver -------------------------------------------------------------------------------
+
+def _problem(params, parameter, model, variant, period, params_of, log, options, executor,
+             workers, fd_step):
+    if model == "hybrid":
+        return HybridProblem(params, parameter, params_of, period, log, options)
+    if model == "continuous":
+        return ContinuousProblem(params, parameter, params_of, period, log, variant=variant,
+                                 options=options, executor=executor, workers=workers,
+                                 fd_step=fd_step)
+    raise InvalidInputError("model must be one of %s, got %r" % (", ".join(MODELS), model))
+
+
+def _start_z(prob, params, start, variant, period):
+    if isinstance(start, Gait):
+        z = start.details.get("z") if start.details else None
+        return prob.section(start.state) if z is None else np.asarray(z, dtype=float)
+    if start is not None:
+        return prob.section(start)
+    if prob.model == "hybrid":
+        g = H.find_gait(params)
+        if period > 1:
+            raise InvalidInputError("a hybrid period-%d start needs start= (Branch.switch)"
+                                    % period)
+        return prob.section(g.state)
+    g = LC.find_gait(params, variant, period=period)
+    return np.asarray(g.details["z"], dtype=float)
+
+
+def continue_gait(params, parameter, stop, *, model="continuous", variant="paper", period=1,
+                  step=None, start=None, value=None, method="pseudo_arclength", max_points=200,
+                  step_min=None, step_max=None, tol=None, locate_tol=None, params_of=None,
+                  log=False, detect=("fold", "period_doubling", "neimark_sacker", "end"),
+                  max_newton=8, executor=None, workers=None, fd_step=1e-5,
+                  options=None, at=()) -> Branch:
+    """Follow the period-``period`` gait of ``params`` as ``parameter`` moves towards ``stop``.
+
+    Parameters
+    ----------
+    params : Params
+        The walker at the start (``parameter`` at its value there, or ``value``).
+    parameter : str
+        A `Params` field, or any name when ``params_of`` is given.
+    stop : float
+        Continue until the parameter reaches ``stop`` (or the family ends, or ``max_points``).
+    model : {"continuous", "hybrid"}
+        The compliant-ground walker (`pdw.find_gait`'s map) or the rigid-ground one
+        (`pdw.hybrid`).
+    variant : str
+        Contact variant of the continuous model.
+    period : int
+        Period n of the gait (steps per cycle).
+    step : float
+        First step, in parameter units (log: in log(parameter)); default 1/50 of the range.
+    start : Gait or array_like, optional
+        The first gait (a `Gait`, e.g. from `Branch.switch`, or a section point / state);
+        default: the model's ``find_gait`` at ``params``.
+    value : float, optional
+        The parameter's value at the start (default: ``getattr(params, parameter)``, or the
+        start gait's).
+    method : {"pseudo_arclength", "natural"}
+    max_points : int
+    step_min, step_max : float
+        Bounds of the arclength step in the scaled coordinates (the range is 1 unit; default
+        1e-6 and 0.1).
+    tol : float
+        Newton tolerance on max|P^n(z) - z| (default 1e-10 hybrid, 1e-8 continuous).
+    locate_tol : float
+        Bifurcations are located to this width in the parameter coordinate (default 1e-6 of
+        the range).
+    params_of : callable, optional
+        value -> Params, for a parameter that moves others with it (e.g. d_n with k_n).
+    log : bool
+        Continue in log(parameter) (for parameters spanning decades, e.g. k_n).
+    detect : tuple of str
+        Which test functions to watch (`pdw.branch.KINDS`).
+    executor, workers : concurrent.futures.Executor, int
+        Where the continuous model's finite-difference evaluations run (default: threads).
+    fd_step : float
+        Central-difference step of the continuous model's Jacobian.
+    options : dict
+        Step-map options (hybrid: `pdw.hybrid.DEFAULT_OPTIONS`; continuous: rtol, atol,
+        event_tol, t_max, dt).
+    at : sequence of float
+        Parameter values at which the branch gets a point of its own (a natural correction
+        there, when the branch passes the value), e.g. to compare with a table.
+
+    Returns
+    -------
+    Branch
+    """
+    t0 = time.perf_counter()
+    if method not in ("pseudo_arclength", "natural"):
+        raise InvalidInputError("method must be 'pseudo_arclength' or 'natural', got %r"
+                                % (method,))
+    bad = set(detect) - {"fold", "period_doubling", "neimark_sacker", "end"}
+    if bad:
+        raise InvalidInputError("detect: unknown kind(s) %s" % sorted(bad))
+    prob = _problem(params, parameter, model, variant, period, params_of, log, options,
+                    executor, workers, fd_step)
+    if value is None:
+        if isinstance(start, Gait) and start.details and "value" in start.details:
+            value = start.details["value"]
+        elif params_of is None:
+            value = getattr(params, parameter)
+        else:
+            raise InvalidInputError("value= (the start's %s) is needed with params_of"
+                                    % parameter)
+    if prob.coord(float(stop)) == prob.coord(float(value)):
+        raise InvalidInputError("stop must differ from the start value %r, got %r"
+                                % (value, stop))
+    z0 = _start_z(prob, params, start, variant, period)
+    details = start.details if isinstance(start, Gait) and start.details else {}
+    tol = tol if tol is not None else (1e-10 if model == "hybrid" else 1e-8)
+    return run_continuation(prob, z0, value, stop, method=method, max_points=max_points,
+                            step=step, step_min=step_min, step_max=step_max, tol=tol,
+                            locate_tol=locate_tol, detect=detect, max_newton=max_newton,
+                            direction=details.get("direction"), origin=details.get("origin"),
+                            settings=dict(log=log, variant=variant, fd_step=fd_step), t0=t0,
+                            at=at)
+
+
+def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_points=200,
+                     step=None, step_min=None, step_max=None, tol=1e-10, locate_tol=None,
+                     detect=("fold", "period_doubling", "neimark_sacker", "end"), max_newton=8,
+                     direction=None, origin=None, settings=None, t0=None, at=()) -> Branch:
+    """The continuation proper, on any problem object (`pdw.analysis.gait_maps`: ``dim``, ``evaluate``,
+    ``coord``/``value``, ``gait``, ``ADMISSIBLE``, ...), from the fixed point z0 at ``value``
+    towards ``stop``; the arguments as in `continue_gait` (``direction``: (dz, dmu) to orient
+    the first tangent; ``origin``: where a switched branch was born, for plots; ``at``:
+    parameter values where a point is also computed, by a natural correction, whenever the
+    branch passes them)."""
+    t0 = time.perf_counter() if t0 is None else t0
+    mu0, mu_stop = prob.coord(float(value)), prob.coord(float(stop))
+    if not np.isfinite(mu_stop) or mu_stop == mu0:
+        raise InvalidInputError("stop must differ from the start value %r, got %r"
+                                % (value, stop))
+    scale = mu_stop - mu0          # signed: u runs from 0 to 1
+    if hasattr(prob, "lam_rel"):
+        prob.lam_step = prob.lam_rel * max(abs(mu0), abs(scale))
+    eng = _Engine(prob, mu0, scale, tol, max_newton, method == "natural")
+    ds = abs(step / scale) if step else 0.02
+    step_min = 1e-6 if step_min is None else step_min
+    step_max = 0.1 if step_max is None else step_max
+    locate_tol = 1e-6 * abs(scale) if locate_tol is None else locate_tol
+    if int(max_points) < 2:
+        raise InvalidInputError("max_points must be >= 2, got %r" % (max_points,))
+    x0 = np.append(np.asarray(z0, dtype=float), 0.0)
+    e = np.zeros(prob.dim + 1)
+    e[-1] = 1.0
+    first, why, _ = eng.correct(x0, e)
+    if first is None:
+        raise GaitNotFoundError("the start is not a period-%d gait of the %s model at %s = %r: "
+                                "%s" % (prob.period, prob.model, prob.parameter, value, why))
+    ev = why
+    ref = e.copy()
+    if direction is not None:
+        dz, dmu = direction
+        ref = np.append(np.asarray(dz, dtype=float), dmu / scale)
+    pts = [_Point(first, ev, eng.tangent(ev, ref), 0, 0.0)]
+    pts[0].tests = _tests(eng, pts[0])
+    bifs = []
+    stop_reason = "max_points (%d) reached" % max_points
+    while len(pts) < max_points:
+        a = pts[-1]
+        b, why, its = eng.step_from(a, ds)
+        if b is None:
+            ds *= 0.5
+            if ds < step_min:
+                bifs.append(Bifurcation(
+                    kind="end", value=eng.value(a.x), gait=None, index=len(pts) - 1,
+                    tolerance=abs(ds * 2 * scale), reason="the corrector fails beyond the "
+                    "last point: %s" % why, z=a.x[:-1].copy(), mu=eng.mu(a.x),
+                    tangent=a.tangent.copy(), multipliers=a.mult.copy()))
+                stop_reason = "end of the family: %s" % why
+                break
+            continue
+        b.tests = _tests(eng, b)
+        found = _check_crossings(eng, a, b, len(pts) - 1, locate_tol, detect)
+        ends = [f for f in found if f.kind == "end"]
+        bifs += found
+        u = b.x[-1]
+        if ends:
+            stop_reason = "end of the family: " + ends[0].reason
+            break
+        if u >= 1.0:
+            # land on stop exactly
+            c, why2, _ = eng.correct(a.x + (b.x - a.x) * (1.0 - a.x[-1]) / (u - a.x[-1]), e)
+            if c is not None:
+                last = _Point(c, why2, eng.tangent(why2, a.tangent), 0, ds)
+                last.tests = _tests(eng, last)
+                pts.append(last)
+            else:
+                pts.append(b)
+            stop_reason = "reached stop = %.10g" % float(stop)
+            bifs = [f for f in bifs if (f.mu - mu0) / scale <= 1.0 + 1e-12]
+            break
+        for ua in sorted((prob.coord(float(v)) - mu0) / scale for v in at):
+            if min(a.x[-1], u) < ua < max(a.x[-1], u):
+                c, evc, _ = eng.correct(a.x + (b.x - a.x) * (ua - a.x[-1]) / (u - a.x[-1]), e)
+                if c is not None:
+                    extra = _Point(c, evc, eng.tangent(evc, a.tangent), 0, 0.0)
+                    extra.tests = _tests(eng, extra)
+                    pts.append(extra)
+        pts.append(b)
+        if u < -1e-9 and not eng.natural:
+            stop_reason = "the branch returned past the start value (after a fold)"
+            break
+        if its <= 2:
+            ds = min(ds * 1.5, step_max)
+        elif its >= 5:
+            ds = max(ds * 0.7, step_min)
+    return _branch(eng, pts, bifs, stop_reason, prob, time.perf_counter() - t0,
+                   dict(method=method, tol=tol, locate_tol=locate_tol, step_min=step_min,
+                        step_max=step_max, start_value=float(value), stop=float(stop),
+                        options=dict(getattr(prob, "opts", {})), origin=origin,
+                        **(settings or {})))
+
+
+def _branch(eng, pts, bifs, stop_reason, prob, wall, settings) -> Branch:
+    mult = np.array([p.mult for p in pts])
+    return Branch(
+        parameter=prob.parameter, model=prob.model, period_n=prob.period,
+        values=np.array([eng.value(p.x) for p in pts]),
+        period=np.array([p.ev.info["period"] for p in pts]),
+        step_length=np.array([p.ev.info["step_length"] for p in pts]),
+        double_support=np.array([p.ev.info["double_support"] for p in pts]),
+        multipliers=mult, stable=np.all(np.abs(mult) < 1.0, axis=1),
+        state=np.array([p.ev.info["state"] for p in pts]),
+        z=np.array([p.x[:-1] for p in pts]), orbit=np.array([p.ev.info["orbit"] for p in pts]),
+        tangents=np.array([p.tangent for p in pts]),
+        step_size=np.array([p.ds for p in pts]),
+        newton_iterations=np.array([p.iters for p in pts]),
+        bifurcations=bifs, stop_reason=stop_reason, n_maps=prob.n_maps, wall_time=wall,
+        settings={**settings, "scale": eng.scale, "mu0": eng.mu0}, problem=prob,
+        switcher=switch_branch)
+
+
+# --- branch switching -------------------------------------------------------------------------
+
+def switch_branch(branch, bifurcation, amplitude=0.005, max_tries=6) -> Gait:
+    """The first gait of the period-2n branch born at a period doubling of ``branch``.
+
+    Newton's method on P^{2n} in the hyperplane w . (x - x*) = a (module docstring), a =
+    ``amplitude`` (in the section coordinates; halved up to ``max_tries`` times when Newton
+    fails or lands back on the period-n branch). The returned `Gait` carries
+    ``details["value"]`` (its parameter) and ``details["direction"]`` (the branch's direction
+    away from the bifurcation), so ``continue_gait(..., period=2n, start=gait)`` follows it.
+    """
+    if bifurcation.kind != "period_doubling":
+        raise InvalidInputError("switch needs a period_doubling bifurcation, got %r"
+                                % bifurcation.kind)
+    p1 = branch.problem
+    s = branch.settings
+    prob = type(p1).__new__(type(p1))
+    prob.__dict__.update(p1.__dict__)
+    prob.period = 2 * p1.period
+    prob.n_maps = 0
+    eng = _Engine(prob, s["mu0"], s["scale"], s["tol"], 12, False)
+    eng1 = _Engine(p1, s["mu0"], s["scale"], s["tol"], 12, False)
+    x_star = np.append(bifurcation.z, (bifurcation.mu - s["mu0"]) / s["scale"])
+    t1 = np.asarray(bifurcation.tangent, dtype=float)
+    w = np.append(bifurcation.eigenvector, 0.0)
+    w = w - (w @ t1) * t1
+    w /= np.linalg.norm(w)
+    a = float(amplitude)
+    why = "not tried"
+    for _ in range(max_tries):
+        x, ev, _ = eng.correct(x_star + a * w, w)
+        if x is not None:
+            one = eng1.evaluate(x, jac=False)
+            gap = np.max(np.abs(one.Pz - x[:-1])) if one.ok else np.inf
+            if gap > 100 * s["tol"]:
+                m = np.linalg.eigvals(ev.M)
+                gait = prob.gait(x[:-1], eng.mu(x), ev, m[np.argsort(-np.abs(m))])
+                d = x - x_star
+                gait.details.update(value=eng.value(x), direction=(d[:-1], d[-1] * s["scale"]),
+                                    switched_from=bifurcation.as_dict(),
+                                    origin=(bifurcation.value, np.asarray(
+                                        bifurcation.details.get("orbit", [bifurcation.z]))),
+                                    distance_to_period_n=float(gap))
+                return gait
+            why = "landed on the period-%d branch" % p1.period
+        else:
+            why = ev
+        a *= 0.5
+    raise GaitNotFoundError("no period-%d gait found next to the period doubling at %s = %.8g: "
+                            "%s" % (prob.period, p1.parameter, bifurcation.value, why))
+
+
+def follow_cascade(params, parameter, stop, depth=2, **kw) -> list:
+    """Continue the period-n gait to ``stop``, switch at its first period doubling, continue
+    the period-2n branch, and so on ``depth`` times: the list of branches."""
+    branches = [continue_gait(params, parameter, stop, **kw)]
+    period = kw.pop("period", 1)
+    kw.pop("start", None)
+    kw.pop("value", None)
+    for _ in range(depth):
+        pds = branches[-1].of_kind("period_doubling")
+        if not pds:
+            break
+        period *= 2
+        g = branches[-1].switch(pds[0])
+        branches.append(continue_gait(g.params, parameter, stop, period=period, start=g, **kw))
+    return branches

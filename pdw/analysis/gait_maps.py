@@ -1,0 +1,273 @@
+"""Step maps of one parameter, with their Jacobians, for continuation (`pdw.analysis.continuation`).
+
+A *problem* is the period-n step map z -> P^n(z; lambda) on a model's Poincaré section with
+the Jacobians the continuation needs: ``M = d P^n / d z`` (the monodromy matrix; its
+eigenvalues are the Floquet multipliers) and ``d P^n / d lambda``. Two models:
+
+* `HybridProblem` (`pdw.hybrid`, rigid ground): z = (theta_st, thetad_st, thetad_sw) just after
+  heel strike. M is **exact**: the variational equations of the symbolic stance Jacobian
+  integrated to the strike (the same Dormand-Prince 5(4) and tolerances as the map) and the
+  saltation matrix of the heel-strike event times the derivative of the impact map
+  (pdw/core/csrc/pdw_hybrid_var.c, emitted pieces from derive/hybrid.py). It agrees with central
+  differences to ~1e-9 at rtol = atol = 1e-12 (tests/test_continuation.py).
+* `ContinuousProblem` (`pdw.limit_cycle`, compliant ground): z (6) at the swing foot's
+  touch-down. M by central differences of the rodas4 map (rtol 1e-10, atol 1e-12, event_tol
+  1e-12, step ``fd_step`` = 1e-5): the map is reproducible to ~1e-10, so M is good to ~1e-5
+  (multipliers below ~1e-4 in modulus are not resolved). The 12 + 2 evaluations run on an
+  executor (threads by default; the compiled loop releases the GIL).
+
+``d P^n / d lambda`` is a central difference in the (internal) parameter coordinate for both, of
+relative step ``lam_rel`` (1e-6 hybrid, 1e-4 continuous) of the continuation's scale.
+Every evaluation also returns the gait's descriptors and its *admissibility* functions:
+quantities that must stay positive for the gait to exist as modelled (the end of a family when
+one crosses zero), see `HybridProblem.ADMISSIBLE` and `ContinuousProblem.ADMISSIBLE`.
+"""
+from __future__ import annotations
+
+import math
+import os
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+from ..core import _hybrid
+from ..core.errors import InvalidInputError
+from ..core.model import parameter_vector
+from ..core.params import Params
+from . import hybrid as H
+from . import limit_cycle as LC
+from .gait_types import Gait
+
+
+class Evaluation:
+    """P^n(z), its Jacobians and descriptors at one (z, lambda); ``ok`` False when a step failed
+    (``status`` says how)."""
+
+    __slots__ = ("ok", "status", "Pz", "M", "P_lam", "info", "admissible")
+
+    def __init__(self, ok, status, Pz=None, M=None, P_lam=None, info=None, admissible=None):
+        self.ok, self.status, self.Pz, self.M, self.P_lam = ok, status, Pz, M, P_lam
+        self.info = info or {}
+        self.admissible = admissible or {}
+
+
+class _Problem:
+    """Common part: the parameter, its coordinate (linear or log) and ``params_of``."""
+
+    dim = 0
+    model = ""
+    ADMISSIBLE: dict = {}
+
+    #: relative step of the central difference in the parameter coordinate (times
+    #: max(|mu_0|, |mu_stop - mu_0|), set by the continuation)
+    lam_rel = 1e-6
+
+    def __init__(self, params, parameter, params_of=None, period=1, log=False, lam_step=1e-6):
+        if not isinstance(params, Params):
+            raise InvalidInputError("params must be a pdw.Params, got %s" % type(params).__name__)
+        if params_of is None and parameter not in Params.__dataclass_fields__:
+            raise InvalidInputError("parameter must be a Params field (%s) or come with "
+                                    "params_of, got %r"
+                                    % (", ".join(Params.__dataclass_fields__), parameter))
+        if int(period) < 1:
+            raise InvalidInputError("period must be an integer >= 1, got %r" % (period,))
+        self.base, self.parameter, self.period = params, parameter, int(period)
+        self._of = params_of
+        self.log = bool(log)
+        self.lam_step = float(lam_step)
+        self.n_maps = 0            # step-map evaluations (one step of the walker each)
+
+    # parameter coordinate: mu = log(lambda) or lambda
+    def value(self, mu):
+        return float(math.exp(mu)) if self.log else float(mu)
+
+    def coord(self, value):
+        if self.log and not value > 0:
+            raise InvalidInputError("log continuation needs %s > 0, got %r"
+                                    % (self.parameter, value))
+        return float(math.log(value)) if self.log else float(value)
+
+    def params_at(self, mu) -> Params:
+        v = self.value(mu)
+        try:
+            return self._of(v) if self._of is not None else self.base.replace(
+                **{self.parameter: v})
+        except ValueError as e:
+            raise InvalidInputError("%s = %r: %s" % (self.parameter, v, e)) from None
+
+
+class HybridProblem(_Problem):
+    """Period-n map of the hybrid walker on z = (theta_st, thetad_st, thetad_sw)."""
+
+    dim = 3
+    model = "hybrid"
+    #: admissibility functions (> 0 along a valid gait): the new stance foot's smallest normal
+    #: force over the stance (no lift-off, it must push), the trailing foot's upward velocity
+    #: after the impact (it leaves the ground), the swing foot's downward speed at the strike
+    #: (a transversal strike, not a graze)
+    ADMISSIBLE = {"Fn_min": "the stance foot would need a pulling ground force (it lifts off)",
+                  "v_old_up": "the trailing foot does not leave the ground after heel strike",
+                  "strike_speed": "the swing foot grazes the ground (strike velocity -> 0)"}
+
+    def __init__(self, params, parameter, params_of=None, period=1, log=False, options=None,
+                 **kw):
+        super().__init__(params, parameter, params_of, period, log, **kw)
+        self.opts = {**H._TIGHT, **H._options(options or {})}
+
+    def section(self, state):
+        s = np.asarray(state, dtype=float).reshape(-1)
+        return s[list(H._SECTION)] if s.size == 4 else s.copy()
+
+    def _steps(self, p, z, jac):
+        """Compose n steps from z: (y_plus, DP (4x4) or None, step dicts) or a failure string."""
+        y = np.ascontiguousarray(H._y_of(z))
+        DP = np.eye(4)
+        steps = []
+        for _ in range(self.period):
+            self.n_maps += 1
+            if jac:
+                res, D = _hybrid.step_jac(p, y, self.opts)
+                DP = D @ DP
+            else:
+                res, _, _ = _hybrid.step(p, y, self.opts)
+            if res["status"] != "ok":
+                return res["status"]
+            steps.append(res)
+            y = np.ascontiguousarray(res["y_plus"])
+        return y, DP, steps
+
+    def evaluate(self, z, mu, jac=True) -> Evaluation:
+        try:
+            p = parameter_vector(self.params_at(mu))
+        except InvalidInputError as e:
+            return Evaluation(False, "invalid parameter: %s" % e)
+        out = self._steps(p, z, jac)
+        if isinstance(out, str):
+            return Evaluation(False, out)
+        y, DP, steps = out
+        Pz = y[list(H._SECTION)]
+        M = P_lam = None
+        if jac:
+            E = np.array([[1.0, 0, 0], [-1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0]])
+            M = DP[list(H._SECTION)] @ E
+            h = self.lam_step
+            vals = []
+            for s in (+h, -h):
+                o = self._steps(parameter_vector(self.params_at(mu + s)), z, False)
+                if isinstance(o, str):
+                    return Evaluation(False, "parameter derivative: " + o)
+                vals.append(o[0][list(H._SECTION)])
+            P_lam = (vals[0] - vals[1]) / (2 * h)
+        info = {"period": float(sum(s["t_strike"] for s in steps)),
+                "step_length": float(np.mean([s["step_length"] for s in steps])),
+                "double_support": 0.0, "state": H._y_of(z),
+                "orbit": np.array([z] + [s["y_plus"][list(H._SECTION)] for s in steps[:-1]])}
+        adm = {"Fn_min": min(s["Fn_min"] for s in steps),
+               "v_old_up": min(s["v_old"][1] for s in steps),
+               "strike_speed": min(-s["vy_strike"] for s in steps)}
+        return Evaluation(True, "ok", Pz, M, P_lam, info, adm)
+
+    def gait(self, z, mu, ev, multipliers) -> Gait:
+        return Gait(state=H._y_of(z), period=ev.info["period"], step_length=ev.info["step_length"],
+                    double_support=0.0, multipliers=multipliers, model="hybrid",
+                    params=self.params_at(mu),
+                    details={"z": np.array(z), "period_n": self.period, "jacobian": ev.M,
+                             "jacobian_kind": "exact (variational equations + saltation)",
+                             "options": dict(self.opts)})
+
+
+class ContinuousProblem(_Problem):
+    """Period-n map of the continuous walker (`pdw.limit_cycle`) on its 6-D section."""
+
+    dim = 6
+    model = "continuous"
+    lam_rel = 1e-4          # the map is reproducible to ~1e-10
+    #: admissibility: the double support must last (> 0; else the feet are never both down and
+    #: the section's event order changes), and the swing phase too
+    ADMISSIBLE = {"double_support": "the double support vanishes (flight or swapped events)",
+                  "swing_period": "the swing phase vanishes"}
+
+    def __init__(self, params, parameter, params_of=None, period=1, log=False, variant="paper",
+                 method="rodas4", options=None, fd_step=1e-5, executor=None, workers=None, **kw):
+        super().__init__(params, parameter, params_of, period, log, **kw)
+        self.variant, self.method = variant, method
+        self.opts = {**LC.TIGHT, **(options or {})}
+        self.fd_step = float(fd_step)
+        self.executor = executor
+        self.workers = max(1, int(workers or os.cpu_count() or 1))
+        self.t_hint = None
+
+    def section(self, state):
+        s = np.asarray(state, dtype=float).reshape(-1)
+        return LC.section_coordinates(s, 2) if s.size == 8 else s.copy()
+
+    def __getstate__(self):
+        # the tasks travel to process pools / Dask workers without the executor itself
+        return {**self.__dict__, "executor": None}
+
+    def _run(self, tasks):
+        fn = _ContinuousTask(self)
+        if self.executor is not None:
+            return list(self.executor.map(fn, tasks))
+        if self.workers <= 1 or len(tasks) == 1:
+            return [fn(t) for t in tasks]
+        with ThreadPoolExecutor(min(self.workers, len(tasks))) as ex:
+            return list(ex.map(fn, tasks))
+
+    def evaluate(self, z, mu, jac=True) -> Evaluation:
+        z = np.asarray(z, dtype=float)
+        try:
+            self.params_at(mu)
+        except InvalidInputError as e:
+            return Evaluation(False, "invalid parameter: %s" % e)
+        tasks = [(z, mu)]
+        if jac:
+            h, hl = self.fd_step, self.lam_step
+            tasks += [(z + e, mu) for e in np.eye(6) * h] + [(z - e, mu) for e in np.eye(6) * h]
+            tasks += [(z, mu + hl), (z, mu - hl)]
+        outs = self._run(tasks)
+        self.n_maps += self.period * len(tasks)
+        Pz, steps = outs[0]
+        if Pz is None:
+            return Evaluation(False, steps[-1]["status"] if steps else "failed")
+        self.t_hint = steps[0]["period"]
+        M = P_lam = None
+        if jac:
+            vals = [o[0] for o in outs]
+            if any(v is None for v in vals):
+                bad = next(o[1][-1]["status"] for o in outs if o[0] is None)
+                return Evaluation(False, "finite-difference neighbour: " + bad)
+            M = np.column_stack([(vals[1 + k] - vals[7 + k]) / (2 * h) for k in range(6)])
+            P_lam = (vals[13] - vals[14]) / (2 * hl)
+        info = {"period": float(sum(s["period"] for s in steps)),
+                "step_length": float(np.mean([s["step_length"] for s in steps])),
+                "double_support": float(np.mean([s["double_support"] for s in steps])),
+                "state": LC.embed(z, self.params_at(mu)),
+                "n_events": int(sum(s["n_events"] for s in steps)),
+                "orbit": np.array([z] + [s["z"] for s in steps[:-1]])}
+        adm = {"double_support": min(s["double_support"] for s in steps),
+               "swing_period": min(s["swing_period"] for s in steps)}
+        return Evaluation(True, "ok", Pz, M, P_lam, info, adm)
+
+    def gait(self, z, mu, ev, multipliers) -> Gait:
+        return Gait(state=ev.info["state"], period=ev.info["period"],
+                    step_length=ev.info["step_length"], double_support=ev.info["double_support"],
+                    multipliers=multipliers, model="continuous", params=self.params_at(mu),
+                    details={"z": np.array(z), "period_n": self.period, "jacobian": ev.M,
+                             "jacobian_kind": "central differences, fd_step %g" % self.fd_step,
+                             "variant": self.variant, "options": dict(self.opts)})
+
+
+class _ContinuousTask:
+    """Callable P^n at (z, mu) -> (P^n(z) or None, steps); picklable (for process pools and
+    Dask) when ``params_of`` is."""
+
+    def __init__(self, prob):
+        self.prob = prob
+
+    def __call__(self, task):
+        z, mu = task
+        pr = self.prob
+        opts = {**pr.opts, "t_hint": pr.t_hint}
+        return LC._compose(np.asarray(z), pr.period, pr.params_at(mu), pr.variant, pr.method,
+                           opts)

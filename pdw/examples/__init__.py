@@ -1,0 +1,54 @@
+"""Example scenes and study files shipped with pdw (package data).
+
+``pdw run --example NAME`` runs a scene, ``pdw sweep --example NAME`` a study;
+``--list-examples`` lists them. In Python: `scene_path`, `study_path`, `scenes`, `studies`.
+
+Scenes (``*.toml`` here) are `pdw.Scene` files (docs/scenes.md); studies (``studies/*.toml``)
+are parameter studies (docs/studies.md) whose ``[scene]`` table is a `pdw.Scene`.
+"""
+from __future__ import annotations
+
+import pathlib
+
+from ..core.errors import InvalidInputError
+
+HERE = pathlib.Path(__file__).resolve().parent
+
+
+def _names(folder: pathlib.Path) -> list:
+    return sorted(p.stem for p in folder.glob("*.toml"))
+
+
+def scenes() -> list:
+    """Names of the example scenes."""
+    return _names(HERE)
+
+
+def studies() -> list:
+    """Names of the example studies (the paper's Table 5 and Figs. 11-14)."""
+    return _names(HERE / "studies")
+
+
+def _path(folder, names, kind, name) -> pathlib.Path:
+    stem = name[:-5] if name.endswith(".toml") else name
+    if stem not in names:
+        raise InvalidInputError("no example %s %r; available: %s" % (kind, name, ", ".join(names)))
+    return folder / (stem + ".toml")
+
+
+def scene_path(name: str) -> pathlib.Path:
+    """Path of the example scene ``name`` (e.g. ``"typical_gait"``)."""
+    return _path(HERE, scenes(), "scene", name)
+
+
+def study_path(name: str) -> pathlib.Path:
+    """Path of the example study ``name`` (e.g. ``"fig11_k_n"``)."""
+    return _path(HERE / "studies", studies(), "study", name)
+
+
+def describe(path: pathlib.Path) -> str:
+    """The first comment line of an example file (its one-line description)."""
+    for line in path.read_text().splitlines():
+        if line.startswith("#"):
+            return line.lstrip("# ").strip()
+    return ""

@@ -1,0 +1,190 @@
+"""``pdw continue SPEC.toml``: a continuation from a TOML file -> CSV, JSON provenance, diagram.
+
+The spec (docs/continuation.md, examples in docs/continuations/)::
+
+    name = "compass_cascade"          # output names
+    title = "..."                     # figure title (optional)
+    model = "hybrid"                  # or "continuous"
+    preset = "compass"                # compass | simplest | paper | paper_steady
+    variant = "paper"                 # continuous model's contact variant
+    parameter = "gamma"
+    stop = 0.0925                     # continue until here
+    start = 0.0524                    # optional: the parameter's value at the start
+
+    [params]                          # optional overrides of the preset
+    d_hip = 0.010
+
+    [couple]                          # optional: other fields as powers of the parameter,
+    d_n = 1.3333333333                # d_n = d_n0 (value / value0)^(4/3)  (params_of)
+
+    [continuation]                    # keyword arguments of pdw.continue_gait, plus
+    step = 0.001                      # cascade = 2: switch at the period doublings twice
+    cascade = 2
+
+    [plot]
+    y = "step_length"                 # pdw.present.plots_continuation.QUANTITIES
+    x_scale = 57.29577951308232       # e.g. radians -> degrees
+    x_label = "slope [deg]"
+
+Writes ``<out>/<name>.csv`` (the points of every branch, with ``branch`` and ``period_n``
+columns), ``<out>/<name>.json`` (provenance: spec, code version, settings, per-branch summary
+with the bifurcations, map evaluations, wall time) and ``<out>/<name>.png``.
+"""
+from __future__ import annotations
+
+import csv
+import hashlib
+import json
+import os
+import pathlib
+import platform
+import sys
+import time
+
+import numpy as np
+
+from ..analysis.branch import _jsonable
+from ..analysis.continuation import continue_gait, follow_cascade
+from ..core.errors import InvalidInputError
+from ..core.params import Params
+
+try:
+    import tomllib
+except ImportError:                                    # pragma: no cover - Python < 3.11
+    import tomli as tomllib
+
+KEYS = {"name", "title", "model", "preset", "variant", "parameter", "stop", "start", "params",
+        "couple", "continuation", "plot"}
+CONTINUATION_KEYS = {"step", "method", "max_points", "step_min", "step_max", "tol",
+                     "locate_tol", "log", "detect", "max_newton", "fd_step", "options",
+                     "cascade", "period", "workers"}
+
+
+def preset(name, **overrides) -> Params:
+    """The walker of a spec's ``preset``."""
+    from ..analysis import hybrid as H
+    if name == "compass":
+        return H.compass_gait_params(**overrides)
+    if name == "simplest":
+        base = dict(l=1.0, c=1.0, w=0.0, r=0.0, J_l=0.0, m_h=1.0, m_l=1e-4, k_hip=0.0,
+                    d_hip=0.0, gamma=0.009, g=1.0)
+        return Params(**{**base, **overrides})
+    if name in ("paper", "paper_steady"):
+        return getattr(Params, name)(**overrides)
+    raise InvalidInputError("preset must be compass, simplest, paper or paper_steady, got %r"
+                            % (name,))
+
+
+def load_spec(path) -> dict:
+    text = pathlib.Path(path).read_text()
+    try:
+        spec = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise InvalidInputError("%s: not valid TOML: %s" % (path, e)) from None
+    bad = set(spec) - KEYS
+    if bad:
+        raise InvalidInputError("%s: unknown key(s) %s; allowed: %s"
+                                % (path, sorted(bad), sorted(KEYS)))
+    for k in ("name", "parameter", "stop"):
+        if k not in spec:
+            raise InvalidInputError("%s: missing %r" % (path, k))
+    bad = set(spec.get("continuation", {})) - CONTINUATION_KEYS
+    if bad:
+        raise InvalidInputError("%s: [continuation] unknown key(s) %s; allowed: %s"
+                                % (path, sorted(bad), sorted(CONTINUATION_KEYS)))
+    spec["_source"], spec["_path"] = text, str(path)
+    return spec
+
+
+def run_spec(spec, out=None):
+    """Run a loaded spec: (branches, paths written)."""
+    params = preset(spec.get("preset", "paper_steady"), **spec.get("params", {}))
+    par = spec["parameter"]
+    couple = dict(spec.get("couple", {}))
+    kw = dict(spec.get("continuation", {}))
+    depth = int(kw.pop("cascade", 0))
+    start = spec.get("start", getattr(params, par, None))
+    params_of = None
+    if couple:
+        p0 = params.replace(**{par: start})
+        v0 = float(start)
+
+        def params_of(v, p0=p0, v0=v0, couple=couple):
+            return p0.replace(**{par: v}, **{f: getattr(p0, f) * (v / v0) ** e
+                                             for f, e in couple.items()})
+    params = params.replace(**{par: start}) if start is not None else params
+    common = dict(model=spec.get("model", "continuous"), variant=spec.get("variant", "paper"),
+                  params_of=params_of, value=start, **kw)
+    t0 = time.perf_counter()
+    if depth > 0:
+        branches = follow_cascade(params, par, spec["stop"], depth=depth, **common)
+    else:
+        branches = [continue_gait(params, par, spec["stop"], **common)]
+    wall = time.perf_counter() - t0
+    out = pathlib.Path(out or os.path.join("out", "continuation", spec["name"]))
+    out.mkdir(parents=True, exist_ok=True)
+    paths = {"csv": out / ("%s.csv" % spec["name"]), "json": out / ("%s.json" % spec["name"]),
+             "png": out / ("%s.png" % spec["name"])}
+    _write_csv(branches, paths["csv"])
+    with open(paths["json"], "w") as fh:
+        json.dump(_provenance(spec, branches, wall), fh, indent=2, default=_jsonable)
+    from .plots_continuation import plot_branches
+    plot = spec.get("plot", {})
+    ax = plot_branches(branches, y=plot.get("y", "step_length"),
+                       x_scale=float(plot.get("x_scale", 1.0)), x_label=plot.get("x_label"),
+                       title=spec.get("title"), path=paths["png"])
+    import matplotlib.pyplot as plt
+    plt.close(ax.figure)
+    return branches, paths
+
+
+def _write_csv(branches, path):
+    rows = [{"branch": k, **r} for k, b in enumerate(branches) for r in b.rows()]
+    fields = []
+    for r in rows:
+        fields += [f for f in r if f not in fields]
+    with open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=fields, restval="")
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: ("%.17g" % v if isinstance(v, float) else v) for k, v in r.items()})
+
+
+def _provenance(spec, branches, wall):
+    from ..core import __version__
+    from ..core._layout import INPUT_HASH
+    from ..studies.sweep import git_describe
+    src = spec["_source"]
+    return {"spec": {"path": spec["_path"], "sha256": hashlib.sha256(src.encode()).hexdigest(),
+                     "toml": src},
+            "code": {"pdw_version": __version__, "input_hash": INPUT_HASH,
+                     "git_describe": git_describe()},
+            "python": sys.version.split()[0], "numpy": np.__version__,
+            "platform": platform.platform(), "cpu_count": os.cpu_count(),
+            "wall_time_s": wall, "map_evaluations": sum(b.n_maps for b in branches),
+            "branches": [b.summary() for b in branches]}
+
+
+def add_cli(subparsers):
+    """Register ``pdw continue`` on an argparse subparsers object."""
+    s = subparsers.add_parser("continue", help="follow a gait through a parameter: branches, "
+                                               "stability, bifurcations (CSV + JSON + diagram)")
+    s.add_argument("spec", help="the continuation file (TOML; see docs/continuation.md)")
+    s.add_argument("--out", help="output folder (default out/continuation/<name>)")
+    s.set_defaults(func=cli_main)
+    return s
+
+
+def cli_main(args):
+    spec = load_spec(args.spec)
+    branches, paths = run_spec(spec, args.out)
+    for b in branches:
+        print("period %d: %d points, %s in [%.8g, %.8g], %d map evaluations, %.1f s; %s"
+              % (b.period_n, len(b), b.parameter, b.values.min(), b.values.max(), b.n_maps,
+                 b.wall_time, b.stop_reason))
+        for f in b.bifurcations:
+            print("  %-16s at %s = %.10g (+- %.2g): %s" % (f.kind, b.parameter, f.value,
+                                                            f.tolerance, f.reason))
+    for p in paths.values():
+        print("wrote %s" % p)
+    return 0
