@@ -17,6 +17,18 @@ PARAMS = (
 # Derived constants appended to the parameter vector once per simulation
 # (`pdw_precompute`), so that no kernel evaluates a transcendental of a parameter.
 DERIVED = ("sin_gamma", "cos_gamma")
+# Parameters of the contact laws beyond the paper's (derive/contact_laws.py, docs/contact_laws.md),
+# appended after DERIVED: they are not `pdw.Params` fields but set from a `pdw.Contact`
+# (zero unless a law that uses them is selected).
+CONTACT_PARAMS = (
+    "e_n",        # coefficient of restitution of the Lankarani-Nikravesh and Flores laws [-]
+    "v_in_min",   # smallest approach speed those laws divide by [m/s]
+)
+
+# Discrete per-foot values captured at touch-down, passed to the kinematics stage ("anchors"):
+# the rolling coordinate s_i (the consistent variant's xi) and the approach speed -v_y (the
+# Lankarani-Nikravesh and Flores damping), foot-major within each kind.
+ANCHORS = ("s0_1", "s0_2", "v_in1", "v_in2")
 
 # Per-foot contact kinematics (docs/model.md section 2, Eqs. 4, 5, 8, 9), for the kernel's variant.
 KIN = (
@@ -26,6 +38,7 @@ KIN = (
     "v_y",    # normal rate of the variant [m/s] (Eq. 5); delta_dot = -v_y
     "s",      # rolling coordinate x_o + (l-r) sin(theta) + r theta [m]; ds/dt = v_x
     "xi",     # tangential deformation of the variant [m] (Eqs. 8, 11)
+    "v_in",   # approach speed -v_y captured at the foot's touch-down [m/s] (anchors)
 )
 
 # Per-foot contact forces and their partial derivatives (docs/model.md section 4, Eqs. 3, 6, 7, 10, 11).

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
+from . import contact_laws as laws
 from . import layout
 
 VARIANTS = ("paper", "consistent")
@@ -46,14 +47,15 @@ def _real(name):
 X = tuple(_real(n) for n in layout.STATE)
 Q = X[: layout.NQ]
 QD = X[layout.NQ:]
-P = {n: _real(n) for n in layout.PARAMS + layout.DERIVED}
+P = {n: _real(n) for n in layout.PARAMS + layout.DERIVED + layout.CONTACT_PARAMS}
 # contact forces as symbols of the dynamics stage, foot 1 then foot 2
 F_N = (_real("F_n1"), _real("F_n2"))
 F_T = (_real("F_t1"), _real("F_t2"))
 QDD = tuple(_real("qdd%d" % i) for i in range(layout.NQ))
 ANCHOR = (_real("s0_1"), _real("s0_2"))
+V_IN = (_real("v_in1"), _real("v_in2"))     # approach speed at touch-down (layout.ANCHORS)
 # per-foot scalar contact variables of the force laws
-DELTA, DELTAD, VT, XI, FN = (_real(n) for n in ("delta", "deltad", "v_t", "xi", "F_n"))
+DELTA, DELTAD, VT, XI, FN, VIN = (_real(n) for n in ("delta", "deltad", "v_t", "xi", "F_n", "v_in"))
 
 
 @dataclass(frozen=True)
@@ -141,6 +143,7 @@ def contact_kinematics(foot: int, variant: str) -> dict:
     else:
         out["v_y"] = v_y
         out["xi"] = out["s"] - ANCHOR[foot]                             # slip since touch-down
+    out["v_in"] = V_IN[foot]                                            # captured at touch-down
     return {k: out[k] for k in layout.KIN}
 
 
@@ -168,8 +171,9 @@ def friction_coefficient(v):
     )
 
 
-def contact_laws(variant: str, features=FEATURES) -> dict:
-    """Force laws of one penetrating support foot, in the scalar variables delta, deltad, v_t, xi.
+def contact_laws(variant: str, features=FEATURES, normal: str = "hunt_crossley") -> dict:
+    """Force laws of one penetrating support foot, in the scalar variables delta, deltad, v_t, xi
+    (and v_in, the approach speed at touch-down, for the laws that use it).
 
     Parameters
     ----------
@@ -177,16 +181,20 @@ def contact_laws(variant: str, features=FEATURES) -> dict:
         Selects the tangential deformation's gate (docs/model.md section 6).
     features : iterable of str
         Force elements present; those absent are folded to zero.
+    normal : str
+        Normal law, one of `derive.contact_laws.NORMAL_LAWS` (default: the paper's
+        Hunt-Crossley, Eqs. 3, 6).
 
     Returns
     -------
     dict keyed by `layout.CONTACT` field names.
     """
-    kn, dn, kt, dt = P["k_n"], _fold(P["d_n"], "normal_damping", features), \
+    dn, kt, dt = _fold(P["d_n"], "normal_damping", features), \
         _fold(P["k_t"], "tangential", features), _fold(P["d_t"], "tangential", features)
-    d15 = DELTA * sp.sqrt(DELTA)            # delta^m = delta^p, m = p = 1.5 (delta > 0 here)
-    fn_raw = kn * d15 + dn * d15 * DELTAD   # Eqs. 3, 6 (q = 1)
-    Fn = sp.Piecewise((fn_raw, fn_raw > 0), (0, True))   # the ground cannot pull
+    Pn = dict(P, d_n=dn)
+    if normal in ("lankarani_nikravesh", "flores") and "normal_damping" not in features:
+        Pn["e_n"] = sp.S.One                # no damping: perfectly elastic
+    Fn = laws.normal_force(normal, DELTA, DELTAD, VIN, Pn)   # the ground cannot pull
     mu = friction_coefficient(VT) if "friction" in features else sp.S.Zero
     # Eq. 7 with m = p = 1.5: -sign(xi) k_t |xi|^1.5 - d_t |xi|^1.5 v_t. Its xi-derivative is
     # written out so that it stays finite at xi = 0 (where the anchored variant starts).

@@ -26,15 +26,24 @@ from . import model as mdl
 
 @dataclass(frozen=True)
 class KernelSpec:
-    """One generated kernel: a variant and the force elements it contains."""
+    """One generated kernel: a variant, the force elements it contains, and its normal contact
+    law (`derive.contact_laws.NORMAL_LAWS`; the paper's Hunt-Crossley by default)."""
 
     variant: str
     features: tuple = mdl.FEATURES
+    normal: str = "hunt_crossley"
 
     @property
     def name(self):
         missing = [f for f in mdl.FEATURES if f not in self.features]
-        return self.variant + "".join("_no_" + f for f in missing)
+        law = "" if self.normal == "hunt_crossley" else "_" + self.normal
+        return self.variant + "".join("_no_" + f for f in missing) + law
+
+    @property
+    def mechanics(self):
+        """The kernel whose mechanical stages this one shares (same variant and features,
+        Hunt-Crossley): only the contact stages depend on the normal law."""
+        return KernelSpec(self.variant, self.features)
 
     @property
     def feature_mask(self):
@@ -63,7 +72,7 @@ def kinematics(spec: KernelSpec):
 
 def contact(spec: KernelSpec):
     """Expressions of `layout.CONTACT` for one penetrating support foot."""
-    return list(mdl.contact_laws(spec.variant, spec.features).values())
+    return list(mdl.contact_laws(spec.variant, spec.features, spec.normal).values())
 
 
 def forcing(spec: KernelSpec) -> sp.Matrix:

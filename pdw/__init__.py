@@ -15,6 +15,7 @@ contact_forces          contact kinematics and forces of both feet (Eqs. 3-11)
 energies                kinetic and potential energies
 simulate, Result        one compiled simulation (support flags, events, status)
 simulate_batch          N walkers in one call, W lanes in lockstep (docs/ensemble.md): BatchResult
+Contact                 the normal and friction contact laws of a run (docs/contact_laws.md)
 Scene, run              everything a simulation needs, as one object or TOML file (docs/scenes.md)
 steps                   per-step gait descriptors (docs/model.md section 8)
 hybrid                  the rigid-ground impact-momentum model (docs/model.md section 9): find_gait, ...
@@ -39,6 +40,7 @@ from .analysis.gait_types import Gait
 from .analysis.limit_cycle import find_gait
 from .core import __version__  # noqa: F401 (pdw.__version__)
 from .core._layout import INPUT_HASH
+from .core.contact import Contact
 from .core.errors import (
     DivergedError,
     FellError,
@@ -86,4 +88,5 @@ __all__ = [
     "limit_cycle", "cell_mapping", "find_gait", "sweep",
     "StepSizeWarning", "StepSizeError", "examples", "continue_gait", "Branch", "Bifurcation",
     "ode_function", "OdeFunction", "load", "RecordBuffer",
+    "Contact",
 ]

@@ -72,7 +72,7 @@ def test_compiled_extension_matches_layout():
     """The built extension was compiled from the generated files that _layout describes."""
     assert _core.NX == len(_layout.STATE) and _core.NQ == _layout.NQ
     assert _core.NWORK == _layout.NWORK
-    assert _core.NP == len(_layout.PARAMS) + len(_layout.DERIVED)
+    assert _core.NP == len(_layout.PARAMS) + len(_layout.DERIVED) + len(_layout.CONTACT_PARAMS)
     table = _core.kernel_table()
     assert [name for name, _, _ in table] == [k[0] for k in _layout.KERNELS]
     assert [_layout.VARIANTS[v] for _, v, _ in table] == [k[1] for k in _layout.KERNELS]

@@ -172,6 +172,7 @@ def _kin_transcribed(i, variant):
     else:
         out["v_y"] = yd_o + (l - r) * sp.sin(th) * thd               # d/dt of Eq. 4
         out["xi"] = out["s"] - s0[i]                                 # slip since touch-down
+    out["v_in"] = sp.Symbol("v_in%d" % (i + 1), real=True)        # approach speed at touch-down
     return out
 
 

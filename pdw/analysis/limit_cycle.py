@@ -145,7 +145,7 @@ def _foot_height(x, leg, p):
 
 def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max=2.5,
          dt=1e-4, rtol=TIGHT["rtol"], atol=TIGHT["atol"], event_tol=TIGHT["event_tol"],
-         record=False) -> dict:
+         record=False, contact=None) -> dict:
     """One step of the Poincaré map from section point z; never raises on a failed step.
 
     Returns a dict: ``status`` (one of `STEP_STATUS`: "ok"; "fell"/"diverged" as `simulate`;
@@ -177,7 +177,7 @@ def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max
         t_end = max(t_end, 10 * dt)
         res = simulate(x0, t_end=t_end, dt=dt, params=p, variant=variant, method=method,
                        flags0=(1, 1), record_every=1, record_forces=record, on_failure="return",
-                       rtol=rtol, atol=atol, event_tol=event_tol)
+                       rtol=rtol, atol=atol, event_tol=event_tol, contact=contact)
         out["stats"] = dict(res.stats)
         lo = next((e for e in res.events if e.leg == 1 and e.kind == "lift_off"), None)
         td = next((e for e in res.events if e.leg == 1 and e.kind == "touch_down"), None)
@@ -421,7 +421,10 @@ def find_gait(params=None, variant="paper", guess=None, method="rodas4", *, peri
     workers : int
         Threads for the Jacobian's 13 map evaluations (default: all cores).
     options
-        Step-map options: rtol, atol, event_tol (default `TIGHT`), t_max, dt.
+        Step-map options: rtol, atol, event_tol (default `TIGHT`), t_max, dt, and
+        ``contact`` (`pdw.Contact`: the contact laws; the section re-initialises both feet's
+        approach speeds, so with lankarani_nikravesh or flores the trailing foot's damping
+        during the double support differs from a continuous run's).
 
     Returns
     -------

@@ -17,7 +17,7 @@ cdef extern from "pdw_model.h":
         PDW_NKERNELS, PDW_NEVENT, PDW_NREC
         PDW_WORK_TRIG, PDW_WORK_KIN, PDW_WORK_CONTACT, PDW_WORK_M, PDW_WORK_F, PDW_WORK_QDD
         PDW_STATUS_RUNNING, PDW_STATUS_EVENTS_FULL
-        PDW_NSTEP, PDW_STEP_RING
+        PDW_NSTEP, PDW_STEP_RING, PDW_NANCHOR, PDW_ANCHOR_V_IN1, PDW_ANCHOR_V_IN2
     ctypedef struct pdw_kernel:
         const char *name
         int variant
@@ -49,7 +49,7 @@ cdef extern from "pdw_sim.h":
     ctypedef struct pdw_discrete:
         int flags[2]
         int armed[2]
-        double anchors[2]
+        double anchors[4]
     ctypedef struct pdw_failure:
         double t
         double x[8]
@@ -192,7 +192,9 @@ cdef int _batch(const double[:, ::1] x, const double[::1] p, const int[:, ::1] f
     _rows("x", n, x.shape[1], n, PDW_NX)
     _len("p", p.shape[0], PDW_NP)
     _rows("flags", flags.shape[0], flags.shape[1], n, 2)
-    _rows("anchors", anchors.shape[0], anchors.shape[1], n, 2)
+    if anchors.shape[0] != n or anchors.shape[1] < 2 or anchors.shape[1] > PDW_NANCHOR:
+        raise ValueError("anchors must have shape (%d, 2..%d) (layout ANCHORS), got (%d, %d)"
+                         % (n, PDW_NANCHOR, anchors.shape[0], anchors.shape[1]))
     _rows(out_name, out_r, out_c, n, want_out_c)
     _rows("work", work.shape[0], work.shape[1], n, PDW_NWORK)
     _flags_ok(flags)
@@ -206,17 +208,36 @@ def precompute(const double[::1] params, double[::1] p):
     pdw_precompute(&params[0], &p[0])
 
 
+cdef int _anchor_width(const double[:, ::1] anchors) except -1:
+    if anchors.shape[1] < 2 or anchors.shape[1] > PDW_NANCHOR:
+        raise ValueError("anchors must have 2 to %d columns (layout ANCHORS), got %d"
+                         % (PDW_NANCHOR, anchors.shape[1]))
+    return anchors.shape[1]
+
+
+cdef inline void _anchors(const double[:, ::1] anchors, Py_ssize_t i, int na,
+                          double *a) noexcept nogil:
+    """Row i of anchors, padded with zeros to PDW_NANCHOR (s0 only: no approach speeds)."""
+    cdef int j
+    for j in range(PDW_NANCHOR):
+        a[j] = anchors[i, j] if j < na else 0.0
+
+
 def rhs_batch(int k, const double[:, ::1] x, const double[::1] p, const int[:, ::1] flags,
               const double[:, ::1] anchors, double[:, ::1] xdot, double[:, ::1] work):
     """f(x) (Eq. A.4) for each row; work (N, NWORK) receives every stage's output.
 
-    Shapes (checked): x, xdot (N, NX); p (NP,); flags (N, 2) of 0/1; anchors (N, 2)."""
+    Shapes (checked): x, xdot (N, NX); p (NP,); flags (N, 2) of 0/1; anchors (N, 2..NANCHOR)
+    (s0 only, or s0 and the approach speeds; missing columns are zero)."""
     cdef const pdw_kernel *kern = _kernel(k)
     _batch(x, p, flags, anchors, "xdot", xdot.shape[0], xdot.shape[1], PDW_NX, work)
     cdef Py_ssize_t i, n = x.shape[0]
+    cdef double a[PDW_NANCHOR]
+    cdef int na = _anchor_width(anchors)
     with nogil:
         for i in range(n):
-            kern.rhs(&x[i, 0], &p[0], &flags[i, 0], &anchors[i, 0], &xdot[i, 0], &work[i, 0])
+            _anchors(anchors, i, na, a)
+            kern.rhs(&x[i, 0], &p[0], &flags[i, 0], a, &xdot[i, 0], &work[i, 0])
 
 
 def jacobian_batch(int k, const double[:, ::1] x, const double[::1] p, const int[:, ::1] flags,
@@ -225,9 +246,31 @@ def jacobian_batch(int k, const double[:, ::1] x, const double[::1] p, const int
     cdef const pdw_kernel *kern = _kernel(k)
     _batch(x, p, flags, anchors, "J", J.shape[0], J.shape[1], PDW_NX * PDW_NX, work)
     cdef Py_ssize_t i, n = x.shape[0]
+    cdef double a[PDW_NANCHOR]
+    cdef int na = _anchor_width(anchors)
     with nogil:
         for i in range(n):
-            kern.jacobian(&x[i, 0], &p[0], &flags[i, 0], &anchors[i, 0], &J[i, 0], &work[i, 0])
+            _anchors(anchors, i, na, a)
+            kern.jacobian(&x[i, 0], &p[0], &flags[i, 0], a, &J[i, 0], &work[i, 0])
+
+
+def contact_batch(int k, const double[:, ::1] kin, const int[:, ::1] flags, const double[::1] p,
+                  double[:, ::1] contact, bint partials=False):
+    """The contact stage alone: per row, kin (N, 2*NKIN) -> contact (N, 2*NCONTACT) (forces
+    only, or with ``partials`` the partial derivatives too); for tests of the force laws."""
+    cdef const pdw_kernel *kern = _kernel(k)
+    cdef Py_ssize_t i, n = kin.shape[0]
+    _rows("kin", n, kin.shape[1], n, 2 * PDW_NKIN)
+    _rows("flags", flags.shape[0], flags.shape[1], n, 2)
+    _rows("contact", contact.shape[0], contact.shape[1], n, 2 * PDW_NCONTACT)
+    _len("p", p.shape[0], PDW_NP)
+    _flags_ok(flags)
+    with nogil:
+        for i in range(n):
+            if partials:
+                kern.contact_partials(&kin[i, 0], &flags[i, 0], &p[0], &contact[i, 0])
+            else:
+                kern.contact(&kin[i, 0], &flags[i, 0], &p[0], &contact[i, 0])
 
 
 def energies_batch(int k, const double[:, ::1] x, const double[::1] p, double[:, ::1] e):
@@ -266,7 +309,7 @@ def bench(int k, str what, const double[::1] x, const double[::1] p, int f1, int
     """Mean ns per evaluation of `what` ("rhs" or "jacobian") over n calls in a C loop."""
     cdef const pdw_kernel *kern = _kernel(k)
     cdef int flags[2]
-    cdef double anchors[2]
+    cdef double anchors[PDW_NANCHOR]
     cdef double work[PDW_NWORK]
     cdef double sink = 0.0, ns
     _len("x", x.shape[0], PDW_NX)
@@ -275,6 +318,9 @@ def bench(int k, str what, const double[::1] x, const double[::1] p, int f1, int
         raise ValueError("n must be >= 0, got %d" % n)
     if (f1 != 0 and f1 != 1) or (f2 != 0 and f2 != 1):
         raise ValueError("flags must be 0 or 1, got (%d, %d)" % (f1, f2))
+    cdef int j
+    for j in range(PDW_NANCHOR):
+        anchors[j] = 0.0
     flags[0] = f1; flags[1] = f2; anchors[0] = a1; anchors[1] = a2
     if what == "rhs":
         with nogil:
@@ -513,6 +559,8 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         "x_final": np.array(<double[:PDW_NX]> s.x),
         "flags_final": (s.disc.flags[0], s.disc.flags[1]),
         "anchors_final": (s.disc.anchors[0], s.disc.anchors[1]),
+        "approach_speeds_final": (s.disc.anchors[PDW_ANCHOR_V_IN1],
+                                  s.disc.anchors[PDW_ANCHOR_V_IN2]),
         "failure": {"t": s.failure.t, "x": np.array(<double[:PDW_NX]> s.failure.x),
                     "leg": s.failure.leg, "reason": s.failure.reason},
     }
@@ -526,9 +574,9 @@ cdef class OdeFunction:
     anything else takes a slower converting path. No check of finiteness is made per call.
     """
     cdef const pdw_kernel *kern
-    cdef double p[32]
+    cdef double p[PDW_NP]
     cdef int _flags[2]
-    cdef double _anchors[2]
+    cdef double _anchors[PDW_NANCHOR]      # s0_1, s0_2 given; the approach speeds stay 0
     cdef double work[PDW_NWORK]
 
     def __cinit__(self, int k, const double[::1] p, int f1, int f2, double a1, double a2):
@@ -536,6 +584,7 @@ cdef class OdeFunction:
         if p.shape[0] != PDW_NP:
             raise ValueError("p must have %d entries" % PDW_NP)
         memcpy(self.p, &p[0], PDW_NP * sizeof(double))
+        memset(self._anchors, 0, PDW_NANCHOR * sizeof(double))
         self._flags[0] = f1
         self._flags[1] = f2
         self._anchors[0] = a1

@@ -21,13 +21,19 @@ _KERNELS = {name: i for i, (name, _, _) in enumerate(_core.kernel_table())}
 _IX = {n: i for i, n in enumerate(STATE)}
 
 
-def kernel_index(variant: str = "paper", features=None) -> int:
-    """Index of the generated kernel for ``variant`` with the given force elements.
+def kernel_index(variant: str = "paper", features=None, normal: str = "hunt_crossley") -> int:
+    """Index of the generated kernel for ``variant`` with the given force elements and normal
+    contact law (`pdw.core._layout.NORMAL_LAWS`).
 
     ``features=None`` means every element (`pdw.core._layout.FEATURES`). A combination without
-    a specialized kernel falls back to the general one.
+    a specialized kernel falls back to the general one (of its normal law).
     """
     check_variant(variant)
+    if normal != "hunt_crossley":
+        if normal not in _layout.NORMAL_LAWS:
+            raise ValueError("normal law must be one of %s, got %r"
+                             % (", ".join(_layout.NORMAL_LAWS), normal))
+        return _KERNELS[variant + "_" + normal]
     feats = _layout.FEATURES if features is None else tuple(features)
     unknown = set(feats) - set(_layout.FEATURES)
     if unknown:

@@ -41,6 +41,11 @@ TOML layout (every key optional; defaults are `Scene()`'s)::
     energies = false                 # energies at those samples
     events = true                    # the list of touch-downs and lift-offs
 
+    [contact]                        # contact laws (docs/contact_laws.md)
+    normal = "hunt_crossley"         # hertz, kelvin_voigt, lankarani_nikravesh, flores
+    friction = "coulomb"
+    # k, d, e, v_in_min: the law's parameters (unset: the preset's k_n, d_n)
+
     [stop]
     t_end = 3.5                      # [s]
     steps = 0                        # stop after this many complete gait steps (0: no limit)
@@ -61,6 +66,7 @@ import pathlib
 from dataclasses import dataclass, field
 
 from ..core import _layout, _toml
+from ..core.contact import Contact
 from ..core.errors import InvalidInputError
 from ..core.integrators import METHODS
 from ..core.params import X0_PAPER, Params
@@ -335,7 +341,32 @@ class Stop(_Section):
                          _one_of(ON_FAILURE))
 
 
-SECTION_TYPES = {"integrator": Integrator, "forces": Forces, "record": Record, "stop": Stop}
+@dataclass(frozen=True)
+class ContactLaws(_Section):
+    """The normal and friction contact laws and their parameters (`pdw.Contact`,
+    docs/contact_laws.md); unset parameters: the preset's k_n, d_n."""
+
+    SECTION = "contact"
+    normal: str = _f("hunt_crossley", "str", "normal law", _one_of(_layout.NORMAL_LAWS))
+    friction: str = _f("coulomb", "str", "friction law", _one_of(_layout.FRICTION_LAWS))
+    k: float | None = _f(None, "float?", "normal stiffness [N/m^1.5; kelvin_voigt N/m]")
+    d: float | None = _f(None, "float?", "normal damping [N s/m^2.5; kelvin_voigt N s/m]")
+    e: float | None = _f(None, "float?", "coefficient of restitution (lankarani_nikravesh, flores)")
+    v_in_min: float | None = _f(None, "float?", "smallest approach speed [m/s] (idem)")
+
+    def _check(self):
+        try:
+            self.to_contact()
+        except InvalidInputError as e:
+            raise _err("contact", "is invalid: %s" % e) from None
+
+    def to_contact(self):
+        """The `pdw.Contact` of this table."""
+        return Contact(**{f.name: getattr(self, f.name) for f in dataclasses.fields(self)})
+
+
+SECTION_TYPES = {"integrator": Integrator, "forces": Forces, "record": Record, "stop": Stop,
+                 "contact": ContactLaws}
 
 
 @dataclass(frozen=True)
@@ -361,6 +392,7 @@ class Scene(_Section):
     forces: Forces = _f(Forces(), "forces", "force elements present")
     record: Record = _f(Record(), "record", "what is recorded")
     stop: Stop = _f(Stop(), "stop", "when the run stops")
+    contact: ContactLaws = _f(ContactLaws(), "contact", "normal and friction contact laws")
 
     def _check(self):
         for name, value in self.params.items():
@@ -402,7 +434,7 @@ class Scene(_Section):
             event_tol=it.event_tol, features=self.features, record_events=rec.events,
             record_energies=rec.energies, stop_steps=st.steps,
             periodic_steps=st.periodic_steps if st.periodic else 0,
-            periodic_tol=st.periodic_tol)
+            periodic_tol=st.periodic_tol, contact=self.contact.to_contact())
 
     def run(self):
         """Run the scene: a `pdw.Result` (with ``result.scene`` set to this scene)."""

@@ -15,6 +15,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..core import _core, _layout, checks
+from ..core import contact as _contact
 from ..core import integrators as _integrators
 from ..core.errors import (
     DivergedError,
@@ -139,6 +140,7 @@ class Result:
     scene: object = None
     sol: object = None
     provenance: dict | None = None
+    contact: object = None      # the pdw.Contact simulated (laws and parameters)
 
     @property
     def walked(self) -> bool:
@@ -202,7 +204,8 @@ _DEFAULTS = dict(t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
                  fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8, h_max=None, event_tol=1e-9,
                  features=None, record_events=True, record_energies=False, stop_steps=0,
                  periodic_steps=0, periodic_tol=1e-3, check_step="warn", t_eval=None,
-                 dense_output=False, out=None, max_steps=None)
+                 dense_output=False, out=None, max_steps=None,
+                 contact=None)
 
 
 def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
@@ -210,7 +213,8 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
              fall_hip_height=None, fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8,
              h_max=None, event_tol=1e-9, *, features=None, record_events=True,
              record_energies=False, stop_steps=0, periodic_steps=0, periodic_tol=1e-3,
-             check_step="warn", t_eval=None, dense_output=False, out=None, max_steps=None):
+             check_step="warn", t_eval=None, dense_output=False, out=None, max_steps=None,
+             contact=None):
     """Simulate the walker from ``x0`` for ``t_end`` seconds (or run a `pdw.Scene`).
 
     ``simulate(scene)`` runs the scene (as `pdw.run`); no other argument may be given then.
@@ -275,7 +279,9 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     check_step : {"warn", "error", "off"}
         Fixed-step methods: compare dt with `pdw.sim.stepsize.step_limit` (the method's estimated
         stability limit for these parameters) and warn (`pdw.StepSizeWarning`) or refuse
-        (`pdw.StepSizeError`) above it, naming the limit and the force that sets it.
+        (`pdw.StepSizeError`) above it, naming the limit and the force that sets it. The
+        limit is calibrated on the default contact law only: runs with another normal law are
+        not checked.
     t_eval : array_like (M,), optional
         Times [s] (non-decreasing, in [0, t_end]) at which to return the solution, as
         ``solve_ivp``: ``Result.t`` is then t_eval (up to the run's end) and ``x``, ``flags``,
@@ -289,6 +295,9 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
         Record into these reusable arrays (`pdw.sim.buffers.RecordBuffer`) instead of fresh
         ones: no page faults on a repeated run. The Result's t, x, flags, Fn, Ft are then views
         into ``out``, overwritten by the next run that uses it.
+    contact : pdw.Contact, dict or str, optional
+        Normal and friction contact laws and their parameters (`pdw.Contact`,
+        docs/contact_laws.md); default the paper's Hunt-Crossley and smooth Coulomb laws.
 
     Returns
     -------
@@ -359,14 +368,21 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
         raise InvalidInputError("t_eval and dense_output interpolate between the accepted steps: "
                                 "record_every must be 1, got %r" % (record_every,))
 
-    k = kernel_index(variant, feats)
+    contact = _contact.Contact.coerce(contact)
+    if (t_eval is not None or dense_output) and contact.normal != "hunt_crossley":
+        raise InvalidInputError("t_eval and dense_output interpolate with the default contact law's "
+                                "f(x); with contact.normal = %r they are not available yet: record "
+                                "every step (record_every=1) instead" % (contact.normal,))
+    params = contact.parameters(params)
+    k = kernel_index(variant, feats, contact.normal)
     if feats != _layout.FEATURES:
         params = params.without(feats)
-    try:
-        _stepsize.check_step(dt, params, method, variant, check_step)
-    except (np.linalg.LinAlgError, FloatingPointError, OverflowError) as e:
-        _step_unknown(dt, method, check_step, e)
-    p = parameter_vector(params)
+    if contact.normal == "hunt_crossley":
+        try:
+            _stepsize.check_step(dt, params, method, variant, check_step)
+        except (np.linalg.LinAlgError, FloatingPointError, OverflowError) as e:
+            _step_unknown(dt, method, check_step, e)
+    p = contact.vector(parameter_vector(params), feats)
     start = time.perf_counter()
     buffers = None
     if out is not None and not isinstance(out, RecordBuffer):
@@ -391,6 +407,7 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
         energies["E"] = e.sum(axis=1)
     res = _result(raw, params, variant, method, dt, t_end, wall, on_failure, feats,
                   bool(record_events), energies, x)
+    res.contact = contact
     if t_eval is not None or dense_output:
         res = _dense.attach(res, t_eval, dense_output, params, variant, feats,
                             _integrators.get(method).order, record_energies)

@@ -14,12 +14,16 @@ static void kinematics(const pdw_kernel *k, const double *p, const double *x,
 void pdw_discrete_init(const pdw_kernel *k, const double *p, const double *x,
                        const int flags0[2], pdw_discrete *d, double *work)
 {
-    const double zero[2] = {0.0, 0.0};
+    const double zero[PDW_NANCHOR] = {0.0};
     kinematics(k, p, x, zero, work);
     for (int i = 0; i < 2; ++i) {
+        const double *ki = work + PDW_WORK_KIN + i*PDW_NKIN;
         d->flags[i] = flags0[i] ? 1 : 0;
         d->armed[i] = 0;
-        d->anchors[i] = d->flags[i] ? work[PDW_WORK_KIN + i*PDW_NKIN + PDW_KIN_S] : 0.0;
+        d->anchors[i] = d->flags[i] ? ki[PDW_KIN_S] : 0.0;
+        /* approach speed of a foot that starts in contact: its penetration rate, if any (the
+         * laws that use it take at least v_in_min) */
+        d->anchors[PDW_ANCHOR_V_IN1 + i] = d->flags[i] ? fmax(-ki[PDW_KIN_V_Y], 0.0) : 0.0;
     }
 }
 
@@ -160,6 +164,7 @@ int pdw_update_flags_trig(pdw_sim *s, double t)
             d->flags[i] = 1;
             d->armed[i] = 0;
             d->anchors[i] = ki[PDW_KIN_S];
+            d->anchors[PDW_ANCHOR_V_IN1 + i] = -vy;           /* approach speed, > 0 */
             const int st = push_event(s, t, i, PDW_EVKIND_TOUCH_DOWN, ki);
             if (st != PDW_STOP_NONE && stop == PDW_STOP_NONE) stop = st;
             changed = 1;

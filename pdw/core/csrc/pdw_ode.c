@@ -54,8 +54,10 @@ static void sample(pdw_sim *s)
 /* Did the part of the discrete state that f depends on change? */
 static int forces_changed(const pdw_discrete *a, const pdw_discrete *b)
 {
-    return a->flags[0] != b->flags[0] || a->flags[1] != b->flags[1]
-        || a->anchors[0] != b->anchors[0] || a->anchors[1] != b->anchors[1];
+    if (a->flags[0] != b->flags[0] || a->flags[1] != b->flags[1]) return 1;
+    for (int i = 0; i < PDW_NANCHOR; ++i)
+        if (a->anchors[i] != b->anchors[i]) return 1;
+    return 0;
 }
 
 /* ---------------------------------------------------------------- fixed step ------------- */

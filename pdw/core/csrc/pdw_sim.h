@@ -13,7 +13,9 @@
 typedef struct pdw_discrete {
     int flags[2];       /* 1 = support, 0 = swing */
     int armed[2];       /* swing foot has been above ground while ahead of the other foot */
-    double anchors[2];  /* rolling coordinate s_i at touch-down (consistent variant's xi) */
+    double anchors[PDW_NANCHOR];  /* per foot, captured at touch-down (layout ANCHORS): the rolling
+                                   * coordinate s_i (consistent variant's xi), then the approach
+                                   * speed -v_y (Lankarani-Nikravesh and Flores damping) */
 } pdw_discrete;
 
 /* Why and where a loop failed. */

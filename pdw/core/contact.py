@@ -1,0 +1,170 @@
+"""Contact laws: which normal and friction law a simulation uses, with physical parameters.
+
+The laws are derived once in ``derive/contact_laws.py`` and compiled ahead of time: one kernel
+per contact variant and normal law (docs/contact_laws.md). A `Contact` names the laws and their
+parameters; ``pdw.simulate(..., contact=Contact(...))`` (or a dict of the same fields, or a
+scene's ``[contact]`` table) selects them. The default, ``Contact()``, is the paper's model:
+Hunt-Crossley with the parameters of `pdw.Params` and the smooth Coulomb friction of Eq. 10;
+it runs the very kernels it always did.
+
+=====================  ============================================  =====================
+normal law             F_n for depth delta > 0, rate delta_dot       parameters (units)
+=====================  ============================================  =====================
+hunt_crossley          k delta^1.5 + d delta^1.5 delta_dot (Eq. 3, 6)  k [N/m^1.5], d [N s/m^2.5]
+hertz                  k delta^1.5                                    k [N/m^1.5]
+kelvin_voigt           k delta + d delta_dot                          k [N/m], d [N s/m]
+lankarani_nikravesh    k delta^1.5 (1 + 3(1-e^2)/4 delta_dot/v0)      k [N/m^1.5], e [-]
+flores                 k delta^1.5 (1 + 8(1-e)/(5e) delta_dot/v0)     k [N/m^1.5], e [-]
+=====================  ============================================  =====================
+
+Every damped law is clamped at 0 (the ground cannot pull). v0 = max(v_in, v_in_min), v_in the
+foot's approach speed captured at its touch-down. k and d default to `Params.k_n`, `Params.d_n`
+(whose units are then the law's).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _layout
+from .errors import InvalidInputError
+from .params import Params
+
+NORMAL_LAWS = _layout.NORMAL_LAWS
+FRICTION_LAWS = _layout.FRICTION_LAWS
+#: which parameters each normal law takes (the others must be left unset)
+LAW_PARAMETERS = {
+    "hunt_crossley": ("k", "d"),
+    "hertz": ("k",),
+    "kelvin_voigt": ("k", "d"),
+    "lankarani_nikravesh": ("k", "e", "v_in_min"),
+    "flores": ("k", "e", "v_in_min"),
+}
+UNITS = {
+    "hunt_crossley": {"k": "N/m^1.5", "d": "N s/m^2.5"},
+    "hertz": {"k": "N/m^1.5"},
+    "kelvin_voigt": {"k": "N/m", "d": "N s/m"},
+    "lankarani_nikravesh": {"k": "N/m^1.5", "e": "-", "v_in_min": "m/s"},
+    "flores": {"k": "N/m^1.5", "e": "-", "v_in_min": "m/s"},
+}
+_P = {n: i for i, n in enumerate(_layout.PARAMS + _layout.DERIVED + _layout.CONTACT_PARAMS)}
+
+
+@dataclass(frozen=True)
+class Contact:
+    """The contact laws of a simulation and their parameters (SI units, see the module table).
+
+    Parameters
+    ----------
+    normal : str
+        Normal law, one of `NORMAL_LAWS`; default the paper's ``"hunt_crossley"``.
+    friction : str
+        Friction law, one of `FRICTION_LAWS` (``"coulomb"``: the smooth law of Eq. 10 with the
+        tangential spring-damper of Eqs. 7, 11).
+    k : float, optional
+        Normal stiffness [N/m^1.5; N/m for kelvin_voigt]; default `Params.k_n`.
+    d : float, optional
+        Normal damping of hunt_crossley [N s/m^2.5] or kelvin_voigt [N s/m]; default
+        `Params.d_n`.
+    e : float, optional
+        Coefficient of restitution of lankarani_nikravesh and flores, in (0, 1]; required there.
+    v_in_min : float, optional
+        Smallest approach speed those laws divide by [m/s] (a foot that starts in contact, or
+        lands slower than this, uses it); default 0.01 m/s.
+
+    Raises
+    ------
+    pdw.InvalidInputError
+        An unknown law, a parameter the law does not take, or a value out of range.
+    """
+
+    normal: str = "hunt_crossley"
+    friction: str = "coulomb"
+    k: float | None = None
+    d: float | None = None
+    e: float | None = None
+    v_in_min: float | None = None
+
+    def __post_init__(self):
+        if self.normal not in NORMAL_LAWS:
+            raise InvalidInputError("contact.normal must be one of %s, got %r"
+                                    % (", ".join(NORMAL_LAWS), self.normal))
+        if self.friction not in FRICTION_LAWS:
+            raise InvalidInputError("contact.friction must be one of %s, got %r"
+                                    % (", ".join(FRICTION_LAWS), self.friction))
+        allowed = LAW_PARAMETERS[self.normal]
+        for name, lo, hi, lo_open in (("k", 0.0, math.inf, True), ("d", 0.0, math.inf, False),
+                                      ("e", 0.0, 1.0, True), ("v_in_min", 0.0, math.inf, True)):
+            v = getattr(self, name)
+            if v is None:
+                continue
+            if name not in allowed:
+                raise InvalidInputError("contact.%s is not a parameter of the %s law (it takes %s)"
+                                        % (name, self.normal, ", ".join(allowed)))
+            try:
+                v = float(v)
+            except (TypeError, ValueError):
+                raise InvalidInputError("contact.%s must be a number, got %r" % (name, v)) from None
+            bad = not math.isfinite(v) or (v <= lo if lo_open else v < lo) or v > hi
+            if bad:
+                raise InvalidInputError("contact.%s = %r is out of range; allowed: %s %g%s [%s]"
+                                        % (name, v, ">" if lo_open else ">=", lo,
+                                           " and <= 1" if hi == 1.0 else "",
+                                           UNITS[self.normal][name]))
+            object.__setattr__(self, name, v)
+        if "e" in allowed and self.e is None:
+            raise InvalidInputError("contact.e (coefficient of restitution, 0 < e <= 1) is "
+                                    "required by the %s law" % self.normal)
+
+    @classmethod
+    def coerce(cls, contact) -> "Contact":
+        """A `Contact` from None (the default), a Contact, a law name, or a dict of fields."""
+        if contact is None:
+            return cls()
+        if isinstance(contact, cls):
+            return contact
+        if isinstance(contact, str):
+            return cls(normal=contact)
+        if isinstance(contact, dict):
+            unknown = set(contact) - set(cls.__dataclass_fields__)
+            if unknown:
+                raise InvalidInputError("unknown contact field(s) %s; allowed: %s"
+                                        % (", ".join(sorted(map(str, unknown))),
+                                           ", ".join(cls.__dataclass_fields__)))
+            return cls(**contact)
+        raise InvalidInputError("contact must be a pdw.Contact, a dict or a law name, got %s"
+                                % type(contact).__name__)
+
+    @property
+    def is_default(self) -> bool:
+        """The paper's laws with the parameters of `Params` (the default kernels)."""
+        return self == Contact()
+
+    def parameters(self, params: Params) -> Params:
+        """``params`` with k_n and d_n set from this contact's k and d (if given); hertz sets
+        d_n = 0 (no damping), lankarani_nikravesh and flores leave d_n unused."""
+        changes = {}
+        if self.k is not None:
+            changes["k_n"] = self.k
+        if self.d is not None:
+            changes["d_n"] = self.d
+        if self.normal == "hertz":
+            changes["d_n"] = 0.0
+        return params.replace(**changes) if changes else params
+
+    def vector(self, p: np.ndarray, features=None) -> np.ndarray:
+        """Fill the contact-law entries (`pdw._layout.CONTACT_PARAMS`) of a kernel parameter
+        vector ``p`` (from `pdw.model.parameter_vector`) in place; returns ``p``. Without the
+        ``normal_damping`` feature, e = 1 (no damping)."""
+        if "e" in LAW_PARAMETERS[self.normal]:
+            damped = features is None or "normal_damping" in features
+            p[_P["e_n"]] = self.e if damped else 1.0
+            p[_P["v_in_min"]] = 0.01 if self.v_in_min is None else self.v_in_min
+        return p
+
+    def as_dict(self) -> dict:
+        """The fields that are set (for scenes and reports)."""
+        return {n: getattr(self, n) for n in self.__dataclass_fields__
+                if getattr(self, n) is not None}
