@@ -164,16 +164,7 @@ cdef const pdw_kernel *_kernel(int k) except NULL:
 
 # --- the boundary: every shape is checked once per call, before a pointer is taken -----------
 
-cdef int _len(str name, Py_ssize_t got, Py_ssize_t want) except -1:
-    if got != want:
-        raise ValueError("%s must have shape (%d,), got (%d,)" % (name, want, got))
-    return 0
-
-
-cdef int _rows(str name, Py_ssize_t r, Py_ssize_t c, Py_ssize_t want_r, Py_ssize_t want_c) except -1:
-    if r != want_r or c != want_c:
-        raise ValueError("%s must have shape (%d, %d), got (%d, %d)" % (name, want_r, want_c, r, c))
-    return 0
+include "_shapes.pxi"
 
 
 cdef int _flags_ok(const int[:, ::1] flags) except -1:

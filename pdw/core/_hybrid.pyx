@@ -66,16 +66,7 @@ NFOOT = PDW_NHYFOOT
 STATUS = ("ok", "no_strike", "fell", "singular", "nonfinite", "max_steps", "step_tiny")
 
 
-cdef int _len(str name, Py_ssize_t got, Py_ssize_t want) except -1:
-    if got != want:
-        raise ValueError("%s must have shape (%d,), got (%d,)" % (name, want, got))
-    return 0
-
-
-cdef int _rows(str name, Py_ssize_t r, Py_ssize_t c, Py_ssize_t want_r, Py_ssize_t want_c) except -1:
-    if r != want_r or c != want_c:
-        raise ValueError("%s must have shape (%d, %d), got (%d, %d)" % (name, want_r, want_c, r, c))
-    return 0
+include "_shapes.pxi"
 
 
 cdef int _py(const double[::1] p, const double[::1] y, str yname="y") except -1:
