@@ -66,14 +66,7 @@ static int start(const pdw_batch_job *job, long i, pdw_sim *s)
     /* pdw_cdm_advance's start-up (no events stored: the update cannot return -1) */
     s->status = PDW_STATUS_RUNNING;
     if (pdw_update_flags(s, 0.0) > 0) { s->started = 1; return 0; }
-    double xdot[PDW_NX];
-    s->kernel->rhs(s->x, s->p, s->disc.flags, s->disc.anchors, xdot, s->work);
-    for (int q = 0; q < PDW_NQ; ++q)
-        s->u_prev[q] = s->x[q] - dt*s->x[PDW_NQ + q] + 0.5*dt*dt*xdot[PDW_NQ + q];
-    s->started = 1;
-    s->n = 0;
-    s->t = 0.0;
-    s->n_rhs = 1;
+    pdw_cdm_start(s);
     return 1;
 }
 
@@ -82,41 +75,16 @@ static int start(const pdw_batch_job *job, long i, pdw_sim *s)
 static int step(pdw_sim *s)
 {
     const pdw_kernel *k = s->kernel;
-    const double dt = s->dt, idt2 = 1.0/(dt*dt), ih = 0.5/dt;
+    const double dt = s->dt;
     double *trig = s->work + PDW_WORK_TRIG, *kin = s->work + PDW_WORK_KIN;
     double *contact = s->work + PDW_WORK_CONTACT, *M = s->work + PDW_WORK_M;
-    double C[PDW_NQ*PDW_NQ], QmG[PDW_NQ], K[PDW_NQ*PDW_NQ], b[PDW_NQ], u[PDW_NQ], xnew[PDW_NX];
+    double C[PDW_NQ*PDW_NQ], QmG[PDW_NQ];
     const double t = s->n * dt;
     if (s->n > 0 && pdw_update_flags_trig(s, t) > 0) return 0;     /* a stop condition */
     if (pdw_check_feet(s, t)) return 0;
     k->contact(kin, s->disc.flags, s->p, contact);
     k->cdm_terms(s->x, trig, s->p, contact, M, C, QmG);
-    for (int i = 0; i < PDW_NQ; ++i) {
-        double mu = 0.0, ku = 0.0;
-        for (int j = 0; j < PDW_NQ; ++j) {
-            const double m = M[i*PDW_NQ + j], c = C[i*PDW_NQ + j];
-            K[i*PDW_NQ + j] = m*idt2 + c*ih;
-            mu += m * s->x[j];
-            ku += (m*idt2 - c*ih) * s->u_prev[j];
-        }
-        b[i] = QmG[i] + 2.0*idt2*mu - ku;
-    }
-    if (pdw_solve_dblock(K, b, u)) {
-        s->status = PDW_STATUS_SINGULAR;
-        s->failure.reason = PDW_REASON_SINGULAR; s->failure.leg = -1; s->failure.t = t;
-        memcpy(s->failure.x, s->x, sizeof s->x);
-        return 0;
-    }
-    for (int i = 0; i < PDW_NQ; ++i) {
-        xnew[i] = u[i];
-        xnew[PDW_NQ + i] = (u[i] - s->u_prev[i]) * ih;
-    }
-    if (pdw_check_state(s, xnew, t)) return 0;
-    for (int i = 0; i < PDW_NQ; ++i) s->u_prev[i] = s->x[i];
-    memcpy(s->x, xnew, sizeof xnew);
-    s->n++;
-    s->t = s->n * dt;
-    s->n_rhs++;
+    if (pdw_cdm_update(s, M, C, QmG, t)) return 0;
     if (s->n < s->n_steps) return 1;
     /* final flags at t_end (scalar trig, as pdw_cdm_advance) */
     if (pdw_update_flags(s, s->n * dt) == 0) s->status = PDW_STATUS_DONE;

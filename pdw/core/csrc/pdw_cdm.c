@@ -10,27 +10,72 @@
 #include "pdw_sim.h"
 #include "pdw_linalg.h"
 
+/* The start-up of Eq. 13: U_{-1} from x_0 and the right-hand side there; n = 0. Shared with the
+ * lane loop of pdw_batch.c, so both take the very same arithmetic. */
+void pdw_cdm_start(pdw_sim *s)
+{
+    const double dt = s->dt;
+    double xdot[PDW_NX];
+    s->kernel->rhs(s->x, s->p, s->disc.flags, s->disc.anchors, xdot, s->work);
+    for (int i = 0; i < PDW_NQ; ++i)
+        s->u_prev[i] = s->x[i] - dt*s->x[PDW_NQ + i] + 0.5*dt*dt*xdot[PDW_NQ + i];
+    s->started = 1;
+    s->n = 0;
+    s->t = 0.0;
+    s->n_rhs = 1;
+}
+
+/* One central-difference update (Eqs. 14-17) at t from the stage outputs M, C and Q_f - G of
+ * x_n: (M/dt^2 + C/2dt) U_{n+1} = ..., the centred velocity, the state check, n advanced.
+ * Returns 0, or 1 when the run stops (singular system or failed state check; s->status set).
+ * Shared with the lane loop of pdw_batch.c. */
+int pdw_cdm_update(pdw_sim *s, const double *M, const double *C, const double *QmG, double t)
+{
+    const double dt = s->dt, idt2 = 1.0/(dt*dt), ih = 0.5/dt;
+    double K[PDW_NQ*PDW_NQ], b[PDW_NQ], u[PDW_NQ], xnew[PDW_NX];
+    for (int i = 0; i < PDW_NQ; ++i) {
+        double mu = 0.0, ku = 0.0;
+        for (int j = 0; j < PDW_NQ; ++j) {
+            const double m = M[i*PDW_NQ + j], c = C[i*PDW_NQ + j];
+            K[i*PDW_NQ + j] = m*idt2 + c*ih;
+            mu += m * s->x[j];
+            ku += (m*idt2 - c*ih) * s->u_prev[j];
+        }
+        b[i] = QmG[i] + 2.0*idt2*mu - ku;
+    }
+    if (pdw_solve_dblock(K, b, u)) {
+        s->status = PDW_STATUS_SINGULAR;
+        s->failure.reason = PDW_REASON_SINGULAR; s->failure.leg = -1; s->failure.t = t;
+        memcpy(s->failure.x, s->x, sizeof s->x);
+        return 1;
+    }
+    for (int i = 0; i < PDW_NQ; ++i) {
+        xnew[i] = u[i];
+        xnew[PDW_NQ + i] = (u[i] - s->u_prev[i]) * ih;
+    }
+    if (pdw_check_state(s, xnew, t)) return 1;
+    for (int i = 0; i < PDW_NQ; ++i) s->u_prev[i] = s->x[i];
+    memcpy(s->x, xnew, sizeof xnew);
+    s->n++;
+    s->t = s->n * dt;
+    s->n_rhs++;
+    return 0;
+}
+
 int pdw_cdm_advance(pdw_sim *s)
 {
     const pdw_kernel *k = s->kernel;
-    const double dt = s->dt, idt2 = 1.0/(dt*dt), ih = 0.5/dt;
+    const double dt = s->dt;
     double *trig = s->work + PDW_WORK_TRIG, *kin = s->work + PDW_WORK_KIN;
     double *contact = s->work + PDW_WORK_CONTACT, *M = s->work + PDW_WORK_M;
-    double C[PDW_NQ*PDW_NQ], QmG[PDW_NQ], K[PDW_NQ*PDW_NQ], b[PDW_NQ], u[PDW_NQ], xnew[PDW_NX];
+    double C[PDW_NQ*PDW_NQ], QmG[PDW_NQ];
 
     s->status = PDW_STATUS_RUNNING;
     if (!s->started) {
-        double xdot[PDW_NX];
         const int r = pdw_update_flags(s, 0.0);
         if (r < 0) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
         if (r > 0) { s->started = 1; pdw_record_final(s, 0.0); return s->status; }
-        k->rhs(s->x, s->p, s->disc.flags, s->disc.anchors, xdot, s->work);
-        for (int i = 0; i < PDW_NQ; ++i)
-            s->u_prev[i] = s->x[i] - dt*s->x[PDW_NQ + i] + 0.5*dt*dt*xdot[PDW_NQ + i];
-        s->started = 1;
-        s->n = 0;
-        s->t = 0.0;
-        s->n_rhs = 1;
+        pdw_cdm_start(s);
         pdw_record(s, 0.0);
     }
     while (s->n < s->n_steps) {
@@ -49,32 +94,7 @@ int pdw_cdm_advance(pdw_sim *s)
         k->contact(kin, s->disc.flags, s->p, contact);
         k->cdm_terms(s->x, trig, s->p, contact, M, C, QmG);
         if (s->n > 0) pdw_record(s, t);  /* sample 0 was recorded at the start */
-        for (int i = 0; i < PDW_NQ; ++i) {
-            double mu = 0.0, ku = 0.0;
-            for (int j = 0; j < PDW_NQ; ++j) {
-                const double m = M[i*PDW_NQ + j], c = C[i*PDW_NQ + j];
-                K[i*PDW_NQ + j] = m*idt2 + c*ih;
-                mu += m * s->x[j];
-                ku += (m*idt2 - c*ih) * s->u_prev[j];
-            }
-            b[i] = QmG[i] + 2.0*idt2*mu - ku;
-        }
-        if (pdw_solve_dblock(K, b, u)) {
-            s->status = PDW_STATUS_SINGULAR;
-            s->failure.reason = PDW_REASON_SINGULAR; s->failure.leg = -1; s->failure.t = t;
-            memcpy(s->failure.x, s->x, sizeof s->x);
-            return s->status;
-        }
-        for (int i = 0; i < PDW_NQ; ++i) {
-            xnew[i] = u[i];
-            xnew[PDW_NQ + i] = (u[i] - s->u_prev[i]) * ih;
-        }
-        if (pdw_check_state(s, xnew, t)) return s->status;
-        for (int i = 0; i < PDW_NQ; ++i) s->u_prev[i] = s->x[i];
-        memcpy(s->x, xnew, sizeof xnew);
-        s->n++;
-        s->t = s->n * dt;
-        s->n_rhs++;
+        if (pdw_cdm_update(s, M, C, QmG, t)) return s->status;
     }
     /* final sample: flags and forces at t_end */
     const int r = pdw_update_flags(s, s->n * dt);

@@ -172,6 +172,10 @@ int pdw_check_feet(pdw_sim *s, double t);
 /* Check a new state (finite, speeds, hip height); on failure sets s->status and s->failure
  * and returns nonzero. */
 int pdw_check_state(pdw_sim *s, const double *xnew, double t);
+/* The central difference method's start-up and one update (pdw_cdm.c), shared by
+ * pdw_cdm_advance and the lane loop of pdw_batch.c. */
+void pdw_cdm_start(pdw_sim *s);
+int pdw_cdm_update(pdw_sim *s, const double *M, const double *C, const double *QmG, double t);
 
 /* A stop condition ended the run at s->x (time t) right after pdw_update_flags: store the
  * sample if step n is a recording step (contact forces computed here). */
