@@ -5,6 +5,7 @@ lockstep, threads over disjoint ranges of walkers.
 Private: the public API is `pdw.sim.batch.simulate_batch`. Every array is caller-allocated,
 C-contiguous (typed memoryviews). `run_range` releases the GIL for the whole range.
 """
+from libc.math cimport INFINITY
 from libc.stdlib cimport malloc, free
 
 
@@ -58,6 +59,9 @@ cdef extern from "pdw_batch.h":
 
 
 MAX_LANES = PDW_BATCH_MAXW
+_OUT_KEYS = ("status", "stop_reason", "flags_final", "x_final", "t_final", "n_steps",
+             "n_gait_steps", "n_touch_down", "n_lift_off", "gait", "fail_reason", "fail_leg",
+             "fail_t", "fail_x")
 
 
 def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[:, ::1] flags0,
@@ -80,6 +84,22 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
         raise ValueError("x0 must be (N, %d) and p (N or 1, %d)" % (PDW_NX, PDW_NP))
     if not (0 <= i0 <= i1 <= n):
         raise ValueError("range [%d, %d) not within [0, %d]" % (i0, i1, n))
+    if not (dt > 0 and dt < INFINITY) or n_steps < 0 or stop_steps < 0 or not (max_speed > 0):
+        raise ValueError("dt must be finite and > 0, n_steps and stop_steps >= 0, max_speed > 0; "
+                         "got dt = %r, n_steps = %d, stop_steps = %d, max_speed = %r"
+                         % (dt, n_steps, stop_steps, max_speed))
+    if periodic_k < 0 or periodic_k == 1 or periodic_k > PDW_STEP_RING or not (periodic_tol >= 0):
+        raise ValueError("periodic_k must be 0 (off) or in [2, %d] and periodic_tol >= 0, got %d, %r"
+                         % (PDW_STEP_RING, periodic_k, periodic_tol))
+    missing = [key for key in _OUT_KEYS if key not in out]
+    if missing:
+        raise ValueError("out lacks the array(s) %s" % ", ".join(missing))
+    cdef Py_ssize_t r
+    for r in range(flags0.shape[0]):
+        if flags0.shape[1] == 2 and ((flags0[r, 0] != 0 and flags0[r, 0] != 1)
+                                     or (flags0[r, 1] != 0 and flags0[r, 1] != 1)):
+            raise ValueError("flags0 row %d must be 0 or 1, got (%d, %d)"
+                             % (r, flags0[r, 0], flags0[r, 1]))
     cdef int[::1] status = out["status"]
     cdef int[::1] stop_reason = out["stop_reason"]
     cdef int[:, ::1] flags_final = out["flags_final"]
