@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core import _batch, _layout
+from ..core import _batch, _layout, checks
 from ..core.errors import InvalidInputError
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
 from ..core.params import Params
@@ -113,34 +113,36 @@ class BatchResult:
 
 
 def _rows(x0):
-    try:
-        x = np.array(x0, dtype=float, order="C")
-    except (TypeError, ValueError):
-        raise InvalidInputError("x0 must be an (N, 8) array of numbers") from None
-    if x.ndim != 2 or x.shape[1] != len(STATE):
-        raise InvalidInputError("x0 must have shape (N, 8) (columns %s), got %s"
-                                % (STATE, np.shape(x0)))
-    bad = ~np.isfinite(x)
-    if bad.any():
-        r, c = np.argwhere(bad)[0]
+    """x0 as a C-contiguous float (N, 8) array: real numbers only (no strings, complex or
+    booleans), finite (`pdw.core.checks.real_array`)."""
+    x = np.asarray(x0) if not isinstance(x0, (str, bytes)) else x0
+    if isinstance(x, np.ndarray) and x.dtype.kind in "iuf" and x.ndim == 2 \
+            and x.shape[1] == len(STATE) and not np.isfinite(x).all():
+        r, c = np.argwhere(~np.isfinite(x))[0]
         raise InvalidInputError("x0 row %d, column %d (%s) must be finite, got %r"
                                 % (r, c, STATE[c], x[r, c]))
-    return x
+    return checks.real_array("x0", x0, [(-1, len(STATE))], STATE)
 
 
 def _flags(flags0, n):
-    f = np.array(flags0, dtype=np.intc)
-    if f.shape == (2,):
-        f = np.tile(f, (n, 1))
-    if f.shape != (n, 2):
-        raise InvalidInputError("flags0 must be (2,) or (N, 2) = (%d, 2), got %s"
-                                % (n, np.shape(flags0)))
-    bad = (f != 0) & (f != 1)
-    if bad.any():
-        r = np.argwhere(bad)[0][0]
-        raise InvalidInputError("flags0 row %d must be two values in {0, 1}, got %r"
-                                % (r, tuple(f[r])))
-    return np.ascontiguousarray(f)
+    """(N, 2) intc flags from a pair or an (N, 2) array of integers in {0, 1} (no 0.9, no
+    strings: `pdw.core.checks.flags`)."""
+    try:
+        rows = not isinstance(flags0, (str, bytes)) and np.shape(flags0) == (n, 2)
+    except ValueError:                        # a ragged sequence
+        rows = False
+    f = None if rows else checks.flags("flags0", flags0, n)
+    if f is None:                             # name the first bad row
+        for r, row in enumerate(np.asarray(flags0)):
+            try:
+                checks.flags("flags0 row %d" % r, row)
+            except InvalidInputError as e:
+                raise InvalidInputError("%s (flags0 must be (2,) or (N, 2) = (%d, 2))"
+                                        % (e, n)) from None
+        f = checks.flags("flags0", flags0, n)
+    if isinstance(f, tuple):
+        f = np.tile(np.array(f, dtype=np.intc), (n, 1))
+    return np.ascontiguousarray(f, dtype=np.intc)
 
 
 def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
@@ -207,7 +209,9 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
             raise InvalidInputError("params row %d must be a pdw.Params, got %s"
                                     % (i, type(p).__name__))
     f0 = _flags(flags0, n)
-    n_steps = int(round(t_end / dt))
+    n_steps = checks.count("t_end / dt", round(t_end / dt))
+    if not isinstance(vector, (bool, np.bool_)):
+        raise InvalidInputError("vector must be True or False, got %r" % (vector,))
     stop_steps = _check_count("stop_steps", stop_steps)
     periodic_steps = _check_count("periodic_steps", periodic_steps)
     if periodic_steps == 1 or periodic_steps > _layout.STEP_RING:
@@ -229,7 +233,8 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
             _stepsize.check_step(dt, p, method, variant, check_step)
     pvec = np.ascontiguousarray([parameter_vector(p) for p in plist])
     ls = np.array([p.l for p in plist], dtype=float)
-    hip = np.broadcast_to(0.5 * ls if fall_hip_height is None else float(fall_hip_height), (n,))
+    hip = np.broadcast_to(0.5 * ls if fall_hip_height is None
+                          else checks.number("fall_hip_height", fall_hip_height), (n,))
     depth = np.broadcast_to(0.25 * ls if fall_depth is None
                             else _check_positive("fall_depth", fall_depth), (n,))
     hip = np.ascontiguousarray(hip, dtype=float)
