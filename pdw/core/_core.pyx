@@ -7,6 +7,7 @@ C headers). Time loops release the GIL and are entered once per simulation.
 """
 import numpy as np
 
+from pdw.core import interrupt as _interrupt
 from pdw.core.errors import InvalidInputError
 
 from cpython.exc cimport PyErr_CheckSignals
@@ -504,6 +505,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         if status == PDW_STATUS_POLL:
             try:
                 PyErr_CheckSignals()
+                _interrupt.check()          # a worker thread's task of an interrupted pool
             except KeyboardInterrupt as e:
                 interrupted = e
                 break

@@ -10,12 +10,11 @@ from __future__ import annotations
 
 import math
 import os
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..core import _batch, _layout, checks
+from ..core import _batch, _layout, checks, interrupt
 from ..core.errors import InvalidInputError
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
 from ..core.params import Params
@@ -23,7 +22,7 @@ from . import stepsize as _stepsize
 from .gait import Steps, steps_from_rows
 from .simulation import _REASONS, _check_count, _check_positive
 
-_STATUS = {0: "running", 1: "walked", 2: "fell", 3: "diverged", 5: "diverged", 6: "periodic"}
+_STATUS = {0: "interrupted", 1: "walked", 2: "fell", 3: "diverged", 5: "diverged", 6: "periodic"}
 _STOP = {0: "t_end", 1: "steps", 2: "periodic"}
 LANES = 8
 """Default lanes per block (walkers advanced in lockstep by one thread)."""
@@ -183,6 +182,13 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
     -------
     BatchResult
         Per-walker arrays (status, x_final, t_final, failure, event counts, last gait steps).
+
+    Raises
+    ------
+    KeyboardInterrupt
+        On Ctrl-C, within a second (the lane loops poll every 512 lockstep steps, in every
+        thread): ``.result`` is the partial `BatchResult`, whose unfinished walkers have status
+        ``"interrupted"`` and their state when stopped (or at t = 0 if never started).
     """
     x = _rows(x0)
     n = len(x)
@@ -244,12 +250,18 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
         chunks = _chunks(n, threads, lanes)
         args = (k, x, pvec, f0, hip, depth, dt, n_steps, max_speed, stop_steps, periodic_steps,
                 periodic_tol, out)
-        if len(chunks) == 1:
-            _batch.run_range(*args, chunks[0][0], chunks[0][1], lanes, bool(vector))
-        else:
-            with ThreadPoolExecutor(min(threads, len(chunks))) as ex:
-                list(ex.map(lambda c: _batch.run_range(*args, c[0], c[1], lanes, bool(vector)),
-                            chunks))
+        try:
+            interrupt.thread_map(lambda c: _batch.run_range(*args, c[0], c[1], lanes,
+                                                            bool(vector)),
+                                 chunks, threads)
+        except KeyboardInterrupt as e:
+            # Ctrl-C: the walkers finished so far, the running ones as they are, the others at
+            # their start; every unfinished one "interrupted"
+            unstarted = np.isnan(out["t_final"])
+            out["x_final"][unstarted] = x[unstarted]
+            out["t_final"][unstarted] = 0.0
+            e.result = _result(out, dt, n_steps * dt, method, variant)
+            raise
     return _result(out, dt, n_steps * dt, method, variant)
 
 
@@ -265,7 +277,7 @@ def _outputs(n):
     ring, nstep = _layout.STEP_RING, len(_layout.STEP)
     return {"status": np.zeros(n, np.intc), "stop_reason": np.zeros(n, np.intc),
             "flags_final": np.zeros((n, 2), np.intc), "x_final": np.zeros((n, len(STATE))),
-            "t_final": np.zeros(n), "n_steps": np.zeros(n, np.int_),
+            "t_final": np.full(n, np.nan), "n_steps": np.zeros(n, np.int_),
             "n_gait_steps": np.zeros(n, np.int_), "n_touch_down": np.zeros(n, np.int_),
             "n_lift_off": np.zeros(n, np.int_), "gait": np.zeros((n, ring, nstep)),
             "fail_reason": np.zeros(n, np.intc), "fail_leg": np.zeros(n, np.intc),
@@ -274,7 +286,7 @@ def _outputs(n):
 
 def _result(out, dt, t_end, method, variant):
     status = np.array([_STATUS[s] for s in out["status"]], dtype=object)
-    stop = np.array([_STOP[r] if r else (s if s in ("fell", "diverged") else "t_end")
+    stop = np.array([_STOP[r] if r else (s if s in ("fell", "diverged", "interrupted") else "t_end")
                      for r, s in zip(out["stop_reason"], status)], dtype=object)
     return BatchResult(
         status=status, stop_reason=stop, x_final=out["x_final"], t_final=out["t_final"],
