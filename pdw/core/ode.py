@@ -31,7 +31,11 @@ def _check_features(features):
     if isinstance(features, str):
         raise InvalidInputError("features must be a collection of names, got the string %r"
                                 % features)
-    unknown = set(features) - set(_layout.FEATURES)
+    try:
+        unknown = set(features) - set(_layout.FEATURES)
+    except TypeError:
+        raise InvalidInputError("features must be a collection of names from %s, got %r"
+                                % (", ".join(_layout.FEATURES), features)) from None
     if unknown:
         raise InvalidInputError("unknown feature(s) %s; allowed: %s"
                                 % (", ".join(sorted(map(str, unknown))),

@@ -206,7 +206,16 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
     if params is None or isinstance(params, Params):
         plist = [Params.paper() if params is None else params]
     else:
-        plist = list(params)
+        if isinstance(params, (str, bytes, dict)):
+            plist = None
+        else:
+            try:
+                plist = list(params)
+            except TypeError:
+                plist = None
+        if plist is None:
+            raise InvalidInputError("params must be a pdw.Params or a sequence of N = %d Params, "
+                                    "got %r" % (n, params))
         if len(plist) != n:
             raise InvalidInputError("params must be one Params or a sequence of N = %d, got %d"
                                     % (n, len(plist)))
