@@ -6,8 +6,10 @@ crash, a raw Python error, or a status that lies. A small budget runs in ``make 
 ``slow`` twins (``make study``) run about 1.6 10^5 cases in all (counts in docs/stability.md).
 ``PDW_FUZZ_EXAMPLES`` overrides the small budget per test.
 """
+import json
 import math
 import os
+import time
 import warnings
 
 import numpy as np
@@ -32,10 +34,34 @@ P = parameter_vector(pdw.Params.paper())
 X0 = np.array(pdw.X0_PAPER)
 
 
+#: ``PDW_FUZZ_COUNT_FILE``: a JSON file where the cases run so far (per target, with the seconds
+#: since its first case) are written every 50 cases, so that a budget cut by a deadline still
+#: has exact counts (docs/stability.md section 11).
+_COUNT_FILE = os.environ.get("PDW_FUZZ_COUNT_FILE")
+_COUNTS = {}
+
+
+def _count(kind):
+    n, t0 = _COUNTS.get(kind, (0, time.monotonic()))
+    _COUNTS[kind] = (n + 1, t0)
+    if _COUNT_FILE and (n + 1) % 50 == 0:
+        try:
+            with open(_COUNT_FILE) as f:
+                known = json.load(f)
+        except (OSError, ValueError):
+            known = {}
+        known.update({k: {"cases": c, "seconds": round(time.monotonic() - t, 1)}
+                      for k, (c, t) in _COUNTS.items()})
+        with open(_COUNT_FILE + ".tmp", "w") as f:
+            json.dump(known, f, indent=1)
+        os.replace(_COUNT_FILE + ".tmp", _COUNT_FILE)
+
+
 def _twin(kind, fn, strategy=None, small=None):
     """A small-budget test and its slow twin with LARGE[kind] examples: fn(data) draws its case
     from hypothesis' data, or fn(case) gets one case of ``strategy``."""
     def case(data):
+        _count(kind)
         fn(data if strategy is None else data.draw(strategy))
 
     def fast(data):
