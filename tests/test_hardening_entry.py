@@ -173,6 +173,26 @@ def test_a_well_formed_record_buffer_still_gives_the_same_run():
     assert np.array_equal(r1.x, r2.x) and b.capacity >= len(r2.t)
 
 
+# --- dense output -------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("kw,field", [(dict(t_eval=np.array([0.01 + 1j])), "t_eval"),
+                                      (dict(t_eval=[0.0, float("nan")]), "t_eval"),
+                                      (dict(dense_output="yes"), "dense_output")])
+def test_dense_output_arguments_are_strict(kw, field):
+    """A complex t_eval was its real part; dense_output="yes" was True."""
+    with pytest.raises(pdw.InvalidInputError, match=field):
+        pdw.simulate(t_end=0.02, method="rodas4", **kw)
+
+
+@pytest.mark.parametrize("tq", ["0.01", 0.01 + 1j, np.full((2, 2), 0.01), float("nan"), 5.0])
+def test_dense_interpolant_refuses_bad_times(tq):
+    """sol("0.01") was parsed; complex and 2-D times gave raw TypeError / ValueError."""
+    sol = pdw.simulate(t_end=0.02, method="rodas4", dense_output=True).sol
+    with pytest.raises(pdw.InvalidInputError, match="t"):
+        sol(tq)
+    assert sol(0.01).shape == (8,) and sol([0.005, 0.01]).shape == (2, 8)
+
+
 # --- pdw.load ----------------------------------------------------------------------------------
 
 @pytest.fixture(scope="module")

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core import _core
+from ..core import _core, checks
 from ..core.errors import InvalidInputError
 from ..core.model import contact_forces, kernel_index, parameter_vector
 
@@ -77,8 +77,14 @@ class DenseOutput:
         i = np.searchsorted(self.t, tq, side="right") - 1
         return np.clip(i, 0, len(self.t) - 2)
 
+    def _times(self, tq):
+        """tq as a 0-d or 1-d float array of real times (no strings, complex, booleans)."""
+        return checks.real_array("t", tq, [(), (-1,)])
+
     def __call__(self, tq):
-        tq = np.asarray(tq, dtype=float)
+        """The interpolated state at time(s) tq [s] (scalar or 1-D, within the span): (8,) or
+        (len(tq), 8)."""
+        tq = self._times(tq)
         scalar = tq.ndim == 0
         tq = np.atleast_1d(tq)
         if np.any(tq < self.t[0]) or np.any(tq > self.t[-1]) or not np.isfinite(tq).all():
@@ -106,19 +112,24 @@ class DenseOutput:
 
     def flags_at(self, tq):
         """Support flags in force at each time, shape (len(t), 2)."""
-        return self.flags[self.interval(np.atleast_1d(np.asarray(tq, dtype=float)))]
+        return self.flags[self.interval(np.atleast_1d(self._times(tq)))]
 
     def anchors_at(self, tq):
-        return self.anchors[self.interval(np.atleast_1d(np.asarray(tq, dtype=float)))]
+        return self.anchors[self.interval(np.atleast_1d(self._times(tq)))]
 
 
 def check_t_eval(t_eval, t_end):
     """t_eval as a sorted 1-D array in [0, t_end] [s], or InvalidInputError."""
+    if isinstance(t_eval, (str, bytes)):
+        raise InvalidInputError("t_eval must be a non-empty 1-D array of times [s], got shape ()")
     try:
-        te = np.asarray(t_eval, dtype=float)
+        te = np.asarray(t_eval)
     except (TypeError, ValueError):
         raise InvalidInputError("t_eval must be a 1-D array of times [s], got %r"
                                 % (t_eval,)) from None
+    if te.dtype.kind not in "iuf":
+        raise InvalidInputError("t_eval must hold real times [s] (not %s)" % te.dtype)
+    te = te.astype(float)
     if te.ndim != 1 or len(te) == 0:
         raise InvalidInputError("t_eval must be a non-empty 1-D array of times [s], got shape %s"
                                 % (te.shape,))

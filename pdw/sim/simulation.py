@@ -362,6 +362,8 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
         raise InvalidInputError("periodic_steps must be 0 (off) or in [2, %d], got %d"
                                 % (_layout.STEP_RING, periodic_steps))
     periodic_tol = _check_positive("periodic_tol", periodic_tol)
+    if not isinstance(dense_output, (bool, np.bool_)):
+        raise InvalidInputError("dense_output must be True or False, got %r" % (dense_output,))
     if t_eval is not None:
         t_eval = _dense.check_t_eval(t_eval, t_end)
     if (t_eval is not None or dense_output) and record_every != 1:
