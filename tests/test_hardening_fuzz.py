@@ -35,23 +35,24 @@ X0 = np.array(pdw.X0_PAPER)
 
 
 #: ``PDW_FUZZ_COUNT_FILE``: a JSON file where the cases run so far (per target, with the seconds
-#: since its first case) are written every 50 cases, so that a budget cut by a deadline still
+#: and the CPU seconds since its first case) are written every 50 cases, so that a budget cut by a deadline still
 #: has exact counts (docs/stability.md section 11).
 _COUNT_FILE = os.environ.get("PDW_FUZZ_COUNT_FILE")
 _COUNTS = {}
 
 
 def _count(kind):
-    n, t0 = _COUNTS.get(kind, (0, time.monotonic()))
-    _COUNTS[kind] = (n + 1, t0)
+    n, t0, c0 = _COUNTS.get(kind, (0, time.monotonic(), time.process_time()))
+    _COUNTS[kind] = (n + 1, t0, c0)
     if _COUNT_FILE and (n + 1) % 50 == 0:
         try:
             with open(_COUNT_FILE) as f:
                 known = json.load(f)
         except (OSError, ValueError):
             known = {}
-        known.update({k: {"cases": c, "seconds": round(time.monotonic() - t, 1)}
-                      for k, (c, t) in _COUNTS.items()})
+        known.update({k: {"cases": c, "seconds": round(time.monotonic() - t, 1),
+                          "cpu_seconds": round(time.process_time() - cpu, 1)}
+                      for k, (c, t, cpu) in _COUNTS.items()})
         with open(_COUNT_FILE + ".tmp", "w") as f:
             json.dump(known, f, indent=1)
         os.replace(_COUNT_FILE + ".tmp", _COUNT_FILE)
