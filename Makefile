@@ -77,7 +77,9 @@ study: $(STAMP)
 
 ## sanitize: the compiled core built with AddressSanitizer + UndefinedBehaviorSanitizer (in
 ## build/sanitize, the normal build untouched), and the tests of the compiled boundary, the loops
-## and the hybrid map run on it (docs/stability.md); any ASan/UBSan report fails the run
+## and the hybrid map run on it (docs/stability.md); any ASan/UBSan report fails the run.
+## allocator_may_return_null=1: an impossible allocation returns NULL (numpy's MemoryError), as
+## glibc's malloc does, instead of aborting the whole run
 SAN_DIR   := build/sanitize
 SAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined -g
 SAN_TESTS ?= tests/test_hardening_boundary.py tests/test_hardening_status.py \
@@ -92,11 +94,11 @@ sanitize: $(STAMP)
 	  $(PY) setup.py -q build_ext --build-lib $(SAN_DIR) --build-temp $(SAN_DIR)/tmp
 	tar --exclude='*.so' --exclude='*.c' --exclude='__pycache__' -cf - pdw tests derive docs \
 	  generated pyproject.toml | tar -xf - -C $(SAN_DIR)
-	cd $(SAN_DIR) && ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 \
+	cd $(SAN_DIR) && ASAN_OPTIONS=detect_leaks=0:abort_on_error=1:allocator_may_return_null=1 \
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  LD_PRELOAD="$$(gcc -print-file-name=libasan.so) $$(gcc -print-file-name=libubsan.so)" \
 	  $(abspath $(PY)) -c "import pdw.core._core as c; assert '$(SAN_DIR)' in c.__file__, c.__file__" && \
-	  ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+	  ASAN_OPTIONS=detect_leaks=0:abort_on_error=1:allocator_may_return_null=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  LD_PRELOAD="$$(gcc -print-file-name=libasan.so) $$(gcc -print-file-name=libubsan.so)" \
 	  $(abspath $(PY)) -m pytest -q -p no:cacheprovider $(SAN_TESTS)
 
