@@ -81,6 +81,8 @@ cdef int _poll(void *ctx) noexcept nogil:
             pending.append(e)
             return 1
     return 0
+
+
 _OUT_KEYS = ("status", "stop_reason", "flags_final", "x_final", "t_final", "n_steps",
              "n_gait_steps", "n_touch_down", "n_lift_off", "gait", "fail_reason", "fail_leg",
              "fail_t", "fail_x")
