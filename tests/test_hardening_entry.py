@@ -101,6 +101,7 @@ BATCH_CASES = [
     (dict(x0=np.ones((1, 8), bool)), "x0"),
     (dict(vector="no"), "vector"),                       # was bool("no") = True
     (dict(t_end=1e30), "t_end / dt"),                    # was a raw OverflowError
+    (dict(t_end=1.7e304), "t_end / dt"),                 # t_end/dt = inf (found by the fuzzer)
 ]
 
 
@@ -110,6 +111,13 @@ def test_simulate_batch_refuses_malformed_input_naming_the_field(kw, field):
     x0 = kw.pop("x0", X2)
     with pytest.raises(pdw.InvalidInputError, match=field.replace("(", r"\(")):
         simulate_batch(x0, **kw)
+
+
+def test_simulate_refuses_a_t_end_whose_step_count_overflows():
+    """t_end = 1.8e304 with dt = 1e-4: t_end/dt is inf, and round(inf) was a raw OverflowError
+    (found by the fuzzer)."""
+    with pytest.raises(pdw.InvalidInputError, match="t_end/dt"):
+        pdw.simulate(t_end=1.797693134862316e+304)
 
 
 def test_simulate_batch_still_takes_well_formed_input():

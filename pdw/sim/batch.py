@@ -224,7 +224,10 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
             raise InvalidInputError("params row %d must be a pdw.Params, got %s"
                                     % (i, type(p).__name__))
     f0 = _flags(flags0, n)
-    n_steps = checks.count("t_end / dt", round(t_end / dt))
+    if not t_end / dt <= checks.MAX_COUNT:           # also inf (t_end near the largest float)
+        raise InvalidInputError("t_end / dt = %g steps is too many (at most %d)"
+                                % (t_end / dt, checks.MAX_COUNT))
+    n_steps = int(round(t_end / dt))
     if not isinstance(vector, (bool, np.bool_)):
         raise InvalidInputError("vector must be True or False, got %r" % (vector,))
     stop_steps = _check_count("stop_steps", stop_steps)

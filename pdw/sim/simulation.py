@@ -329,10 +329,10 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     checks.choice("on_failure", on_failure, ("raise", "return"))
     f0 = checks.flags("flags0", flags0)
     record_every = checks.count("record_every", record_every)
-    n_steps = int(round(t_end / dt))
-    if n_steps > checks.MAX_COUNT:
+    if not t_end / dt <= checks.MAX_COUNT:           # also inf (t_end near the largest float)
         raise InvalidInputError("t_end/dt = %g steps is too many (at most %d)"
                                 % (t_end / dt, checks.MAX_COUNT))
+    n_steps = int(round(t_end / dt))
     adaptive = _core.method_table()[METHODS.index(method)][2]
     if max_steps is None:
         budget = 10 ** 6 + int(2e6 * t_end) if adaptive else 0
