@@ -39,6 +39,10 @@ cdef extern from "pdw_batch.h":
         long stop_steps
         int periodic_k
         double periodic_tol
+        int method
+        double t_end
+        double rtol, atol, h_max, event_tol
+        long max_steps
         int *status
         int *stop_reason
         int *flags_final
@@ -55,6 +59,15 @@ cdef extern from "pdw_batch.h":
         double *fail_x
     long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
                        int vector) noexcept nogil
+    long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W,
+                          pdw_sim *lanes) noexcept nogil
+
+
+cdef extern from "pdw_sim.h":
+    ctypedef struct pdw_method:
+        int adaptive
+    const pdw_method pdw_methods[]
+    const int pdw_nmethods
 
 
 MAX_LANES = PDW_BATCH_MAXW
@@ -63,8 +76,15 @@ MAX_LANES = PDW_BATCH_MAXW
 def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[:, ::1] flags0,
               const double[::1] hip, const double[::1] depth, double dt, long n_steps,
               double max_speed, long stop_steps, int periodic_k, double periodic_tol,
-              dict out, long i0, long i1, int lanes, bint vector):
+              dict out, long i0, long i1, int lanes, bint vector, int method=0,
+              double t_end=0.0, double rtol=1e-6, double atol=1e-8, double h_max=0.0,
+              double event_tol=1e-9, long max_steps=0):
     """Advance walkers [i0, i1) with `lanes` lanes (GIL released), writing rows of `out`.
+
+    method: index into the compiled method table (pdw.core.integrators.METHODS); 0 (cdm) takes
+    the lockstep cdm loop (pdw_batch_cdm, `vector` applies), any other the per-lane rounds of
+    pdw_batch_method with t_end (0: n_steps dt), rtol, atol, h_max (0: t_end), event_tol and
+    max_steps (0: no budget) as `pdw.core._core.run` takes them; dt is then the first step.
 
     x0 (N, 8); p (N, NP) or (1, NP) (one vector for all); flags0 (N, 2) intc; hip, depth (N,).
     out: the dict of output arrays made by pdw.sim.batch (status, stop_reason, flags_final,
@@ -115,6 +135,10 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
             ("out['fail_x']", (fail_x.shape[0], fail_x.shape[1]), (n, PDW_NX))):
         if got != want:
             raise ValueError("%s must have shape %s, got %s" % (name, want, got))
+    if method < 0 or method >= pdw_nmethods:
+        raise ValueError("method id %d out of range [0, %d)" % (method, pdw_nmethods))
+    if max_steps < 0 or not (event_tol > 0) or not (rtol > 0) or not (atol > 0):
+        raise ValueError("max_steps must be >= 0 and rtol, atol, event_tol > 0")
     if n == 0 or i0 == i1:
         return 0
     cdef pdw_batch_job job
@@ -132,6 +156,13 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     job.stop_steps = stop_steps
     job.periodic_k = periodic_k
     job.periodic_tol = periodic_tol
+    job.method = method
+    job.t_end = t_end if t_end > 0 else n_steps * dt
+    job.rtol = rtol
+    job.atol = atol
+    job.h_max = h_max
+    job.event_tol = event_tol
+    job.max_steps = max_steps
     job.status = &status[0]
     job.stop_reason = &stop_reason[0]
     job.flags_final = &flags_final[0, 0]
@@ -152,7 +183,10 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     cdef long done
     try:
         with nogil:
-            done = pdw_batch_cdm(&job, i0, i1, lanes, sims, vector)
+            if method == 0:
+                done = pdw_batch_cdm(&job, i0, i1, lanes, sims, vector)
+            else:
+                done = pdw_batch_method(&job, i0, i1, lanes, sims)
     finally:
         free(sims)
     return done

@@ -4,7 +4,10 @@ The compiled engine (pdw/core/csrc/pdw_batch.c) advances a block of W walkers wi
 central difference method (docs/model.md section 7), one walker per lane: the sin/cos of all lanes in
 one vector loop (glibc's libmvec), the generated stages and the discrete logic (flags, arming,
 anchors, events, online gait descriptors) per lane, exactly as `pdw.simulate`; a lane whose
-walker finishes takes the next one. Threads (GIL released) take disjoint ranges of walkers.
+walker finishes takes the next one. Every other method of `pdw.METHODS` (rodas4, dopri5, rk4,
+verlet) runs in rounds of one step per lane through the scalar integrator's own C, each lane
+with its own time, step size, accept/reject and located events. Threads (GIL released) take
+disjoint ranges of walkers.
 """
 from __future__ import annotations
 
@@ -17,6 +20,8 @@ import numpy as np
 
 from ..core import _batch, _layout
 from ..core.errors import InvalidInputError
+from ..core.integrators import METHODS
+from ..core.integrators import get as _method_info
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
 from ..core.params import Params
 from . import stepsize as _stepsize
@@ -146,7 +151,8 @@ def _flags(flags0, n):
 def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
                    flags0=(0, 1), threads=None, lanes=LANES, vector=False, stop_steps=0,
                    periodic_steps=0, periodic_tol=1e-3, fall_hip_height=None, fall_depth=None,
-                   max_speed=1e3, check_step="warn") -> BatchResult:
+                   max_speed=1e3, check_step="warn", rtol=1e-6, atol=1e-8, h_max=None,
+                   event_tol=1e-9, max_steps=None) -> BatchResult:
     """Simulate N walkers at once: the result of `pdw.simulate` for each, without recording.
 
     Parameters
@@ -158,9 +164,12 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
     params : Params or sequence of N Params, optional
         One parameter set for all walkers (default: the paper's) or one per walker.
     variant : {"paper", "consistent"}
-    method : {"cdm"}
-        Only the paper's central difference method (docs/model.md section 7) has a batched loop;
-        adaptive rodas4 with per-lane step control is not implemented (docs/ensemble.md).
+    method : {"cdm", "verlet", "rk4", "dopri5", "rodas4"}
+        "cdm" (the paper's central difference method, docs/model.md section 7) runs the lockstep
+        lane loop; every other method of `pdw.METHODS` runs per lane through the scalar
+        integrator's C, one (accepted) step per lane per round: each lane keeps its own time,
+        step size, accept/reject and event location, and every walker is bitwise its
+        `simulate` run (docs/ensemble.md). For the adaptive methods dt is the first step.
     flags0 : (2,) or (N, 2) ints in {0, 1}
         Initial support flags of legs 1, 2.
     threads : int, optional
@@ -174,7 +183,8 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
         step-sized shifts of events, so final states then agree with `simulate` in outcome,
         not to 1e-12 (docs/ensemble.md).
     stop_steps, periodic_steps, periodic_tol, fall_hip_height, fall_depth, max_speed, check_step
-        As `simulate`; fall_hip_height and fall_depth default to 0.5 l and 0.25 l of each
+    rtol, atol, h_max, event_tol, max_steps
+        As `simulate` (adaptive methods; max_steps is the budget of each walker); fall_hip_height and fall_depth default to 0.5 l and 0.25 l of each
         walker's parameters. A divergence is a status here (``"diverged"``), never an error.
 
     Returns
@@ -192,9 +202,22 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
         check_variant(variant)
     except ValueError as e:
         raise InvalidInputError(str(e)) from None
-    if method != "cdm":
-        raise InvalidInputError("simulate_batch supports method 'cdm' only, got %r (use "
-                                "pdw.simulate on a thread pool for the others)" % (method,))
+    if method not in METHODS:
+        raise InvalidInputError("method must be one of %s, got %r" % (METHODS, method))
+    if vector and method != "cdm":
+        raise InvalidInputError("vector=True (vector sin/cos) applies to method 'cdm' only, "
+                                "got method %r" % (method,))
+    adaptive = _method_info(method).adaptive
+    rtol = _check_positive("rtol", rtol)
+    atol = _check_positive("atol", atol)
+    h_max = 0.0 if h_max is None else _check_positive("h_max", h_max)
+    event_tol = _check_positive("event_tol", event_tol)
+    if max_steps is None:
+        budget = 10 ** 6 + int(2e6 * t_end) if adaptive else 0     # as simulate's
+    else:
+        budget = _check_count("max_steps", max_steps)
+        if budget < 1:
+            raise InvalidInputError("max_steps must be >= 1, got %d" % budget)
     if params is None or isinstance(params, Params):
         plist = [Params.paper() if params is None else params]
     else:
@@ -235,17 +258,23 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
     hip = np.ascontiguousarray(hip, dtype=float)
     depth = np.ascontiguousarray(depth, dtype=float)
     out = _outputs(n)
+    if not adaptive and max_steps is not None and n_steps > budget:
+        raise InvalidInputError("t_end/dt = %d steps exceeds max_steps = %d: raise max_steps "
+                                "or take a larger dt" % (n_steps, budget))
+    t_stop = t_end if adaptive else n_steps * dt
+    opts = dict(method=METHODS.index(method), t_end=t_stop, rtol=rtol, atol=atol, h_max=h_max,
+                event_tol=event_tol, max_steps=budget)
     if n:
         chunks = _chunks(n, threads, lanes)
         args = (k, x, pvec, f0, hip, depth, dt, n_steps, max_speed, stop_steps, periodic_steps,
                 periodic_tol, out)
         if len(chunks) == 1:
-            _batch.run_range(*args, chunks[0][0], chunks[0][1], lanes, bool(vector))
+            _batch.run_range(*args, chunks[0][0], chunks[0][1], lanes, bool(vector), **opts)
         else:
             with ThreadPoolExecutor(min(threads, len(chunks))) as ex:
-                list(ex.map(lambda c: _batch.run_range(*args, c[0], c[1], lanes, bool(vector)),
-                            chunks))
-    return _result(out, dt, n_steps * dt, method, variant)
+                list(ex.map(lambda c: _batch.run_range(*args, c[0], c[1], lanes, bool(vector),
+                                                       **opts), chunks))
+    return _result(out, dt, t_stop, method, variant)
 
 
 def _chunks(n, threads, lanes):

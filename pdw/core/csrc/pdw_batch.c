@@ -143,3 +143,63 @@ long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *l
     }
     return i1 - i0;
 }
+
+/* Load walker i into lane s with the settings pdw/core/_core.pyx's run gives pdw.simulate's
+ * pdw_sim (nothing recorded, events only counted), polling after every step. */
+static void start_method(const pdw_batch_job *job, long i, pdw_sim *s)
+{
+    int flags0[2];
+    const pdw_method *m = &pdw_methods[job->method];
+    memset(s, 0, sizeof *s);
+    s->kernel = job->kernel;
+    memcpy(s->p, job->p + i*job->p_stride, PDW_NP * sizeof(double));
+    s->t_end = job->t_end;
+    s->rtol = job->rtol;
+    s->atol = job->atol;
+    s->h_max = job->h_max > 0 ? job->h_max : job->t_end;
+    s->h = job->dt;
+    s->event_tol = job->event_tol;
+    s->dt = job->dt;
+    s->n_steps = job->n_steps;
+    s->fall_hip_height = job->fall_hip_height[i];
+    s->fall_depth = job->fall_depth[i];
+    s->max_speed = job->max_speed;
+    s->max_steps = m->adaptive ? job->max_steps : 0;
+    /* a poll every 2 loop iterations returns after each (accepted) step: the drivers poll at
+     * the top of an iteration, where a resumed call continues exactly */
+    s->poll_every = 2;
+    s->stop_steps = job->stop_steps;
+    s->periodic_k = job->periodic_k;
+    s->periodic_tol = job->periodic_tol;
+    pdw_gait_init(&s->gait);
+    memcpy(s->x, job->x0 + i*PDW_NX, sizeof s->x);
+    flags0[0] = job->flags0[2*i];
+    flags0[1] = job->flags0[2*i + 1];
+    pdw_discrete_init(s->kernel, s->p, s->x, flags0, &s->disc, s->work);
+}
+
+long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes)
+{
+    long walker[PDW_BATCH_MAXW], next = i0;
+    const pdw_advance_fn advance = pdw_methods[job->method].advance;
+    int running = 0;
+    if (W < 1) W = 1;
+    if (W > PDW_BATCH_MAXW) W = PDW_BATCH_MAXW;
+    for (int l = 0; l < W; ++l) {
+        walker[l] = -1;
+        if (next < i1) { walker[l] = next; start_method(job, next++, &lanes[l]); running++; }
+    }
+    while (running > 0) {
+        for (int l = 0; l < W; ++l) {
+            if (walker[l] < 0) continue;
+            /* nothing recorded and events not stored: RECORDS_FULL and EVENTS_FULL cannot
+             * occur, POLL is the end of this lane's step */
+            if (advance(&lanes[l]) == PDW_STATUS_POLL) continue;
+            finish(job, walker[l], &lanes[l]);
+            walker[l] = -1;
+            running--;
+            if (next < i1) { walker[l] = next; start_method(job, next++, &lanes[l]); running++; }
+        }
+    }
+    return i1 - i0;
+}

@@ -30,6 +30,12 @@ typedef struct pdw_batch_job {
     long stop_steps;            /* 0: off */
     int periodic_k;             /* 0: off */
     double periodic_tol;
+    /* methods other than cdm (pdw_batch_method): the settings of pdw_sim as pdw.simulate
+     * (pdw/core/_core.pyx run) sets them */
+    int method;                 /* index into pdw_methods */
+    double t_end;               /* end time [s] (adaptive methods end exactly here) */
+    double rtol, atol, h_max, event_tol;  /* adaptive methods; dt is the first step */
+    long max_steps;             /* adaptive methods' step budget (accepted + rejected); 0: none */
     /* --- outputs, per walker (caller-allocated) --- */
     int *status;                /* (n,) PDW_STATUS_* */
     int *stop_reason;           /* (n,) PDW_STOP_* */
@@ -53,5 +59,13 @@ void pdw_batch_sincos(int n, const double *a, double *s, double *c);
  * caller-allocated pdw_sim. vector: 1 = vector sin/cos, 0 = scalar (bitwise `pdw.simulate`).
  * Returns the number of walkers finished (i1 - i0). */
 long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes, int vector);
+
+/* Advance walkers [i0, i1) of job with any method of pdw_methods (job->method), W lanes in
+ * rounds: each round takes one step (one accepted step of an adaptive method) of every lane
+ * through the method's own advance (pdw_sim.h's contract, resumed exactly through
+ * PDW_STATUS_POLL), so that each lane keeps its own time, step size, accept/reject, flags and
+ * located events and every walker is bitwise its `pdw.simulate` run; a finished lane takes the
+ * next walker. Returns i1 - i0. */
+long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes);
 
 #endif /* PDW_BATCH_H */
