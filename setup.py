@@ -31,7 +31,7 @@ setup(
         [Extension("pdw.core._core", sources=sources, include_dirs=["generated", CSRC],
                    extra_compile_args=extra, extra_link_args=link, libraries=["m"]),
          Extension("pdw.core._batch", sources=batch_sources, include_dirs=["generated", CSRC],
-                   extra_compile_args=extra + ["-fopenmp-simd"], extra_link_args=link,
+                   extra_compile_args=extra + ["-fopenmp-simd", "-ffp-contract=off"], extra_link_args=link,
                    libraries=["mvec", "m"]),
          Extension("pdw.core._hybrid", sources=hybrid, include_dirs=["generated", CSRC],
                    extra_compile_args=extra, extra_link_args=link, libraries=["m"])],

@@ -11,7 +11,7 @@ import pathlib
 
 import sympy as sp
 
-from . import contact_laws, hybrid, layout, stages
+from . import contact_laws, emit_batch, hybrid, layout, stages
 from . import model as mdl
 from .printer import c_block
 
@@ -382,9 +382,12 @@ def write_all(root: pathlib.Path):
     """Write every generated file below ``root`` (the repository root). Returns their paths."""
     h = input_hash()
     src, ops = source(h)
+    banner = BANNER.format(sympy=sp.__version__, hash=h)
     files = {
         root / "generated" / "pdw_model.h": header(h),
         root / "generated" / "pdw_model.c": src,
+        root / "generated" / "pdw_batch_gen.h": emit_batch.header(banner, KERNELS, _names,
+                                                                   c_block, NFORCES),
         root / "pdw" / "core" / "_layout.py": python_layout(h, ops),
     }
     for path, text in files.items():

@@ -61,6 +61,11 @@ cdef extern from "pdw_batch.h":
                        int vector) noexcept nogil
     long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W,
                           pdw_sim *lanes) noexcept nogil
+    ctypedef struct pdw_soa_state:
+        int W
+    int pdw_batch_isa_supported(int isa) noexcept nogil
+    long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
+                           int vector, int isa, pdw_soa_state *S) noexcept nogil
 
 
 cdef extern from "pdw_sim.h":
@@ -71,6 +76,19 @@ cdef extern from "pdw_sim.h":
 
 
 MAX_LANES = PDW_BATCH_MAXW
+ISAS = {"scalar": -1, "base": 0, "avx2": 1, "avx512": 2}
+"""The cdm lane loops: "scalar" (every lane through the generated scalar stages), and the
+structure-of-arrays step compiled for the x86-64 baseline (SSE2), AVX2 and AVX-512F."""
+
+
+def isa_supported(name):
+    """Can this CPU run the cdm lane loop compiled for instruction set `name` (ISAS)?"""
+    return bool(pdw_batch_isa_supported(ISAS[name]))
+
+
+def best_isa():
+    """The widest instruction set of ISAS this CPU runs."""
+    return [n for n in ("avx512", "avx2", "base") if isa_supported(n)][0]
 
 
 def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[:, ::1] flags0,
@@ -78,13 +96,15 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
               double max_speed, long stop_steps, int periodic_k, double periodic_tol,
               dict out, long i0, long i1, int lanes, bint vector, int method=0,
               double t_end=0.0, double rtol=1e-6, double atol=1e-8, double h_max=0.0,
-              double event_tol=1e-9, long max_steps=0):
+              double event_tol=1e-9, long max_steps=0, int isa=0):
     """Advance walkers [i0, i1) with `lanes` lanes (GIL released), writing rows of `out`.
 
     method: index into the compiled method table (pdw.core.integrators.METHODS); 0 (cdm) takes
     the lockstep cdm loop (pdw_batch_cdm, `vector` applies), any other the per-lane rounds of
     pdw_batch_method with t_end (0: n_steps dt), rtol, atol, h_max (0: t_end), event_tol and
     max_steps (0: no budget) as `pdw.core._core.run` takes them; dt is then the first step.
+    isa: the cdm loop, a value of ISAS (-1: per-lane scalar stages; an unsupported one falls
+    back to it).
 
     x0 (N, 8); p (N, NP) or (1, NP) (one vector for all); flags0 (N, 2) intc; hip, depth (N,).
     out: the dict of output arrays made by pdw.sim.batch (status, stop_reason, flags_final,
@@ -180,13 +200,20 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     cdef pdw_sim *sims = <pdw_sim *> malloc(lanes * sizeof(pdw_sim))
     if sims == NULL:
         raise MemoryError()
+    cdef pdw_soa_state *soa = <pdw_soa_state *> malloc(sizeof(pdw_soa_state))
+    if soa == NULL:
+        free(sims)
+        raise MemoryError()
     cdef long done
     try:
         with nogil:
-            if method == 0:
+            if method == 0 and isa >= 0:
+                done = pdw_batch_cdm_soa(&job, i0, i1, lanes, sims, vector, isa, soa)
+            elif method == 0:
                 done = pdw_batch_cdm(&job, i0, i1, lanes, sims, vector)
             else:
                 done = pdw_batch_method(&job, i0, i1, lanes, sims)
     finally:
         free(sims)
+        free(soa)
     return done

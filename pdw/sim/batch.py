@@ -32,6 +32,26 @@ _STATUS = {0: "running", 1: "walked", 2: "fell", 3: "diverged", 5: "diverged", 6
 _STOP = {0: "t_end", 1: "steps", 2: "periodic"}
 LANES = 8
 """Default lanes per block (walkers advanced in lockstep by one thread)."""
+ISA_ENV = "PDW_BATCH_ISA"
+"""Environment variable that picks the cdm lane loop: ``scalar`` (every lane through the
+generated scalar stages), ``base`` (the structure-of-arrays step at the x86-64 baseline, SSE2),
+``avx2`` or ``avx512``; default: the widest this CPU runs (`pdw.core._batch.best_isa`). Every
+choice gives the same bits with ``vector=False``; the tests force each one."""
+
+
+def batch_isa() -> str:
+    """The cdm lane loop `simulate_batch` uses: $PDW_BATCH_ISA, else the widest supported."""
+    name = os.environ.get(ISA_ENV, "").strip().lower()
+    if not name:
+        return _batch.best_isa()
+    if name not in _batch.ISAS:
+        raise InvalidInputError("%s must be one of %s, got %r"
+                                % (ISA_ENV, tuple(_batch.ISAS), name))
+    if not _batch.isa_supported(name):
+        raise InvalidInputError("%s = %r: this CPU does not run it (it runs %s)"
+                                % (ISA_ENV, name, [n for n in _batch.ISAS
+                                                   if _batch.isa_supported(n)]))
+    return name
 
 
 @dataclass
@@ -263,7 +283,7 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
                                 "or take a larger dt" % (n_steps, budget))
     t_stop = t_end if adaptive else n_steps * dt
     opts = dict(method=METHODS.index(method), t_end=t_stop, rtol=rtol, atol=atol, h_max=h_max,
-                event_tol=event_tol, max_steps=budget)
+                event_tol=event_tol, max_steps=budget, isa=_batch.ISAS[batch_isa()])
     if n:
         chunks = _chunks(n, threads, lanes)
         args = (k, x, pvec, f0, hip, depth, dt, n_steps, max_speed, stop_steps, periodic_steps,

@@ -11,6 +11,7 @@
 #include <string.h>
 #include "pdw_batch.h"
 #include "pdw_linalg.h"
+#include "pdw_batch_gen.h"
 
 /* Write lane s's walker i outputs. */
 static void finish(const pdw_batch_job *job, long i, const pdw_sim *s)
@@ -199,6 +200,127 @@ long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim
             walker[l] = -1;
             running--;
             if (next < i1) { walker[l] = next; start_method(job, next++, &lanes[l]); running++; }
+        }
+    }
+    return i1 - i0;
+}
+
+/* ---- the structure-of-arrays lane loop ------------------------------------------------ */
+
+void pdw_soa_cdm_step_base(const pdw_soa_kernel *k, pdw_soa_state *S, int W, double dt,
+                           double max_speed, int vector);
+void pdw_soa_cdm_step_avx2(const pdw_soa_kernel *k, pdw_soa_state *S, int W, double dt,
+                           double max_speed, int vector);
+void pdw_soa_cdm_step_avx512(const pdw_soa_kernel *k, pdw_soa_state *S, int W, double dt,
+                             double max_speed, int vector);
+
+int pdw_batch_isa_supported(int isa)
+{
+    if (isa == PDW_ISA_SCALAR || isa == PDW_ISA_BASE) return 1;
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+    __builtin_cpu_init();
+    if (isa == PDW_ISA_AVX2) return __builtin_cpu_supports("avx2") != 0;
+    if (isa == PDW_ISA_AVX512) return __builtin_cpu_supports("avx512f") != 0;
+#endif
+    return 0;
+}
+
+/* Lane l of S from its pdw_sim (after a start or a scalar step). */
+static void soa_load(pdw_soa_state *S, int l, const pdw_sim *s)
+{
+    for (int i = 0; i < PDW_NX; ++i) S->x[i*PDW_SOA + l] = s->x[i];
+    for (int i = 0; i < PDW_NQ; ++i) S->u_prev[i*PDW_SOA + l] = s->u_prev[i];
+    for (int i = 0; i < PDW_NANCHOR; ++i) S->anchors[i*PDW_SOA + l] = s->disc.anchors[i];
+    for (int i = 0; i < 2; ++i) {
+        S->flags[i*PDW_SOA + l] = s->disc.flags[i];
+        S->armed[i*PDW_SOA + l] = s->disc.armed[i];
+    }
+    S->upd[l] = s->n > 0;
+}
+
+/* The parts of lane l's pdw_sim that the SoA step advances, from S. */
+static void soa_store(const pdw_soa_state *S, int l, pdw_sim *s)
+{
+    for (int i = 0; i < PDW_NX; ++i) s->x[i] = S->x[i*PDW_SOA + l];
+    for (int i = 0; i < PDW_NQ; ++i) s->u_prev[i] = S->u_prev[i*PDW_SOA + l];
+    for (int i = 0; i < 2; ++i) s->disc.armed[i] = S->armed[i*PDW_SOA + l];
+}
+
+/* Start walker i in lane l (pdw_sim and S). Returns 1 if it runs, 0 if it finished at once. */
+static int soa_start(const pdw_batch_job *job, long i, pdw_sim *s, pdw_soa_state *S, int l)
+{
+    if (!start(job, i, s)) return 0;
+    for (int j = 0; j < PDW_NP; ++j) S->p[j*PDW_SOA + l] = s->p[j];
+    S->hip[l] = s->fall_hip_height;
+    S->depth[l] = s->fall_depth;
+    soa_load(S, l, s);
+    return 1;
+}
+
+/* Fill lane l with the next walker of [next, i1) that does not finish at its start. */
+static long soa_refill(const pdw_batch_job *job, long *next, long i1, pdw_sim *s,
+                       pdw_soa_state *S, int l)
+{
+    while (*next < i1) {
+        const long i = (*next)++;
+        if (soa_start(job, i, s, S, l)) return i;
+        finish(job, i, s);
+    }
+    return -1;
+}
+
+long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
+                       int vector, int isa, pdw_soa_state *S)
+{
+    const long kid = job->kernel - pdw_kernels;
+    void (*stepfn)(const pdw_soa_kernel *, pdw_soa_state *, int, double, double, int) = NULL;
+    if (isa == PDW_ISA_BASE) stepfn = pdw_soa_cdm_step_base;
+    else if (isa == PDW_ISA_AVX2) stepfn = pdw_soa_cdm_step_avx2;
+    else if (isa == PDW_ISA_AVX512) stepfn = pdw_soa_cdm_step_avx512;
+    if (kid < 0 || kid >= PDW_NKERNELS || pdw_soa_kernels[kid].kinematics == NULL
+        || stepfn == NULL || !pdw_batch_isa_supported(isa))
+        return pdw_batch_cdm(job, i0, i1, W, lanes, vector);
+    const pdw_soa_kernel *k = &pdw_soa_kernels[kid];
+    long walker[PDW_BATCH_MAXW], next = i0;
+    int running = 0;
+    if (W < 1) W = 1;
+    if (W > PDW_BATCH_MAXW) W = PDW_BATCH_MAXW;
+    memset(S, 0, sizeof *S);
+    for (int l = 0; l < W; ++l) {
+        walker[l] = soa_refill(job, &next, i1, &lanes[l], S, l);
+        if (walker[l] >= 0) running++;
+    }
+    while (running > 0) {
+        stepfn(k, S, W, job->dt, job->max_speed, vector);
+        for (int l = 0; l < W; ++l) {
+            if (walker[l] < 0) continue;
+            pdw_sim *s = &lanes[l];
+            int more;
+            if (S->rare[l]) {
+                /* the scalar step from the same state and trig: it takes the event, the fall
+                 * or the failure exactly as pdw_cdm_advance */
+                soa_store(S, l, s);
+                for (int j = 0; j < PDW_NTRIG; ++j)
+                    s->work[PDW_WORK_TRIG + j] = S->trig[j*PDW_SOA + l];
+                more = step(s);
+                if (more) soa_load(S, l, s);
+            } else {
+                s->n++;
+                s->t = s->n * s->dt;
+                s->n_rhs++;
+                S->upd[l] = 1;
+                more = s->n < s->n_steps;
+                if (!more) {
+                    /* final flags at t_end (scalar trig), as step() */
+                    soa_store(S, l, s);
+                    if (pdw_update_flags(s, s->n * s->dt) == 0) s->status = PDW_STATUS_DONE;
+                }
+            }
+            if (more) continue;
+            finish(job, walker[l], s);
+            running--;
+            walker[l] = soa_refill(job, &next, i1, s, S, l);
+            if (walker[l] >= 0) running++;
         }
     }
     return i1 - i0;

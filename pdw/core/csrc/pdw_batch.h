@@ -52,6 +52,37 @@ typedef struct pdw_batch_job {
     double *fail_x;             /* (n, PDW_NX) */
 } pdw_batch_job;
 
+/* The lanes of a block as structure of arrays: element i of lane l at a[i*PDW_SOA + l]
+ * (PDW_SOA = PDW_BATCH_MAXW), caller-allocated. The lane's pdw_sim holds everything else
+ * (events, gait, counters, failure) and is brought up to date (x, u_prev, armed) whenever a
+ * lane leaves the vector path. */
+typedef struct pdw_soa_state {
+    double x[PDW_NX*PDW_BATCH_MAXW], u_prev[PDW_NQ*PDW_BATCH_MAXW];
+    double p[PDW_NP*PDW_BATCH_MAXW], anchors[PDW_NANCHOR*PDW_BATCH_MAXW];
+    double hip[PDW_BATCH_MAXW], depth[PDW_BATCH_MAXW];
+    int flags[2*PDW_BATCH_MAXW], armed[2*PDW_BATCH_MAXW], armed_next[2*PDW_BATCH_MAXW];
+    int upd[PDW_BATCH_MAXW];    /* 1: past the first step (the flags are updated first) */
+    int rare[PDW_BATCH_MAXW];   /* out: 1 = nothing committed, run the scalar step */
+    double trig[PDW_NTRIG*PDW_BATCH_MAXW], kin[2*PDW_NKIN*PDW_BATCH_MAXW];
+    double contact[2*PDW_NCONTACT*PDW_BATCH_MAXW];
+    double M[PDW_NQ*PDW_NQ*PDW_BATCH_MAXW], C[PDW_NQ*PDW_NQ*PDW_BATCH_MAXW];
+    double QmG[PDW_NQ*PDW_BATCH_MAXW];
+} pdw_soa_state;
+
+/* Instruction sets of the structure-of-arrays step (pdw_batch_soa_*.c); PDW_ISA_SCALAR: no
+ * SoA step, every lane through the generated scalar stages (pdw_batch_cdm). */
+enum { PDW_ISA_SCALAR = -1, PDW_ISA_BASE = 0, PDW_ISA_AVX2 = 1, PDW_ISA_AVX512 = 2 };
+
+/* 1 if this CPU (and this build) can run the SoA step compiled for isa. */
+int pdw_batch_isa_supported(int isa);
+
+/* Advance walkers [i0, i1) of job as pdw_batch_cdm does, the ordinary steps of a block through
+ * the structure-of-arrays step compiled for isa (S: caller-allocated). Falls back to
+ * pdw_batch_cdm when the kernel has no batched stages or isa is PDW_ISA_SCALAR or unsupported.
+ * Bitwise pdw_batch_cdm (and `pdw.simulate`) with vector = 0. */
+long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
+                       int vector, int isa, pdw_soa_state *S);
+
 /* sin and cos of the n angles a into s and c through glibc's vector routines (libmvec). */
 void pdw_batch_sincos(int n, const double *a, double *s, double *c);
 

@@ -1,0 +1,137 @@
+"""Emit ``generated/pdw_batch_gen.h``: structure-of-arrays (SoA) variants of the cdm stages.
+
+A batched stage computes one stage of the scalar kernel for W walkers at once, one per lane:
+every array of the scalar stage (``x``, ``p``, ``trig``, ``anchors``, ``kin``, ``contact``,
+``M``, ``C``, ``QmG``) becomes lane-minor, element ``a[i]`` of lane ``l`` at
+``a[i*PDW_SOA + l]`` (``PDW_SOA`` = 64, the most lanes), and the body runs in a
+``#pragma omp simd`` loop over the lanes that the C compiler vectorizes (one lane per SIMD
+slot). The expressions are the scalar stages' (`derive.stages`), eliminated by the same
+`derive.printer.c_block` into the same statements, so a lane computes exactly the scalar
+kernel's operations in the same order; they use only + - * / sqrt fabs and comparisons, all
+correctly rounded in SIMD, so with no FMA contraction (ISO C mode) a lane's result is bitwise
+the scalar one. The contact stage's branch (a penetrating support foot) becomes a mask: every
+lane evaluates the force law and keeps it only where its foot is one (``on ? force : 0.0``).
+
+The functions are ``static``: the header is included by each instruction-set variant of the
+lane loop (pdw/core/csrc/pdw_batch_soa.inc), compiled once per target (run-time dispatch,
+docs/ensemble.md). Kernels with a normal law other than Hunt-Crossley have no batched stages
+(NULL in the table): the lane loop then runs them through the scalar stages.
+
+Deterministic, stamped with `derive.emit.input_hash` like the other generated files.
+"""
+from __future__ import annotations
+
+import re
+
+from . import layout, stages
+
+_ELEM = re.compile(r"^(\w+)\[(.+)\]$")
+
+
+def _soa(ref: str) -> str:
+    """``a[i]`` -> ``a[(i)*PDW_SOA + l]``; a local name stays as it is."""
+    m = _ELEM.match(ref)
+    return ref if m is None else "%s[(%s)*PDW_SOA + l]" % (m.group(1), m.group(2))
+
+
+LOOP = "    #pragma omp simd\n    for (int l = 0; l < W; ++l) {\n%s\n    }"
+
+
+def _function(signature, body):
+    return "%s\n{\n%s\n}\n" % (signature, body)
+
+
+def emit_kernel(spec, names, c_block, nforces):
+    """C source of the batched kinematics, contact and cdm_terms stages of one kernel."""
+    k = "pdw_soa_" + spec.name
+    soa = {s: _soa(c) for s, c in names.items()}
+    out = ["/* ---- kernel %s, batched (SoA) ---- */\n" % spec.name]
+
+    targets = [_soa("kin[%d*PDW_NKIN + PDW_KIN_%s]" % (i, f.upper()))
+               for i in range(2) for f in layout.KIN]
+    code, _ = c_block(stages.kinematics(spec), targets, soa, indent="        ")
+    out.append(_function(
+        "static void %s_kinematics(int W, const double *restrict x, const double *restrict trig,\n"
+        "    const double *restrict p, const double *restrict anchors, double *restrict kin)" % k,
+        "    (void)anchors;\n" + LOOP % code))
+
+    fields = layout.CONTACT[:nforces]
+    outs = ["o_%s" % f.lower() for f in fields]
+    code, _ = c_block(stages.contact(spec)[:nforces], outs, soa, indent="            ")
+    store = "\n".join("            c[PDW_CONTACT_%s*PDW_SOA + l] = on ? %s : 0.0;"
+                      % (f.upper(), o) for f, o in zip(fields, outs))
+    out.append(_function(
+        "static void %s_contact(int W, const double *restrict kin, const int *restrict flags,\n"
+        "    const double *restrict p, double *restrict contact)" % k,
+        "    for (int i = 0; i < 2; ++i) {\n"
+        "        const double *restrict ki = kin + i*PDW_NKIN*PDW_SOA;\n"
+        "        double *restrict c = contact + i*PDW_NCONTACT*PDW_SOA;\n"
+        "        const int *restrict fl = flags + i*PDW_SOA;\n"
+        "        #pragma omp simd\n"
+        "        for (int l = 0; l < W; ++l) {\n"
+        "            /* mask: a penetrating support foot (the scalar stage's branch) */\n"
+        "            const int on = (fl[l] != 0) & (ki[PDW_KIN_Y_D*PDW_SOA + l] < 0.0);\n"
+        "            const double delta = -ki[PDW_KIN_Y_D*PDW_SOA + l];\n"
+        "            const double deltad = -ki[PDW_KIN_V_Y*PDW_SOA + l];\n"
+        "            const double v_t = ki[PDW_KIN_V_X*PDW_SOA + l];\n"
+        "            const double xi = ki[PDW_KIN_XI*PDW_SOA + l];\n"
+        "            const double v_in = ki[PDW_KIN_V_IN*PDW_SOA + l];\n"
+        "            (void)delta; (void)deltad; (void)v_t; (void)xi; (void)v_in;\n"
+        "            double %s;\n"
+        "%s\n%s\n        }\n    }" % (", ".join(outs), code, store)))
+
+    targets = [_soa("M[%d]" % i) for i in range(16)] + [_soa("C[%d]" % i) for i in range(16)] \
+        + [_soa("QmG[%d]" % i) for i in range(4)]
+    code, _ = c_block(stages.cdm_terms(spec), targets, soa, indent="        ")
+    out.append(_function(
+        "static void %s_cdm_terms(int W, const double *restrict x, const double *restrict trig,\n"
+        "    const double *restrict p, const double *restrict contact,\n"
+        "    double *restrict M, double *restrict C, double *restrict QmG)" % k, LOOP % code))
+    return "\n".join(out)
+
+
+HEADER = """\
+{banner}
+/* Structure-of-arrays stages for the ensemble engine (derive/emit_batch.py, docs/ensemble.md):
+ * element i of lane l at a[i*PDW_SOA + l]. Included by each instruction-set variant of the
+ * lane loop (pdw/core/csrc/pdw_batch_soa.inc); every function is static. */
+#ifndef PDW_BATCH_GEN_H
+#define PDW_BATCH_GEN_H
+
+#include <math.h>
+#include <stddef.h>
+#include "pdw_model.h"
+
+/* the stride of a structure-of-arrays row: the most lanes of a block */
+enum {{ PDW_SOA = 64 }};
+
+/* The batched stages of one kernel (NULL: none, run the scalar stages). */
+typedef struct pdw_soa_kernel {{
+    void (*kinematics)(int W, const double *x, const double *trig, const double *p,
+                       const double *anchors, double *kin);
+    void (*contact)(int W, const double *kin, const int *flags, const double *p,
+                    double *contact);
+    void (*cdm_terms)(int W, const double *x, const double *trig, const double *p,
+                      const double *contact, double *M, double *C, double *QmG);
+}} pdw_soa_kernel;
+
+{body}
+/* indexed like pdw_kernels[] */
+static const pdw_soa_kernel pdw_soa_kernels[PDW_NKERNELS] = {{
+{table}
+}};
+
+#endif /* PDW_BATCH_GEN_H */
+"""
+
+
+def header(banner, kernels, names_of, c_block, nforces):
+    """The text of generated/pdw_batch_gen.h."""
+    body, rows = [], []
+    for spec in kernels:
+        if spec.normal != "hunt_crossley":
+            rows.append("    {NULL, NULL, NULL},   /* %s */" % spec.name)
+            continue
+        body.append(emit_kernel(spec, names_of(spec), c_block, nforces))
+        rows.append("    {%s_kinematics, %s_contact, %s_cdm_terms}," % (("pdw_soa_" + spec.name,) * 3))
+    return HEADER.format(banner=banner, body="\n".join(body), table="\n".join(rows))
