@@ -6,7 +6,7 @@ PIP    := $(PY) -m pip
 OUT    ?= out/typical_gait
 BUILT  := $(VENV)/.pdw-built
 STAMP  := $(VENV)/.pdw-installed
-SOURCES := $(wildcard generated/*.c generated/*.h pdw/core/*.pyx pdw/core/*.pxi pdw/core/csrc/*.c pdw/core/csrc/*.h) setup.py pyproject.toml
+SOURCES := $(wildcard generated/*.c generated/*.h pdw/core/*.pyx pdw/core/*.pxi pdw/core/csrc/*.c pdw/core/csrc/*.h pdw/core/csrc/*.inc) setup.py pyproject.toml
 # an extra's requirements, read from pyproject.toml (installed without rebuilding pdw)
 EXTRA_REQS = $(PY) -c "import sys, tomllib; print('\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies'][sys.argv[1]]))"
 

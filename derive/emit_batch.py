@@ -3,7 +3,8 @@
 A batched stage computes one stage of the scalar kernel for W walkers at once, one per lane:
 every array of the scalar stage (``x``, ``p``, ``trig``, ``anchors``, ``kin``, ``contact``,
 ``M``, ``C``, ``QmG``) becomes lane-minor, element ``a[i]`` of lane ``l`` at
-``a[i*PDW_SOA + l]`` (``PDW_SOA`` = 64, the most lanes), and the body runs in a
+``a[i*PDW_SOA + l]`` (``PDW_SOA`` = 72: room for the most lanes, 64, and not a power of
+two, so that the rows a stage touches fall in different cache sets), and the body runs in a
 ``#pragma omp simd`` loop over the lanes that the C compiler vectorizes (one lane per SIMD
 slot). The expressions are the scalar stages' (`derive.stages`), eliminated by the same
 `derive.printer.c_block` into the same statements, so a lane computes exactly the scalar
@@ -24,6 +25,7 @@ from __future__ import annotations
 import re
 
 from . import layout, stages
+from . import model as mdl
 
 _ELEM = re.compile(r"^(\w+)\[(.+)\]$")
 
@@ -34,7 +36,11 @@ def _soa(ref: str) -> str:
     return ref if m is None else "%s[(%s)*PDW_SOA + l]" % (m.group(1), m.group(2))
 
 
-LOOP = "    #pragma omp simd\n    for (int l = 0; l < W; ++l) {\n%s\n    }"
+# lanes in chunks of PDW_SOA_CHUNK = 8 (a constant trip count, a multiple of every vector
+# width: no scalar remainder, no profitability threshold at run time; a block of W lanes
+# computes ceil(W/8)*8, the padding lanes' values unused)
+LOOP = ("    for (int l0 = 0; l0 < W; l0 += PDW_SOA_CHUNK) {\n"
+        "    #pragma omp simd\n    for (int l = l0; l < l0 + PDW_SOA_CHUNK; ++l) {\n%s\n    }\n    }")
 
 
 def _function(signature, body):
@@ -57,7 +63,15 @@ def emit_kernel(spec, names, c_block, nforces):
 
     fields = layout.CONTACT[:nforces]
     outs = ["o_%s" % f.lower() for f in fields]
-    code, _ = c_block(stages.contact(spec)[:nforces], outs, soa, indent="            ")
+    exprs = stages.contact(spec)[:nforces]
+    # the parameters as locals loaded up front: the law's branches then hold no loads, and the
+    # compiler turns them into selects (a branch with a load would need a masked load)
+    used = set().union(*(e.free_symbols for e in exprs))
+    pre = {s_: "pv_%s" % n for n, s_ in mdl.P.items() if s_ in used}
+    loads = "".join("            const double %s = %s;\n" % (pre[s_], soa[s_])
+                    for s_ in sorted(pre, key=lambda s_: pre[s_]))
+    code, _ = c_block(exprs, outs, {**soa, **pre}, indent="            ")
+    code = loads + code
     store = "\n".join("            c[PDW_CONTACT_%s*PDW_SOA + l] = on ? %s : 0.0;"
                       % (f.upper(), o) for f, o in zip(fields, outs))
     out.append(_function(
@@ -67,8 +81,9 @@ def emit_kernel(spec, names, c_block, nforces):
         "        const double *restrict ki = kin + i*PDW_NKIN*PDW_SOA;\n"
         "        double *restrict c = contact + i*PDW_NCONTACT*PDW_SOA;\n"
         "        const int *restrict fl = flags + i*PDW_SOA;\n"
+        "        for (int l0 = 0; l0 < W; l0 += PDW_SOA_CHUNK) {\n"
         "        #pragma omp simd\n"
-        "        for (int l = 0; l < W; ++l) {\n"
+        "        for (int l = l0; l < l0 + PDW_SOA_CHUNK; ++l) {\n"
         "            /* mask: a penetrating support foot (the scalar stage's branch) */\n"
         "            const int on = (fl[l] != 0) & (ki[PDW_KIN_Y_D*PDW_SOA + l] < 0.0);\n"
         "            const double delta = -ki[PDW_KIN_Y_D*PDW_SOA + l];\n"
@@ -78,7 +93,7 @@ def emit_kernel(spec, names, c_block, nforces):
         "            const double v_in = ki[PDW_KIN_V_IN*PDW_SOA + l];\n"
         "            (void)delta; (void)deltad; (void)v_t; (void)xi; (void)v_in;\n"
         "            double %s;\n"
-        "%s\n%s\n        }\n    }" % (", ".join(outs), code, store)))
+        "%s\n%s\n        }\n        }\n    }" % (", ".join(outs), code, store)))
 
     targets = [_soa("M[%d]" % i) for i in range(16)] + [_soa("C[%d]" % i) for i in range(16)] \
         + [_soa("QmG[%d]" % i) for i in range(4)]
@@ -102,8 +117,12 @@ HEADER = """\
 #include <stddef.h>
 #include "pdw_model.h"
 
-/* the stride of a structure-of-arrays row: the most lanes of a block */
-enum {{ PDW_SOA = 64 }};
+/* the stride of a structure-of-arrays row: room for the most lanes of a block (64), and 9
+ * cache lines, not a power of two, so that the many rows a stage touches at the same lane
+ * fall in different cache sets (a 512-byte stride thrashes an 8-way L1 in 8 sets) */
+enum {{ PDW_SOA = 72 }};
+/* lanes are computed in chunks of this many (the stages compute ceil(W/8)*8 lanes) */
+enum {{ PDW_SOA_CHUNK = 8 }};
 
 /* The batched stages of one kernel (NULL: none, run the scalar stages). */
 typedef struct pdw_soa_kernel {{

@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 
 import pdw
-from pdw.core import _layout
-from pdw.sim.batch import simulate_batch
+from pdw.core import _batch, _layout
+from pdw.sim.batch import ISA_ENV, simulate_batch
 
 T_END = 1.2      # long enough for touch-downs, lift-offs, gait steps and falls
 
@@ -231,3 +231,47 @@ def test_other_methods_are_the_scalar_runs_bitwise(method, dt):
         r = pdw.simulate(x[i], t_end=0.4, dt=dt, method=method, record_every=1,
                          record_forces=False, on_failure="return", check_step="off")
         _assert_bitwise(b, i, r)
+
+
+# ---- the cdm lane loops: structure of arrays per instruction set, dispatched at run time ----
+
+ISAS = [n for n in _batch.ISAS if _batch.isa_supported(n)]
+
+
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("variant, n, lanes", [("paper", 13, 8), ("consistent", 7, 3)])
+def test_every_lane_loop_is_bitwise_the_scalar_run(isa, variant, n, lanes, monkeypatch):
+    """PDW_BATCH_ISA forces each loop this CPU runs (so the narrower ones are tested on a wide
+    machine): the structure-of-arrays step (masks, the generated batched stages) is the scalar
+    step bit for bit, events, falls and failures going through the scalar code."""
+    monkeypatch.setenv(ISA_ENV, isa)
+    x = _states(n, seed=8)
+    b = simulate_batch(x, t_end=T_END, lanes=lanes, threads=1, variant=variant,
+                       check_step="off")
+    statuses = set()
+    for i in range(n):
+        r = _scalar(x[i], pdw.Params.paper(), variant=variant)
+        _assert_bitwise(b, i, r)
+        statuses.add(r.status)
+    assert statuses >= {"walked", "fell"}, statuses
+
+
+@pytest.mark.parametrize("isa", ISAS)
+def test_vector_trig_is_lane_independent_per_isa(isa, monkeypatch):
+    monkeypatch.setenv(ISA_ENV, isa)
+    x = _states(11, seed=9)
+    ref = simulate_batch(x, t_end=0.6, lanes=1, threads=1, vector=True, check_step="off")
+    for lanes in (3, 8, 16):
+        b = simulate_batch(x, t_end=0.6, lanes=lanes, threads=1, vector=True, check_step="off")
+        np.testing.assert_array_equal(b.x_final, ref.x_final)
+
+
+def test_isa_choice_is_checked(monkeypatch):
+    monkeypatch.setenv(ISA_ENV, "sse9")
+    with pytest.raises(pdw.InvalidInputError, match=ISA_ENV):
+        simulate_batch(_states(2), t_end=0.1)
+    missing = [n for n in _batch.ISAS if not _batch.isa_supported(n)]
+    if missing:
+        monkeypatch.setenv(ISA_ENV, missing[0])
+        with pytest.raises(pdw.InvalidInputError, match="does not run"):
+            simulate_batch(_states(2), t_end=0.1)

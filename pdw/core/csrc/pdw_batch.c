@@ -11,7 +11,6 @@
 #include <string.h>
 #include "pdw_batch.h"
 #include "pdw_linalg.h"
-#include "pdw_batch_gen.h"
 
 /* Write lane s's walker i outputs. */
 static void finish(const pdw_batch_job *job, long i, const pdw_sim *s)
@@ -207,12 +206,14 @@ long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim
 
 /* ---- the structure-of-arrays lane loop ------------------------------------------------ */
 
-void pdw_soa_cdm_step_base(const pdw_soa_kernel *k, pdw_soa_state *S, int W, double dt,
+void pdw_soa_cdm_step_base(int kernel, pdw_soa_state *S, int W, double dt,
                            double max_speed, int vector);
-void pdw_soa_cdm_step_avx2(const pdw_soa_kernel *k, pdw_soa_state *S, int W, double dt,
+void pdw_soa_cdm_step_avx2(int kernel, pdw_soa_state *S, int W, double dt,
                            double max_speed, int vector);
-void pdw_soa_cdm_step_avx512(const pdw_soa_kernel *k, pdw_soa_state *S, int W, double dt,
+void pdw_soa_cdm_step_avx512(int kernel, pdw_soa_state *S, int W, double dt,
                              double max_speed, int vector);
+
+int pdw_soa_has_kernel_base(int kernel);
 
 int pdw_batch_isa_supported(int isa)
 {
@@ -225,15 +226,28 @@ int pdw_batch_isa_supported(int isa)
     return 0;
 }
 
+void pdw_soa_trig_libm(pdw_soa_state *S, int W, int only_first)
+{
+    const double *x = S->x;
+    double *trig = S->trig;
+    for (int l = 0; l < W; ++l) {
+        if (only_first && S->upd[l]) continue;
+        trig[PDW_TRIG_SIN_THETA1*PDW_SOA_STRIDE + l] = sin(x[PDW_X_THETA1*PDW_SOA_STRIDE + l]);
+        trig[PDW_TRIG_COS_THETA1*PDW_SOA_STRIDE + l] = cos(x[PDW_X_THETA1*PDW_SOA_STRIDE + l]);
+        trig[PDW_TRIG_SIN_THETA2*PDW_SOA_STRIDE + l] = sin(x[PDW_X_THETA2*PDW_SOA_STRIDE + l]);
+        trig[PDW_TRIG_COS_THETA2*PDW_SOA_STRIDE + l] = cos(x[PDW_X_THETA2*PDW_SOA_STRIDE + l]);
+    }
+}
+
 /* Lane l of S from its pdw_sim (after a start or a scalar step). */
 static void soa_load(pdw_soa_state *S, int l, const pdw_sim *s)
 {
-    for (int i = 0; i < PDW_NX; ++i) S->x[i*PDW_SOA + l] = s->x[i];
-    for (int i = 0; i < PDW_NQ; ++i) S->u_prev[i*PDW_SOA + l] = s->u_prev[i];
-    for (int i = 0; i < PDW_NANCHOR; ++i) S->anchors[i*PDW_SOA + l] = s->disc.anchors[i];
+    for (int i = 0; i < PDW_NX; ++i) S->x[i*PDW_SOA_STRIDE + l] = s->x[i];
+    for (int i = 0; i < PDW_NQ; ++i) S->u_prev[i*PDW_SOA_STRIDE + l] = s->u_prev[i];
+    for (int i = 0; i < PDW_NANCHOR; ++i) S->anchors[i*PDW_SOA_STRIDE + l] = s->disc.anchors[i];
     for (int i = 0; i < 2; ++i) {
-        S->flags[i*PDW_SOA + l] = s->disc.flags[i];
-        S->armed[i*PDW_SOA + l] = s->disc.armed[i];
+        S->flags[i*PDW_SOA_STRIDE + l] = s->disc.flags[i];
+        S->armed[i*PDW_SOA_STRIDE + l] = s->disc.armed[i];
     }
     S->upd[l] = s->n > 0;
 }
@@ -241,16 +255,16 @@ static void soa_load(pdw_soa_state *S, int l, const pdw_sim *s)
 /* The parts of lane l's pdw_sim that the SoA step advances, from S. */
 static void soa_store(const pdw_soa_state *S, int l, pdw_sim *s)
 {
-    for (int i = 0; i < PDW_NX; ++i) s->x[i] = S->x[i*PDW_SOA + l];
-    for (int i = 0; i < PDW_NQ; ++i) s->u_prev[i] = S->u_prev[i*PDW_SOA + l];
-    for (int i = 0; i < 2; ++i) s->disc.armed[i] = S->armed[i*PDW_SOA + l];
+    for (int i = 0; i < PDW_NX; ++i) s->x[i] = S->x[i*PDW_SOA_STRIDE + l];
+    for (int i = 0; i < PDW_NQ; ++i) s->u_prev[i] = S->u_prev[i*PDW_SOA_STRIDE + l];
+    for (int i = 0; i < 2; ++i) s->disc.armed[i] = S->armed[i*PDW_SOA_STRIDE + l];
 }
 
 /* Start walker i in lane l (pdw_sim and S). Returns 1 if it runs, 0 if it finished at once. */
 static int soa_start(const pdw_batch_job *job, long i, pdw_sim *s, pdw_soa_state *S, int l)
 {
     if (!start(job, i, s)) return 0;
-    for (int j = 0; j < PDW_NP; ++j) S->p[j*PDW_SOA + l] = s->p[j];
+    for (int j = 0; j < PDW_NP; ++j) S->p[j*PDW_SOA_STRIDE + l] = s->p[j];
     S->hip[l] = s->fall_hip_height;
     S->depth[l] = s->fall_depth;
     soa_load(S, l, s);
@@ -273,14 +287,13 @@ long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_si
                        int vector, int isa, pdw_soa_state *S)
 {
     const long kid = job->kernel - pdw_kernels;
-    void (*stepfn)(const pdw_soa_kernel *, pdw_soa_state *, int, double, double, int) = NULL;
+    void (*stepfn)(int, pdw_soa_state *, int, double, double, int) = NULL;
     if (isa == PDW_ISA_BASE) stepfn = pdw_soa_cdm_step_base;
     else if (isa == PDW_ISA_AVX2) stepfn = pdw_soa_cdm_step_avx2;
     else if (isa == PDW_ISA_AVX512) stepfn = pdw_soa_cdm_step_avx512;
-    if (kid < 0 || kid >= PDW_NKERNELS || pdw_soa_kernels[kid].kinematics == NULL
+    if (kid < 0 || kid >= PDW_NKERNELS || !pdw_soa_has_kernel_base((int)kid)
         || stepfn == NULL || !pdw_batch_isa_supported(isa))
         return pdw_batch_cdm(job, i0, i1, W, lanes, vector);
-    const pdw_soa_kernel *k = &pdw_soa_kernels[kid];
     long walker[PDW_BATCH_MAXW], next = i0;
     int running = 0;
     if (W < 1) W = 1;
@@ -290,8 +303,18 @@ long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_si
         walker[l] = soa_refill(job, &next, i1, &lanes[l], S, l);
         if (walker[l] >= 0) running++;
     }
+    /* lanes without a walker and the padding lanes up to a multiple of 8 (computed, never
+     * read) step a copy of lane 0: ordinary numbers, no denormal or NaN slow paths (if lane 0
+     * has no walker, none has) */
+    for (int l = 1; l < ((W + 7) & ~7) && walker[0] >= 0; ++l) {
+        if (l < W && walker[l] >= 0) continue;
+        for (int j = 0; j < PDW_NP; ++j) S->p[j*PDW_SOA_STRIDE + l] = S->p[j*PDW_SOA_STRIDE];
+        S->hip[l] = S->hip[0];
+        S->depth[l] = S->depth[0];
+        soa_load(S, l, &lanes[0]);
+    }
     while (running > 0) {
-        stepfn(k, S, W, job->dt, job->max_speed, vector);
+        stepfn((int)kid, S, W, job->dt, job->max_speed, vector);
         for (int l = 0; l < W; ++l) {
             if (walker[l] < 0) continue;
             pdw_sim *s = &lanes[l];
@@ -301,7 +324,7 @@ long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_si
                  * or the failure exactly as pdw_cdm_advance */
                 soa_store(S, l, s);
                 for (int j = 0; j < PDW_NTRIG; ++j)
-                    s->work[PDW_WORK_TRIG + j] = S->trig[j*PDW_SOA + l];
+                    s->work[PDW_WORK_TRIG + j] = S->trig[j*PDW_SOA_STRIDE + l];
                 more = step(s);
                 if (more) soa_load(S, l, s);
             } else {

@@ -13,6 +13,8 @@
 #include "pdw_sim.h"
 
 enum { PDW_BATCH_MAXW = 64 };
+/* the row stride of pdw_soa_state: the generated stages' PDW_SOA (generated/pdw_batch_gen.h) */
+enum { PDW_SOA_STRIDE = 72 };
 
 typedef struct pdw_batch_job {
     /* --- inputs --- */
@@ -52,22 +54,26 @@ typedef struct pdw_batch_job {
     double *fail_x;             /* (n, PDW_NX) */
 } pdw_batch_job;
 
-/* The lanes of a block as structure of arrays: element i of lane l at a[i*PDW_SOA + l]
- * (PDW_SOA = PDW_BATCH_MAXW), caller-allocated. The lane's pdw_sim holds everything else
+/* The lanes of a block as structure of arrays: element i of lane l at a[i*PDW_SOA_STRIDE + l],
+ * caller-allocated (64-byte aligned: a row's first 8 lanes are one cache line). The lane's pdw_sim holds everything else
  * (events, gait, counters, failure) and is brought up to date (x, u_prev, armed) whenever a
  * lane leaves the vector path. */
 typedef struct pdw_soa_state {
-    double x[PDW_NX*PDW_BATCH_MAXW], u_prev[PDW_NQ*PDW_BATCH_MAXW];
-    double p[PDW_NP*PDW_BATCH_MAXW], anchors[PDW_NANCHOR*PDW_BATCH_MAXW];
-    double hip[PDW_BATCH_MAXW], depth[PDW_BATCH_MAXW];
-    int flags[2*PDW_BATCH_MAXW], armed[2*PDW_BATCH_MAXW], armed_next[2*PDW_BATCH_MAXW];
-    int upd[PDW_BATCH_MAXW];    /* 1: past the first step (the flags are updated first) */
-    int rare[PDW_BATCH_MAXW];   /* out: 1 = nothing committed, run the scalar step */
-    double trig[PDW_NTRIG*PDW_BATCH_MAXW], kin[2*PDW_NKIN*PDW_BATCH_MAXW];
-    double contact[2*PDW_NCONTACT*PDW_BATCH_MAXW];
-    double M[PDW_NQ*PDW_NQ*PDW_BATCH_MAXW], C[PDW_NQ*PDW_NQ*PDW_BATCH_MAXW];
-    double QmG[PDW_NQ*PDW_BATCH_MAXW];
+    double x[PDW_NX*PDW_SOA_STRIDE], u_prev[PDW_NQ*PDW_SOA_STRIDE];
+    double p[PDW_NP*PDW_SOA_STRIDE], anchors[PDW_NANCHOR*PDW_SOA_STRIDE];
+    double hip[PDW_SOA_STRIDE], depth[PDW_SOA_STRIDE];
+    int flags[2*PDW_SOA_STRIDE], armed[2*PDW_SOA_STRIDE], armed_next[2*PDW_SOA_STRIDE];
+    int upd[PDW_SOA_STRIDE];    /* 1: past the first step (the flags are updated first) */
+    int rare[PDW_SOA_STRIDE];   /* out: 1 = nothing committed, run the scalar step */
+    double trig[PDW_NTRIG*PDW_SOA_STRIDE], kin[2*PDW_NKIN*PDW_SOA_STRIDE];
+    double contact[2*PDW_NCONTACT*PDW_SOA_STRIDE];
+    double M[PDW_NQ*PDW_NQ*PDW_SOA_STRIDE], C[PDW_NQ*PDW_NQ*PDW_SOA_STRIDE];
+    double QmG[PDW_NQ*PDW_SOA_STRIDE];
 } pdw_soa_state;
+
+/* The trig of lanes l < W from libm (bitwise pdw_trig): all lanes, or (only_first != 0) only
+ * those at their first step (upd[l] == 0). */
+void pdw_soa_trig_libm(pdw_soa_state *S, int W, int only_first);
 
 /* Instruction sets of the structure-of-arrays step (pdw_batch_soa_*.c); PDW_ISA_SCALAR: no
  * SoA step, every lane through the generated scalar stages (pdw_batch_cdm). */
