@@ -27,10 +27,12 @@ sources = ["pdw/core/_core.pyx", "generated/pdw_model.c"] + loops
 batch_sources = ["pdw/core/_batch.pyx", "generated/pdw_model.c"] + loops + batch
 # The lane loops (pdw_batch_soa.inc, generated/pdw_batch_gen.h) must vectorize: -fno-wrapv undoes
 # Python's -fwrapv (with it GCC cannot count a loop `l < l0 + 8` and vectorizes none of them);
-# -fno-trapping-math lets it turn the contact law's branches into selects (no value changes);
+# -fno-trapping-math and -fno-tree-sink let it turn the contact law's branches into selects
+# (neither changes a value);
 # -ffp-contract=off: no FMA contraction on FMA targets (ISO C mode has it off already), so every
 # instruction set gives the scalar stages' bits.
-BATCH_FLAGS = ["-fopenmp-simd", "-fno-wrapv", "-fno-trapping-math", "-ffp-contract=off"]
+BATCH_FLAGS = ["-fopenmp-simd", "-fno-wrapv", "-fno-trapping-math", "-fno-tree-sink",
+               "-ffp-contract=off"]
 # headers and the lane loop's template: a change rebuilds every object (setuptools compares
 # only a source's own time stamp otherwise)
 depends = sorted(glob.glob(CSRC + "/*.h") + glob.glob(CSRC + "/*.inc") + glob.glob("generated/*.h"))
