@@ -386,7 +386,7 @@ def write_all(root: pathlib.Path):
     files = {
         root / "generated" / "pdw_model.h": header(h),
         root / "generated" / "pdw_model.c": src,
-        root / "generated" / "pdw_batch_gen.h": emit_batch.header(banner, KERNELS, _names,
+        root / "generated" / "pdw_batch_gen.h": emit_batch.header(banner, h, KERNELS, _names,
                                                                    c_block, NFORCES),
         root / "pdw" / "core" / "_layout.py": python_layout(h, ops),
     }

@@ -117,6 +117,9 @@ HEADER = """\
 #include <stddef.h>
 #include "pdw_model.h"
 
+/* derive/ input hash these stages were generated from (= PDW_INPUT_HASH of pdw_model.h) */
+#define PDW_BATCH_INPUT_HASH "{hash}"
+
 /* the stride of a structure-of-arrays row: room for the most lanes of a block (64), and 9
  * cache lines, not a power of two, so that the many rows a stage touches at the same lane
  * fall in different cache sets (a 512-byte stride thrashes an 8-way L1 in 8 sets) */
@@ -144,7 +147,7 @@ static const pdw_soa_kernel pdw_soa_kernels[PDW_NKERNELS] = {{
 """
 
 
-def header(banner, kernels, names_of, c_block, nforces):
+def header(banner, h, kernels, names_of, c_block, nforces):
     """The text of generated/pdw_batch_gen.h."""
     body, rows = [], []
     for spec in kernels:
@@ -153,4 +156,4 @@ def header(banner, kernels, names_of, c_block, nforces):
             continue
         body.append(emit_kernel(spec, names_of(spec), c_block, nforces))
         rows.append("    {%s_kinematics, %s_contact, %s_cdm_terms}," % (("pdw_soa_" + spec.name,) * 3))
-    return HEADER.format(banner=banner, body="\n".join(body), table="\n".join(rows))
+    return HEADER.format(banner=banner, hash=h, body="\n".join(body), table="\n".join(rows))
