@@ -239,7 +239,8 @@ ISAS = [n for n in _batch.ISAS if _batch.isa_supported(n)]
 
 
 @pytest.mark.parametrize("isa", ISAS)
-@pytest.mark.parametrize("variant, n, lanes", [("paper", 13, 8), ("consistent", 7, 3)])
+@pytest.mark.parametrize("variant, n, lanes", [("paper", 13, 8), ("consistent", 7, 3),
+                                               ("paper", 70, 64)])
 def test_every_lane_loop_is_bitwise_the_scalar_run(isa, variant, n, lanes, monkeypatch):
     """PDW_BATCH_ISA forces each loop this CPU runs (so the narrower ones are tested on a wide
     machine): the structure-of-arrays step (masks, the generated batched stages) is the scalar
