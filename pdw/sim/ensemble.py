@@ -109,6 +109,7 @@ def scalar_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method="c
         with ThreadPoolExecutor(min(nt, n)) as ex:
             results = list(ex.map(one, range(n)))
     out = from_results(results, dt=dt, t_end=t_end, method=method, variant=variant)
+    out.engine = "scalar"
     if record is not None:
         out.recorded = record_subset(out, record, record_every, x, plist, f0, kw)
     return out
@@ -201,7 +202,7 @@ def concat(parts) -> BatchResult:
         off += len(p)
     p0 = parts[0]
     return BatchResult(**arrays, dt=p0.dt, t_end=p0.t_end, method=p0.method,
-                       variant=p0.variant, recorded=recorded)
+                       variant=p0.variant, recorded=recorded, engine=p0.engine)
 
 
 def run_chunked(kw, executor, chunk_size, scalar=False, progress=None) -> BatchResult:
