@@ -168,3 +168,76 @@ def test_basin_chunks_checkpoint_and_resume(tmp_path, monkeypatch):
     with ThreadPoolExecutor(2) as ex:
         e = B.basin(**kw, chunk_size=5, executor=ex)
     np.testing.assert_array_equal(e.outcome, ref.outcome)
+
+
+STUDY = """
+name = "bsweep"
+[scene]
+preset = "paper_steady"
+x0 = [0.0, 0.4969, -0.0582, 0.0582, 0.5092, 0.0186, 3.3338, -1.0093]
+[scene.integrator]
+method = "%s"
+[scene.stop]
+t_end = 4.0
+on_failure = "return"
+[[axes]]
+name = "k_hip"
+values = [0.3, 0.9, 1.5]
+[[axes]]
+name = "d_hip"
+values = [0.005, 0.02, 0.2]
+[run]
+fallback = false
+"""
+
+
+def _rows_equal(rows, ref):
+    assert [r["index"] for r in rows] == [r["index"] for r in ref]
+    for r, s in zip(rows, ref):
+        assert {k: v for k, v in r.items() if k != "wall_s"} == \
+            {k: v for k, v in s.items() if k != "wall_s"}, (r, s)
+
+
+@pytest.mark.parametrize("backend", ["serial", "process"])
+def test_sweep_points_as_batches_are_the_scalar_rows(tmp_path, backend):
+    """A cdm study runs as batches (groups of points with per-walker Params): every row is
+    the row `run_point` computes for that point alone; the CSV read back is the same."""
+    from pdw.studies.study import parse_study
+    from pdw.studies.sweep import read_rows, run_point, run_study
+    from pdw.studies.sweep_batch import batchable
+    st = parse_study(STUDY % "cdm")
+    assert batchable(st)
+    res = run_study(st, tmp_path / backend, backend=backend, workers=2, progress=False)
+    assert res.engine == "batch"
+    ref = [run_point(st.task(k, v)) for k, v in st.points()]
+    statuses = {r["status"] for r in ref}
+    assert "walked" in statuses and len(statuses) > 1, statuses       # a mix
+    for r, s in zip(res.rows, ref):
+        for k, v in s.items():
+            if k == "wall_s":
+                continue
+            w = r[k]
+            assert (w == v) or (v == "" and w == "") or (isinstance(v, float) and
+                                                        float(w) == v), (k, w, v)
+    again = read_rows(res.paths["csv"], st)
+    assert sorted(again) == [r["index"] for r in res.rows]
+
+
+def test_sweep_with_a_method_the_engine_refuses_runs_point_by_point(tmp_path, monkeypatch):
+    from pdw.studies import sweep_batch
+    from pdw.studies.study import parse_study
+    from pdw.studies.sweep import run_study
+    st = parse_study(STUDY % "cdm")
+    E.supports.cache_clear()
+    monkeypatch.setattr(sweep_batch.ensemble, "supports", lambda m, v="paper": False)
+    res = run_study(st, tmp_path, backend="serial", progress=False)
+    assert res.engine == "scalar"
+    monkeypatch.undo()
+    E.supports.cache_clear()
+    b = run_study(st, tmp_path / "b", backend="serial", progress=False)
+    assert b.engine == "batch"
+    _rows_equal(b.rows, res.rows)
+    assert not sweep_batch.batchable(parse_study(STUDY % "rodas4")) or E.supports("rodas4")
+    off = run_study(st, tmp_path / "off", backend="serial", progress=False, batch=False)
+    assert off.engine == "scalar"
+    _rows_equal(off.rows, b.rows)

@@ -30,6 +30,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..core import _layout
+from ..core.contact import Contact
 from ..core.errors import InvalidInputError
 from ..core.model import STATE
 from ..core.params import Params
@@ -51,6 +52,14 @@ def supports(method, variant="paper") -> bool:
     except InvalidInputError:
         return False
     return True
+
+
+def plain_model(features=None, contact=None) -> bool:
+    """True for the model the batch engine runs: every force element, the default contact
+    laws (None or a default `pdw.Contact`)."""
+    if features is not None and set(features) != set(_layout.FEATURES):
+        return False
+    return contact is None or Contact.coerce(contact).is_default
 
 
 def _plist(params, n):
@@ -293,7 +302,7 @@ def simulate_many(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method="
     batch_only = {k: options.pop(k) for k in ("lanes", "vector") if k in options}
     scalar_only = {k: options.pop(k) for k in ("rtol", "atol", "event_tol", "h_max", "features",
                                                "contact") if k in options}
-    plain = scalar_only.get("features") is None and scalar_only.get("contact") is None
+    plain = plain_model(scalar_only.get("features"), scalar_only.get("contact"))
     kw = dict(x0=x0, t_end=t_end, dt=dt, params=params, variant=variant, method=method,
               flags0=flags0, threads=threads, executor=executor, chunk_size=chunk_size,
               record=record, record_every=record_every, **options)

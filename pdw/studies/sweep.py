@@ -53,6 +53,7 @@ from ..core.params import Params
 from ..core.progress import Progress  # noqa: F401 (pdw.sweep.Progress)
 from ..core.provenance import source_revision
 from .study import COLUMNS, Study, check_name, load_study, parse_study, settings_hash  # noqa: F401 (pdw.sweep.parse_study)
+from .sweep_batch import batchable, groups, run_points
 
 # --- the worker -------------------------------------------------------------------------------
 
@@ -222,7 +223,8 @@ def provenance(study, **extra) -> dict:
 @dataclasses.dataclass
 class StudyResult:
     """Outcome of `run_study`: ``rows`` (list of dicts sorted by index), ``paths`` written,
-    ``computed`` (indices computed in this call), ``resumed`` (indices read from the CSV)."""
+    ``computed`` (indices computed in this call), ``resumed`` (indices read from the CSV),
+    ``engine`` ("batch": groups of points through `pdw.studies.sweep_batch`; "scalar")."""
 
     study: Study
     rows: list
@@ -230,6 +232,7 @@ class StudyResult:
     computed: list
     resumed: list
     wall_s: float
+    engine: str = "scalar"
 
     def column(self, name):
         return np.array([np.nan if r[name] == "" else r[name] for r in self.rows], dtype=float) \
@@ -318,7 +321,7 @@ def _make_executor(backend, workers):
 
 
 def run_study(study, out=None, *, executor=None, workers=None, backend="thread", resume=True,
-              progress=True, figures=None) -> StudyResult:
+              progress=True, figures=None, batch=True) -> StudyResult:
     """Run a study (a `Study` or a path to its TOML file).
 
     Parameters
@@ -343,6 +346,9 @@ def run_study(study, out=None, *, executor=None, workers=None, backend="thread",
         (``<name>.png``); `pdw.present.study_plots.plot_study` is the standard one (``pdw sweep``
         passes it). None or False: no figure. The figure belongs to the presentation layer, so it is
         passed in rather than imported here (docs/architecture.md).
+    batch : bool
+        Run the points as batches through the ensemble engine when the study qualifies
+        (`pdw.studies.sweep_batch.batchable`; the rows are the same); False: point by point.
 
     If a point's task fails in the executor (a killed worker, an interrupt), the points finished
     so far are already in the CSV; the error is re-raised, and a rerun resumes.
@@ -356,10 +362,11 @@ def run_study(study, out=None, *, executor=None, workers=None, backend="thread",
     out = pathlib.Path(out or pathlib.Path("out") / "studies" / study.name)
     out.mkdir(parents=True, exist_ok=True)
     with _FolderLock(out):
-        return _run_locked(study, out, executor, workers, backend, resume, progress, figures)
+        return _run_locked(study, out, executor, workers, backend, resume, progress, figures,
+                           batch)
 
 
-def _run_locked(study, out, executor, workers, backend, resume, progress, figures):
+def _run_locked(study, out, executor, workers, backend, resume, progress, figures, batch):
     csv_path, json_path = out / (study.name + ".csv"), out / (study.name + ".json")
     header = _header(study)
     t_start = time.perf_counter()
@@ -383,20 +390,30 @@ def _run_locked(study, out, executor, workers, backend, resume, progress, figure
     bar = Progress(len(points), len(done), label=study.name, enabled=progress)
     computed = []
     error = None
+    # points that share the scene run as batches (pdw.studies.sweep_batch), one task a group
+    engine = "batch" if batch and todo and batchable(study) else "scalar"
+    if engine == "batch":
+        fn, units = run_points, [[study.task(k, v) for k, v in g]
+                                 for g in groups(todo, workers or os.cpu_count() or 1)]
+    else:
+        fn, units = run_point, [study.task(k, v) for k, v in todo]
     with open(csv_path, "a", newline="") as f:
-        def record(row):
-            f.write(_csv_line(row, header))
-            f.flush()
-            done[row["index"]] = row
-            computed.append(row["index"])
-            bar.update(1)
+        def record(out):
+            for row in (out if engine == "batch" else [out]):
+                if row["index"] in done and row["index"] in computed:
+                    continue
+                f.write(_csv_line(row, header))
+                f.flush()
+                done[row["index"]] = row
+                computed.append(row["index"])
+                bar.update(1)
         try:
             if executor is None and own is None:
-                for k, v in todo:
-                    record(run_point(study.task(k, v)))
+                for u in units:
+                    record(fn(u))
             else:
                 ex = executor if executor is not None else own
-                futs = [ex.submit(run_point, study.task(k, v)) for k, v in todo]
+                futs = [ex.submit(fn, u) for u in units]
                 try:
                     for fut in cf.as_completed(futs):
                         record(fut.result())
@@ -406,9 +423,7 @@ def _run_locked(study, out, executor, workers, backend, resume, progress, figure
                     # keep what finished meanwhile
                     for fut in futs:
                         if fut.done() and not fut.cancelled() and fut.exception() is None:
-                            row = fut.result()
-                            if row["index"] not in done:
-                                record(row)
+                            record(fut.result())
                     raise
         except BaseException as e:      # noqa: BLE001 - re-raised below after bookkeeping
             error = e
@@ -427,7 +442,7 @@ def _run_locked(study, out, executor, workers, backend, resume, progress, figure
     meta = provenance(study, started=started,
                       finished=datetime.datetime.now(datetime.timezone.utc).isoformat(
                           timespec="seconds"),
-                      wall_s=wall, executor=exec_desc, n_points=len(points),
+                      wall_s=wall, executor=exec_desc, engine=engine, n_points=len(points),
                       n_resumed=len(points) - len(computed), n_computed=len(computed),
                       cpu_s_points=float(sum(r["wall_s"] for r in rows if r["wall_s"] != "")),
                       status_counts=statuses, csv=csv_path.name)
@@ -439,7 +454,7 @@ def _run_locked(study, out, executor, workers, backend, resume, progress, figure
             meta["figure"] = "not written: matplotlib is not installed"
     _write_atomic(json_path, json.dumps(meta, indent=2, default=_jsonable) + "\n")
     return StudyResult(study=study, rows=rows, paths=paths, computed=sorted(computed),
-                       resumed=sorted(set(done) - set(computed)), wall_s=wall)
+                       resumed=sorted(set(done) - set(computed)), wall_s=wall, engine=engine)
 
 
 def _jsonable(o):
