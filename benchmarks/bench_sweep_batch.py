@@ -1,4 +1,4 @@
-"""`pdw sweep` points as batches (pdw.studies.sweep_batch) against point by point: the same
+"""`pdw sweep` points as batches (pdw.studies.points) against point by point: the same
 study (cdm, dt = 1e-4, 16 s per point, paper_steady over k_hip x d_hip), interleaved rounds,
 the same rows asserted, wall and process CPU time, load average printed.
 

@@ -20,6 +20,7 @@ from ..core.errors import InvalidInputError
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
 from ..core.params import Params
 from . import stepsize as _stepsize
+from .chunks import honest, record_subset, run_chunked
 from .gait import Steps, steps_from_rows
 from .simulation import _REASONS, _check_count, _check_positive
 
@@ -184,7 +185,7 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
         As `simulate`; fall_hip_height and fall_depth default to 0.5 l and 0.25 l of each
         walker's parameters. A divergence is a status here (``"diverged"``), never an error;
         the end-of-run checks of `simulate` (runaway, ``"no_steps"``) are applied to the final
-        states (`pdw.sim.ensemble.honest`).
+        states (`pdw.sim.chunks.honest`).
     executor : concurrent.futures.Executor-like, optional
         Cut the batch into chunks of ``chunk_size`` consecutive walkers, each one task
         ``executor.submit`` (a thread or process pool, Dask's ``client.get_executor()``), the
@@ -210,7 +211,6 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
     x = _rows(x0)
     n = len(x)
     if executor is not None or chunk_size is not None:
-        from .ensemble import run_chunked
         kw = dict(x0=x, t_end=t_end, dt=dt, params=params, variant=variant, method=method,
                   flags0=flags0, threads=threads, lanes=lanes, vector=vector,
                   stop_steps=stop_steps, periodic_steps=periodic_steps,
@@ -219,7 +219,7 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
                   record=record, record_every=record_every)
         if chunk_size is None:
             chunk_size = max(1, math.ceil(n / 8))
-        return run_chunked(kw, executor, chunk_size)
+        return run_chunked(simulate_batch, kw, executor, chunk_size)
     t_end = _check_positive("t_end", t_end)
     dt = _check_positive("dt", dt)
     if dt > t_end:
@@ -282,7 +282,6 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
                 list(ex.map(lambda c: _batch.run_range(*args, c[0], c[1], lanes, bool(vector)),
                             chunks))
     res = _result(out, dt, n_steps * dt, method, variant)
-    from .ensemble import honest, record_subset
     honest(res, x, plist if len(plist) == n else plist[0])
     if record is not None:
         res.recorded = record_subset(

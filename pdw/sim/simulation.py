@@ -106,8 +106,6 @@ class Result:
         ``{"touch_down": n, "lift_off": n}`` over the whole run.
     stop_reason : str
         ``"t_end"``, ``"steps"`` (stop_steps reached), ``"periodic"``, or the failure status.
-    flags_final : tuple of int
-        Support flags of legs 1, 2 at ``t_final`` (known whether or not samples are recorded).
     energies : dict or None
         With ``record_energies``: T, V_gravity, V_hip and E [J] at the recorded samples.
     sol : DenseOutput or None
@@ -140,7 +138,6 @@ class Result:
     energies: dict | None = None
     features: tuple = _layout.FEATURES
     scene: object = None
-    flags_final: tuple | None = None
     sol: object = None
     provenance: dict | None = None
     contact: object = None      # the pdw.Contact simulated (laws and parameters)
@@ -523,8 +520,7 @@ def _result(raw, params, variant, method, dt, t_end, wall, on_failure,
                  n_gait_steps=int(raw["n_gait_steps"]), event_counts=dict(raw["event_counts"]),
                  events_recorded=events_recorded,
                  stop_reason=stop if stop != "none" else ("t_end" if public == "walked" else public),
-                 energies=energies, features=tuple(features),
-                 flags_final=tuple(int(f) for f in raw["flags_final"]))
+                 energies=energies, features=tuple(features))
     if status == "interrupted":
         exc = raw["interrupted"]
         exc.result = res

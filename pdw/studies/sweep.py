@@ -49,81 +49,10 @@ import time
 import numpy as np
 
 from ..core.errors import InvalidInputError, PdwError
-from ..core.params import Params
 from ..core.progress import Progress  # noqa: F401 (pdw.sweep.Progress)
 from ..core.provenance import source_revision
+from .points import _classify, _newton_point, batchable, groups, run_point, run_points  # noqa: F401 (pdw.sweep.run_point)
 from .study import COLUMNS, Study, check_name, load_study, parse_study, settings_hash  # noqa: F401 (pdw.sweep.parse_study)
-from .sweep_batch import batchable, groups, run_points
-
-# --- the worker -------------------------------------------------------------------------------
-
-def _classify(table, steady, tol):
-    """'period-1', 'period-2' or 'none' from the last steps' L and cycle."""
-    L, T = table["L"], table["cycle"]
-    ok = np.isfinite(L) & np.isfinite(T)
-    L, T = L[ok], T[ok]
-    n = max(steady, 2)
-    if len(L) >= n and max(np.ptp(L[-n:]), np.ptp(T[-n:])) < tol:
-        return "period-1"
-    if len(L) >= 2 * n and max(np.max(np.abs(L[-n:] - L[-n - 2:-2])),
-                               np.max(np.abs(T[-n:] - T[-n - 2:-2]))) < tol:
-        return "period-2"
-    return "none"
-
-
-def run_point(task) -> dict:
-    """Compute one point of a study (module-level, so that process pools and Dask workers can
-    import it). ``task``: `Study.task`. Returns the CSV row (a flat dict of numbers and short
-    strings); an invalid point gives ``status = "error"`` instead of raising."""
-    from ..sim.gait import steps
-    from ..sim.scene import Scene
-    from ..sim.simulation import simulate
-    t0 = time.perf_counter()
-    row = {"index": int(task["index"]), **task["values"]}
-    row.update({c: "" for c in COLUMNS})
-    row["settings"] = task.get("settings", "")
-    run = task["run"]
-    try:
-        params = Params(**task["params"])
-        scene = Scene.from_dict(task["scene"])
-        if run["mode"] == "simulate":
-            res = simulate(**{**scene.simulate_kwargs(), "params": params})
-            st = steps(res)
-            s = st.steady(run["steady"])
-            row.update(status=res.status, n_steps=len(st), t_final=res.t_final, source="simulate",
-                       gait=_classify(st.table, run["steady"], run["period_tol"])
-                       if res.status == "walked" else "")
-            if res.status == "walked" and len(st) >= run["steady"]:
-                row.update({k: s[k] for k in ("L", "P", "v", "cycle", "double_support",
-                                              "ds_fraction", "travel")},
-                           spread_L=s["spread_L"], spread_cycle=s["spread_cycle"])
-        if run["mode"] == "newton" or (run["fallback"] and row["gait"] != "period-1"):
-            _newton_point(row, params, scene)
-    except (PdwError, ValueError) as e:
-        row.update(status="error", error=str(e)[:300])
-    row["wall_s"] = time.perf_counter() - t0
-    return row
-
-
-def _newton_point(row, params, scene):
-    """Fill ``row`` from `pdw.find_gait` (default guesses); keeps ``row`` if none is found."""
-    from ..analysis.gait_types import GaitNotFoundError
-    from ..analysis.limit_cycle import find_gait
-    try:
-        g = find_gait(params, variant=scene.variant, method=scene.integrator.method, workers=1,
-                      max_iter=12)
-    except GaitNotFoundError as e:
-        if row["status"] == "":
-            row.update(status="no_gait", source="newton", error=str(e)[:200])
-        return
-    sp = g.details["swing_period"]
-    mu = float(np.max(np.abs(g.multipliers)))
-    row.update(status="walked" if mu < 1 else "unstable", source="newton",
-               gait="period-1" if mu < 1 else "unstable", L=g.step_length, P=sp,
-               v=g.step_length / sp, cycle=g.period, double_support=g.double_support,
-               ds_fraction=g.double_support / g.period, travel=g.details["travel"],
-               spread_L=g.details["residual"], spread_cycle="", max_multiplier=mu, error="")
-
 
 # --- CSV (resumable) ------------------------------------------------------------------------------
 
@@ -224,7 +153,7 @@ def provenance(study, **extra) -> dict:
 class StudyResult:
     """Outcome of `run_study`: ``rows`` (list of dicts sorted by index), ``paths`` written,
     ``computed`` (indices computed in this call), ``resumed`` (indices read from the CSV),
-    ``engine`` ("batch": groups of points through `pdw.studies.sweep_batch`; "scalar")."""
+    ``engine`` ("batch": groups of points through `pdw.studies.points.run_points`; "scalar")."""
 
     study: Study
     rows: list
@@ -348,7 +277,7 @@ def run_study(study, out=None, *, executor=None, workers=None, backend="thread",
         passed in rather than imported here (docs/architecture.md).
     batch : bool
         Run the points as batches through the ensemble engine when the study qualifies
-        (`pdw.studies.sweep_batch.batchable`; the rows are the same); False: point by point.
+        (`pdw.studies.points.batchable`; the rows are the same); False: point by point.
 
     If a point's task fails in the executor (a killed worker, an interrupt), the points finished
     so far are already in the CSV; the error is re-raised, and a rerun resumes.
@@ -390,7 +319,7 @@ def _run_locked(study, out, executor, workers, backend, resume, progress, figure
     bar = Progress(len(points), len(done), label=study.name, enabled=progress)
     computed = []
     error = None
-    # points that share the scene run as batches (pdw.studies.sweep_batch), one task a group
+    # points that share the scene run as batches (pdw.studies.points), one task a group
     engine = "batch" if batch and todo and batchable(study) else "scalar"
     if engine == "batch":
         fn, units = run_points, [[study.task(k, v) for k, v in g]
