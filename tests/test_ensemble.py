@@ -98,6 +98,10 @@ def test_chunks_over_an_executor_are_the_unchunked_batch(pool):
     serial = simulate_batch(x, t_end=T_END, params=params, flags0=f0, threads=1,
                             check_step="off", chunk_size=3)
     _assert_identical(ref, serial)
+    with pytest.raises(pdw.InvalidInputError, match="chunk_size"):
+        simulate_batch(x, t_end=T_END, chunk_size=0)
+    with pytest.raises(pdw.InvalidInputError, match="record"):
+        simulate_batch(x, t_end=T_END, chunk_size=4, record=[11])
 
 
 def test_recorded_subset_is_scalar_simulate():

@@ -92,23 +92,28 @@ def concat(parts):
         recorded.update({off + k: v for k, v in p.recorded.items()})
         off += len(p)
     p0 = parts[0]
-    return type(p0)(**arrays, dt=p0.dt, t_end=p0.t_end, method=p0.method,
-                       variant=p0.variant, recorded=recorded, engine=p0.engine)
+    return type(p0)(**arrays, dt=p0.dt, t_end=p0.t_end, method=p0.method, variant=p0.variant,
+                    recorded=recorded, engine=p0.engine)
 
 
 def run_chunked(fn, kw, executor, chunk_size, progress=None):
-    """``fn(**kw)`` (`simulate_batch` or `pdw.sim.ensemble.scalar_batch`) for the batch ``kw``
-    (its keyword arguments,
-    ``x0`` (N, 8) validated) into chunks of ``chunk_size`` walkers over ``executor`` (anything
-    with ``submit(fn, arg) -> Future``; None: this thread), reassembled in order. Per-walker
-    inputs (``params`` as a sequence, ``flags0`` (N, 2), ``record``) are cut with the chunk.
-    ``progress``: a `pdw.core.progress.Progress` (updated by walkers) or None."""
+    """``fn(**kw)`` (`simulate_batch` or `pdw.sim.ensemble.scalar_batch`; ``kw`` its keyword
+    arguments, ``x0`` (N, 8) validated) in chunks of ``chunk_size`` consecutive walkers over
+    ``executor`` (anything with ``submit(fn, *args) -> Future``; None: one after the other in
+    this thread), reassembled in order. Per-walker inputs (``params`` as a sequence, ``flags0``
+    (N, 2), ``record``) are cut with the chunk. ``progress``: a `pdw.core.progress.Progress`
+    (updated by walkers) or None."""
     x = kw["x0"]
     n = len(x)
-    size = max(1, _check_count("chunk_size", chunk_size)) if chunk_size is not None else n
+    size = _check_count("chunk_size", chunk_size) if chunk_size is not None else max(n, 1)
+    if size < 1:
+        raise InvalidInputError("chunk_size must be >= 1, got %d" % size)
     params, flags0 = kw.get("params"), np.asarray(kw.get("flags0", (0, 1)))
     per_walker_params = not (params is None or isinstance(params, Params))
     record = sorted(set(int(i) for i in kw.get("record") or ()))
+    if record and not (0 <= record[0] and record[-1] < n):
+        raise InvalidInputError("record must list walker indices in [0, %d), got %d"
+                                % (n, record[0] if record[0] < 0 else record[-1]))
     tasks = []
     for lo in range(0, max(n, 1), size):
         hi = min(n, lo + size)
