@@ -1,4 +1,4 @@
-"""`pdw sweep` points as batches (pdw.studies.points) against point by point: the same
+"""`pdw sweep` points as batches (pdw.studies.points.run_points) against point by point: the same
 study (cdm, dt = 1e-4, 16 s per point, paper_steady over k_hip x d_hip), interleaved rounds,
 the same rows asserted, wall and process CPU time, load average printed.
 
@@ -24,13 +24,13 @@ method = "cdm"
 dt = 1e-4
 [[axes]]
 name = "k_hip"
-start = 0.3
-stop = 1.5
+start = 0.8
+stop = 1.1
 num = 8
 [[axes]]
 name = "d_hip"
 start = 0.005
-stop = 0.03
+stop = 0.015
 num = 6
 [run]
 fallback = false
@@ -60,14 +60,15 @@ def main():
         return v[len(v) // 2]
     ws, cs = med(times[False], 0), med(times[False], 1)
     wb, cb = med(times[True], 0), med(times[True], 1)
-    statuses = sorted({x["status"] for x in rows[True]})
+    st_rows = [x["status"] for x in rows[True]]
+    statuses = ["%d %s" % (st_rows.count(s), s) for s in sorted(set(st_rows))]
     lines = ["pdw sweep, %d points (paper_steady, k_hip x d_hip, cdm dt 1e-4, 16 s each, "
              "fallback off; statuses %s), thread pool of 2, %d interleaved rounds, medians"
              % (n, ", ".join(statuses), ROUNDS),
              "load average before %.2f %.2f %.2f, after %.2f %.2f %.2f (%d cores)"
              % (load0 + load1 + (os.cpu_count(),)),
              "point by point (run_point):  wall %.3f s, CPU %.3f s" % (ws, cs),
-             "batched (sweep_batch):       wall %.3f s, CPU %.3f s" % (wb, cb),
+             "batched (points.run_points): wall %.3f s, CPU %.3f s" % (wb, cb),
              "speed-up: wall %.2fx, CPU %.2fx; rows identical (all columns but wall_s)"
              % (ws / wb, cs / cb)]
     publish("bench_sweep_batch.txt", lines)
