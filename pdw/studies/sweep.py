@@ -329,7 +329,7 @@ def _run_locked(study, out, executor, workers, backend, resume, progress, figure
     with open(csv_path, "a", newline="") as f:
         def record(out):
             for row in (out if engine == "batch" else [out]):
-                if row["index"] in done and row["index"] in computed:
+                if row["index"] in done:      # already written (the interrupt path)
                     continue
                 f.write(_csv_line(row, header))
                 f.flush()
