@@ -102,6 +102,11 @@ def test_chunks_over_an_executor_are_the_unchunked_batch(pool):
         simulate_batch(x, t_end=T_END, chunk_size=0)
     with pytest.raises(pdw.InvalidInputError, match="record"):
         simulate_batch(x, t_end=T_END, chunk_size=4, record=[11])
+    for bad in (0.0, "paper", [pdw.Params.paper()] * 3):
+        with pytest.raises(pdw.InvalidInputError, match="params"):
+            simulate_batch(x, t_end=T_END, chunk_size=4, params=bad)
+        with pytest.raises(pdw.InvalidInputError, match="params"):
+            E.scalar_batch(x, t_end=T_END, params=bad)
 
 
 def test_recorded_subset_is_scalar_simulate():

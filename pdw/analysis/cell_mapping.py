@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core import interrupt
 from ..core.errors import InvalidInputError
 from ..core.params import X0_PAPER, Params
 from . import limit_cycle as lc
@@ -309,12 +310,7 @@ def point_mapping_basin(cm: CellMap, z_star, *, n_steps=12, tol=1e-4, workers=No
     z_star = np.asarray(z_star, dtype=float)
     fn = lambda z: _converge(z, z_star, n_steps, tol, p, cm.variant, cm.info.get("method", "rodas4"), opts)  # noqa: E731
     nw = min(lc._workers(workers), len(Z))
-    if nw <= 1:
-        outs = [fn(z) for z in Z]
-    else:
-        from concurrent.futures import ThreadPoolExecutor
-        with ThreadPoolExecutor(nw) as ex:
-            outs = list(ex.map(fn, Z))
+    outs = interrupt.thread_map(fn, Z, nw)             # Ctrl-C stops every thread
     return np.array([o[0] for o in outs]), np.array([o[1] for o in outs])
 
 

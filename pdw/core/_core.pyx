@@ -7,6 +7,9 @@ C headers). Time loops release the GIL and are entered once per simulation.
 """
 import numpy as np
 
+from pdw.core import interrupt as _interrupt
+from pdw.core.errors import InvalidInputError
+
 from cpython.exc cimport PyErr_CheckSignals
 from libc.string cimport memset, memcpy
 
@@ -458,6 +461,14 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         n_rec_cap = rec_t.shape[0]
         if not record_contact:
             rec_contact = np.zeros((0, PDW_NREC))
+        # every buffer as long as rec_t, checked before a pointer is taken (issue 16)
+        _rows("buffers[1] (x)", rec_x.shape[0], rec_x.shape[1] if rec_x.ndim == 2 else -1,
+              n_rec_cap, PDW_NX)
+        _rows("buffers[2] (flags)", rec_flags.shape[0],
+              rec_flags.shape[1] if rec_flags.ndim == 2 else -1, n_rec_cap, 2)
+        if record_contact:
+            _rows("buffers[3] (contact)", rec_contact.shape[0],
+                  rec_contact.shape[1] if rec_contact.ndim == 2 else -1, n_rec_cap, PDW_NREC)
     else:
         rec_t = np.zeros(n_rec_cap)
         rec_x = np.zeros((n_rec_cap, PDW_NX))
@@ -494,6 +505,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         if status == PDW_STATUS_POLL:
             try:
                 PyErr_CheckSignals()
+                _interrupt.check()          # a worker thread's task of an interrupted pool
             except KeyboardInterrupt as e:
                 interrupted = e
                 break
@@ -557,6 +569,24 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     }
 
 
+def _real_states(x, bint allow_rows):
+    """x as a C-contiguous float64 array of shape (8,) (or (N, 8) when allow_rows): real
+    numbers only, no strings, complex, booleans or reshaping (`pdw.core.checks.real_array`;
+    finiteness is not checked per call)."""
+    if isinstance(x, (str, bytes)):
+        raise InvalidInputError("x must be an array of numbers, got the string %r" % (x,))
+    try:
+        arr = np.asarray(x)
+    except (TypeError, ValueError):
+        raise InvalidInputError("x must be an array of numbers, got %r" % (x,)) from None
+    if arr.dtype.kind not in "iuf":
+        raise InvalidInputError("x must hold real numbers (not %s)" % arr.dtype)
+    if not (arr.shape == (PDW_NX,) or (allow_rows and arr.ndim == 2 and arr.shape[1] == PDW_NX)):
+        raise InvalidInputError("x must have shape (%d,)%s, got %s"
+                                % (PDW_NX, " or (N, %d)" % PDW_NX if allow_rows else "", arr.shape))
+    return np.ascontiguousarray(arr, dtype=np.float64)
+
+
 cdef class OdeFunction:
     """f(t, x) of Eq. A.4 with the discrete state fixed: the model object for external solvers.
 
@@ -572,17 +602,17 @@ cdef class OdeFunction:
 
     def __cinit__(self, int k, const double[::1] p, int f1, int f2, double a1, double a2):
         self.kern = _kernel(k)
-        if p.shape[0] != PDW_NP:
-            raise ValueError("p must have %d entries" % PDW_NP)
+        _len("p", p.shape[0], PDW_NP)
         memcpy(self.p, &p[0], PDW_NP * sizeof(double))
         memset(self._anchors, 0, PDW_NANCHOR * sizeof(double))
-        self._flags[0] = f1
-        self._flags[1] = f2
-        self._anchors[0] = a1
-        self._anchors[1] = a2
+        self.set_discrete(f1, f2, a1, a2)
 
     def set_discrete(self, int f1, int f2, double a1, double a2):
-        """Replace the support flags and anchors (already validated by the caller)."""
+        """Replace the support flags (0 or 1) and the anchors (finite) [m]."""
+        if (f1 != 0 and f1 != 1) or (f2 != 0 and f2 != 1):
+            raise ValueError("flags must be 0 or 1, got (%d, %d)" % (f1, f2))
+        if not (a1 - a1 == 0.0 and a2 - a2 == 0.0):
+            raise ValueError("anchors must be finite, got (%r, %r)" % (a1, a2))
         self._flags[0] = f1
         self._flags[1] = f2
         self._anchors[0] = a1
@@ -602,10 +632,10 @@ cdef class OdeFunction:
         try:
             v = x
         except (ValueError, TypeError, BufferError):
-            arr = np.ascontiguousarray(x, dtype=np.float64)
+            arr = _real_states(x, True)
             if arr.ndim == 2:
                 return self.batch(arr)
-            v = arr.ravel()
+            v = arr
         if v.shape[0] != PDW_NX:
             raise ValueError("x must have shape (8,), got (%d,)" % v.shape[0])
         out = np.empty(PDW_NX)
@@ -634,7 +664,7 @@ cdef class OdeFunction:
         try:
             v = x
         except (ValueError, TypeError, BufferError):
-            v = np.ascontiguousarray(x, dtype=np.float64).ravel()
+            v = _real_states(x, False)
         if v.shape[0] != PDW_NX:
             raise ValueError("x must have shape (8,), got (%d,)" % v.shape[0])
         out = np.empty((PDW_NX, PDW_NX))
@@ -650,7 +680,8 @@ cdef class OdeFunction:
         if out is None:
             out = np.empty((n, PDW_NX))
         elif out.shape[0] != n or out.shape[1] != PDW_NX:
-            raise ValueError("out must have shape (%d, 8)" % n)
+            raise ValueError("out must have shape (%d, %d), got (%d, %d)"
+                             % (n, PDW_NX, out.shape[0], out.shape[1]))
         cdef double w[PDW_NWORK]
         with nogil:
             for i in range(n):

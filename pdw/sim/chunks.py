@@ -30,7 +30,15 @@ _NOT_SIMULATE = ("x0", "params", "flags0", "threads", "lanes", "vector", "execut
 def _plist(params, n):
     if params is None or isinstance(params, Params):
         return [Params.paper() if params is None else params] * n
-    plist = list(params)
+    plist = None
+    if not isinstance(params, (str, bytes, dict)):
+        try:
+            plist = list(params)
+        except TypeError:
+            pass
+    if plist is None:
+        raise InvalidInputError("params must be a pdw.Params or a sequence of N = %d Params, "
+                                "got %r" % (n, params))
     if len(plist) != n:
         raise InvalidInputError("params must be one Params or a sequence of N = %d, got %d"
                                 % (n, len(plist)))
@@ -110,6 +118,8 @@ def run_chunked(fn, kw, executor, chunk_size, progress=None):
         raise InvalidInputError("chunk_size must be >= 1, got %d" % size)
     params, flags0 = kw.get("params"), np.asarray(kw.get("flags0", (0, 1)))
     per_walker_params = not (params is None or isinstance(params, Params))
+    if per_walker_params:
+        params = _plist(params, n)
     record = sorted(set(int(i) for i in kw.get("record") or ()))
     if record and not (0 <= record[0] and record[-1] < n):
         raise InvalidInputError("record must list walker indices in [0, %d), got %d"
