@@ -110,13 +110,13 @@ def rhs(x, params=None, flags=(0, 1), anchors=(0.0, 0.0), variant="paper", featu
     -------
     ndarray, shape (8,) or (N, 8)
     """
-    if (features is None and type(x) is np.ndarray and x.shape == (_core.NX,)
-            and x.dtype == np.float64):
+    if features is None:
+        # fast path: one finite, C-contiguous float64 state, checked in compiled code
         try:
             fn = _rhs_function(params, variant, flags, anchors)
         except TypeError:       # unhashable arguments (a list of flags): the general path
             fn = None
-        if fn is not None and x.flags.c_contiguous:
+        if fn is not None:
             out = fn.checked(x)
             if out is not None:
                 return out
