@@ -83,6 +83,7 @@ import numpy as np
 from ..core.errors import FellError, InvalidInputError, SimulationError
 from ..core.integrators import INTEGRATORS, METHODS
 from ..core.params import X0_DISTURBED, X0_PAPER, Params
+from ..core.progress import progress_bar
 from ..sim.simulation import simulate
 from .gait_types import Gait, GaitNotFoundError
 
@@ -242,15 +243,18 @@ def _workers(workers):
     return max(1, int(workers if workers is not None else (os.cpu_count() or 1)))
 
 
-def map_batch(Z, params=None, variant="paper", method="rodas4", *, workers=None, **options):
-    """Steps from every row of Z (N, 6), in ``workers`` threads: list of step dicts."""
+def map_batch(Z, params=None, variant="paper", method="rodas4", *, workers=None,
+              progress=False, **options):
+    """Steps from every row of Z (N, 6), in ``workers`` threads: list of step dicts
+    (``progress``: False, True or a `pdw.Progress`, one unit per row)."""
     Z = np.atleast_2d(np.asarray(Z, dtype=float))
+    bar = progress_bar(progress, len(Z), "step map")
     fn = lambda z: step(z, params, variant, method, **options)   # noqa: E731
     nw = min(_workers(workers), len(Z))
     if nw <= 1:
-        return [fn(z) for z in Z]
+        return [fn(z) for z in bar.track(Z)]
     with ThreadPoolExecutor(nw) as ex:
-        return list(ex.map(fn, Z))
+        return list(bar.track(ex.map(fn, Z)))
 
 
 def _compose(z, n, params, variant, method, options):
