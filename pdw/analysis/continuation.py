@@ -33,11 +33,15 @@ branch, tangent to (v, 0), does.
 from __future__ import annotations
 
 import time
+from concurrent.futures import Executor
+from typing import Callable, Literal, Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..core.errors import InvalidInputError
-from ..core.progress import progress_bar
+from ..core.params import Params
+from ..core.progress import Progress, progress_bar
 from . import hybrid as H
 from . import limit_cycle as LC
 from .branch import Bifurcation, Branch
@@ -77,12 +81,20 @@ def _start_z(prob, params, start, variant, period):
     return np.asarray(g.details["z"], dtype=float)
 
 
-def continue_gait(params, parameter, stop, *, model="continuous", variant="paper", period=1,
-                  step=None, start=None, value=None, method="pseudo_arclength", max_points=200,
-                  step_min=None, step_max=None, tol=None, locate_tol=None, params_of=None,
-                  log=False, detect=("fold", "period_doubling", "neimark_sacker", "end"),
-                  max_newton=8, executor=None, workers=None, fd_step=1e-5,
-                  options=None, at=(), progress=False) -> Branch:
+def continue_gait(params: Params, parameter: str, stop: float, *,
+                  model: Literal["continuous", "hybrid"] = "continuous", variant: str = "paper",
+                  period: int = 1, step: float | None = None, start: Gait | ArrayLike | None = None,
+                  value: float | None = None,
+                  method: Literal["pseudo_arclength", "natural"] = "pseudo_arclength",
+                  max_points: int = 200, step_min: float | None = None,
+                  step_max: float | None = None, tol: float | None = None,
+                  locate_tol: float | None = None,
+                  params_of: Callable[[float], Params] | None = None, log: bool = False,
+                  detect: Sequence[str] = ("fold", "period_doubling", "neimark_sacker", "end"),
+                  max_newton: int = 8, executor: Executor | None = None,
+                  workers: int | None = None, fd_step: float = 1e-5,
+                  options: dict | None = None, at: Sequence[float] = (),
+                  progress: bool | Progress = False) -> Branch:
     """Follow the period-``period`` gait of ``params`` as ``parameter`` moves towards ``stop``.
 
     Parameters
@@ -109,7 +121,9 @@ def continue_gait(params, parameter, stop, *, model="continuous", variant="paper
         The parameter's value at the start (default: ``getattr(params, parameter)``, or the
         start gait's).
     method : {"pseudo_arclength", "natural"}
+        Pseudo-arclength (follows folds) or natural continuation (steps in the parameter).
     max_points : int
+        Most points on the branch.
     step_min, step_max : float
         Bounds of the arclength step in the scaled coordinates (the range is 1 unit; default
         1e-6 and 0.1).
@@ -124,6 +138,8 @@ def continue_gait(params, parameter, stop, *, model="continuous", variant="paper
         Continue in log(parameter) (for parameters spanning decades, e.g. k_n).
     detect : tuple of str
         Which test functions to watch (`pdw.branch.KINDS`).
+    max_newton : int
+        Newton iterations of the corrector per point.
     executor, workers : concurrent.futures.Executor, int
         Where the continuous model's finite-difference evaluations run (default: threads).
     fd_step : float

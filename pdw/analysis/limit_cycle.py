@@ -77,8 +77,10 @@ from __future__ import annotations
 import math
 import os
 from concurrent.futures import ThreadPoolExecutor
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..core.errors import FellError, InvalidInputError, SimulationError
 from ..core.integrators import INTEGRATORS, METHODS
@@ -398,8 +400,10 @@ def _newton(z, period, params, variant, method, opts, tol, max_iter, fd_step, wo
                       iterations=max_iter)
 
 
-def find_gait(params=None, variant="paper", guess=None, method="rodas4", *, period=1, tol=1e-9,
-              max_iter=20, fd_step=1e-5, settle_time=8.0, workers=None, **options) -> Gait:
+def find_gait(params: Params | None = None, variant: str = "paper",
+              guess: ArrayLike | Gait | None = None, method: str = "rodas4", *, period: int = 1,
+              tol: float = 1e-9, max_iter: int = 20, fd_step: float = 1e-5,
+              settle_time: float = 8.0, workers: int | None = None, **options: Any) -> Gait:
     """The period-``period`` gait of the continuous (compliant-ground) walker by Newton shooting
     on the touch-down Poincaré map (module docstring).
 
@@ -418,6 +422,8 @@ def find_gait(params=None, variant="paper", guess=None, method="rodas4", *, peri
         Solve P^period(z) = z (2 for a period-two gait, ...).
     tol : float
         Newton converges when max|P^n(z) - z| < tol.
+    max_iter : int
+        Newton iterations per guess.
     fd_step : float
         Absolute step of the central-difference Jacobian.
     settle_time : float

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import sys
 import time
+from typing import Any
 
 from .errors import InvalidInputError
 
@@ -41,8 +42,8 @@ class Progress:
         self.stream = sys.stderr if stream is None else stream
         tty = bool(getattr(self.stream, "isatty", lambda: False)())
         self._wanted = bool(enabled) and tty
-        self._bar = None
-        self._tqdm = None
+        self._bar: Any = None            # the tqdm bar while one is drawn
+        self._tqdm: Any = None           # tqdm's class, when installed and drawing
         self._finished = False
         self._t0 = time.perf_counter()
         self._last = 0.0

@@ -1,6 +1,8 @@
 """`pdw.load`: a Result back from a file written by `Result.save` (`pdw.sim.io`)."""
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 from ..core import _layout
@@ -10,10 +12,21 @@ from .gait import Steps
 from .simulation import Event, Result
 
 
-def load(path) -> Result:
-    """Read a Result written by `Result.save` (``.npz`` or ``.nc``); ``res.provenance`` holds
-    the metadata (pdw version, INPUT_HASH, pdw's source revision, settings, scene, time of
-    writing)."""
+def load(path: str | os.PathLike) -> Result:
+    """Read a Result written by `Result.save`.
+
+    Parameters
+    ----------
+    path : str or path-like
+        An ``.npz`` file, or ``.nc`` (NetCDF, needs xarray).
+
+    Returns
+    -------
+    Result
+        The run's recorded arrays (t (M,) [s], x (M, 8), flags (M, 2), Fn, Ft (M, 2) [N]),
+        events, gait descriptors and settings; ``res.provenance`` holds the metadata (pdw
+        version, INPUT_HASH, pdw's source revision, settings, scene, time of writing).
+    """
     arrays, meta = _io.read(path)
     s = meta["settings"]
     events = [Event(float(e[0]), int(e[1]), _layout.EVENT_KIND[int(e[2])], float(e[3]), float(e[4]))
