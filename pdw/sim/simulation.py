@@ -161,7 +161,8 @@ class Result:
         return self.status in ("walked", "periodic")
 
     def state(self, name: str) -> np.ndarray:
-        """Recorded time series of one state component by name, e.g. ``"thetad1"``."""
+        """Recorded time series of one state component by name (`pdw.STATE`), e.g.
+        ``res.state("thetad1")``: ndarray (M,) aligned with ``res.t`` [m, rad, m/s or rad/s]."""
         return self.x[:, STATE.index(name)]
 
     def __repr__(self):
@@ -210,6 +211,8 @@ class Result:
         return _io.save(self, path)
 
     def summary(self) -> str:
+        """One line: method, status, steps and step size, end time, events, gait steps (and the
+        stop condition that ended the run)."""
         n_ev = sum(self.event_counts.values()) if self.event_counts else len(self.events)
         s = "%s: %s, %d steps of %.3g s to t = %.4f s, %d events, %d gait steps" % (
             self.method, self.status, self.n_steps, self.dt, self.t_final, n_ev, self.n_gait_steps)
