@@ -57,6 +57,10 @@ TOML layout (every key optional; defaults are `Scene()`'s)::
     # fall_hip_height, fall_depth [m]: the fall thresholds (default 0.5 l, 0.25 l)
 
 Unknown keys and values of the wrong type are errors naming the key (``record.evry``).
+
+Why this module is long: it is the scene's schema, every section's fields with their TOML
+types, units, meaning and checks (the field metadata), next to the reading, checking and
+writing that use them; split, a field and its check would live apart.
 """
 from __future__ import annotations
 

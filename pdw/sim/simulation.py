@@ -3,6 +3,11 @@
 The loop (C, GIL released) carries the support flags, the arming of the scuffing
 guard and the tangential anchors as discrete state, updated once per step (paper
 Fig. 3, docs/model.md sections 5-7). Python is entered once per simulation.
+
+Why this module is long: `simulate` is the one entry point of a run, with about 30
+parameters, each typed, documented (numpydoc, units) and checked here before the compiled
+loop is entered, and `Result` is what it returns; the checks stay next to the documentation
+of what they check.
 """
 from __future__ import annotations
 
