@@ -30,7 +30,7 @@ import numpy as np
 from ..core import _layout
 from ..core.errors import InvalidInputError
 from ..core.params import Params
-from ..core.progress import Progress
+from ..core.progress import progress_bar
 from ..sim.batch import simulate_batch
 from . import cell_mapping as cmap
 from . import limit_cycle as lc
@@ -150,8 +150,8 @@ def basin(params=None, phi=(0.69, 0.81, 100), thetad2=(-3.2, -0.4, 100), *, t_en
     executor : concurrent.futures.Executor-like, optional
         Run the chunks as ``executor.submit(simulate_batch, ...)`` tasks (a process pool, a
         Dask client's executor); each chunk then uses ``threads`` threads (default 1 here).
-    progress : bool
-        A progress bar over grid points on stderr (`pdw.core.progress`).
+    progress : bool or pdw.Progress
+        A progress bar over grid points on stderr (`pdw.core.progress.progress_bar`).
 
     Returns
     -------
@@ -194,7 +194,7 @@ def basin(params=None, phi=(0.69, 0.81, 100), thetad2=(-3.2, -0.4, 100), *, t_en
                 outcome, steps, wall = ck["outcome"].copy(), ck["n_steps"].copy(), float(ck["wall"])
     bounds = [(lo, min(n, lo + chunk_size)) for lo in range(0, n, chunk_size)]
     todo = [(lo, hi) for lo, hi in bounds if (outcome[lo:hi] < 0).any()]
-    bar = Progress(n, n - sum(hi - lo for lo, hi in todo), label="basin", enabled=progress)
+    bar = progress_bar(progress, n, "basin", done=n - sum(hi - lo for lo, hi in todo))
     nthreads = threads if threads is not None else (1 if executor is not None else None)
 
     def finish(lo, hi, res, seconds):

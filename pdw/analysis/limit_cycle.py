@@ -76,13 +76,16 @@ from __future__ import annotations
 
 import math
 import os
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..core import interrupt
 from ..core.errors import FellError, InvalidInputError, SimulationError
 from ..core.integrators import INTEGRATORS, METHODS
 from ..core.params import X0_DISTURBED, X0_PAPER, Params
+from ..core.progress import progress_bar
 from ..sim.simulation import simulate
 from .gait_types import Gait, GaitNotFoundError
 
@@ -242,11 +245,14 @@ def _workers(workers):
     return max(1, int(workers if workers is not None else (os.cpu_count() or 1)))
 
 
-def map_batch(Z, params=None, variant="paper", method="rodas4", *, workers=None, **options):
-    """Steps from every row of Z (N, 6), in ``workers`` threads: list of step dicts."""
+def map_batch(Z, params=None, variant="paper", method="rodas4", *, workers=None,
+              progress=False, **options):
+    """Steps from every row of Z (N, 6), in ``workers`` threads: list of step dicts
+    (``progress``: False, True or a `pdw.Progress`, one unit per row)."""
     Z = np.atleast_2d(np.asarray(Z, dtype=float))
+    bar = progress_bar(progress, len(Z), "step map")
     fn = lambda z: step(z, params, variant, method, **options)   # noqa: E731
-    return interrupt.thread_map(fn, Z, min(_workers(workers), len(Z)))
+    return interrupt.thread_map(fn, Z, min(_workers(workers), len(Z)), bar)
 
 
 def _compose(z, n, params, variant, method, options):
@@ -386,8 +392,10 @@ def _newton(z, period, params, variant, method, opts, tol, max_iter, fd_step, wo
                       iterations=max_iter)
 
 
-def find_gait(params=None, variant="paper", guess=None, method="rodas4", *, period=1, tol=1e-9,
-              max_iter=20, fd_step=1e-5, settle_time=8.0, workers=None, **options) -> Gait:
+def find_gait(params: Params | None = None, variant: str = "paper",
+              guess: ArrayLike | Gait | None = None, method: str = "rodas4", *, period: int = 1,
+              tol: float = 1e-9, max_iter: int = 20, fd_step: float = 1e-5,
+              settle_time: float = 8.0, workers: int | None = None, **options: Any) -> Gait:
     """The period-``period`` gait of the continuous (compliant-ground) walker by Newton shooting
     on the touch-down Poincaré map (module docstring).
 
@@ -406,6 +414,8 @@ def find_gait(params=None, variant="paper", guess=None, method="rodas4", *, peri
         Solve P^period(z) = z (2 for a period-two gait, ...).
     tol : float
         Newton converges when max|P^n(z) - z| < tol.
+    max_iter : int
+        Newton iterations per guess.
     fd_step : float
         Absolute step of the central-difference Jacobian.
     settle_time : float

@@ -12,6 +12,8 @@ from pdw.core.errors import InvalidInputError
 
 from cpython.exc cimport PyErr_CheckSignals
 from libc.string cimport memset, memcpy
+from cpython.buffer cimport (PyObject_GetBuffer, PyBuffer_Release, PyBUF_C_CONTIGUOUS,
+                            PyBUF_FORMAT)
 
 
 cdef extern from "pdw_model.h":
@@ -587,103 +589,6 @@ def _real_states(x, bint allow_rows):
     return np.ascontiguousarray(arr, dtype=np.float64)
 
 
-cdef class OdeFunction:
-    """f(t, x) of Eq. A.4 with the discrete state fixed: the model object for external solvers.
+# --- the model object for external solvers (pdw.ode_function) ----------------------------
 
-    Built (and validated) by `pdw.ode_function`; every call goes straight to the compiled
-    kernel. ``x`` must be a C-contiguous float64 array of shape (8,) (what ``solve_ivp`` passes);
-    anything else takes a slower converting path. No check of finiteness is made per call.
-    """
-    cdef const pdw_kernel *kern
-    cdef double p[PDW_NP]
-    cdef int _flags[2]
-    cdef double _anchors[PDW_NANCHOR]      # s0_1, s0_2 given; the approach speeds stay 0
-    cdef double work[PDW_NWORK]
-
-    def __cinit__(self, int k, const double[::1] p, int f1, int f2, double a1, double a2):
-        self.kern = _kernel(k)
-        _len("p", p.shape[0], PDW_NP)
-        memcpy(self.p, &p[0], PDW_NP * sizeof(double))
-        memset(self._anchors, 0, PDW_NANCHOR * sizeof(double))
-        self.set_discrete(f1, f2, a1, a2)
-
-    def set_discrete(self, int f1, int f2, double a1, double a2):
-        """Replace the support flags (0 or 1) and the anchors (finite) [m]."""
-        if (f1 != 0 and f1 != 1) or (f2 != 0 and f2 != 1):
-            raise ValueError("flags must be 0 or 1, got (%d, %d)" % (f1, f2))
-        if not (a1 - a1 == 0.0 and a2 - a2 == 0.0):
-            raise ValueError("anchors must be finite, got (%r, %r)" % (a1, a2))
-        self._flags[0] = f1
-        self._flags[1] = f2
-        self._anchors[0] = a1
-        self._anchors[1] = a2
-
-    @property
-    def flags(self):
-        return (self._flags[0], self._flags[1])
-
-    @property
-    def anchors(self):
-        return (self._anchors[0], self._anchors[1])
-
-    def __call__(self, t, x):
-        cdef const double[::1] v
-        cdef double[::1] o
-        try:
-            v = x
-        except (ValueError, TypeError, BufferError):
-            arr = _real_states(x, True)
-            if arr.ndim == 2:
-                return self.batch(arr)
-            v = arr
-        if v.shape[0] != PDW_NX:
-            raise ValueError("x must have shape (8,), got (%d,)" % v.shape[0])
-        out = np.empty(PDW_NX)
-        o = out
-        self.kern.rhs(&v[0], self.p, self._flags, self._anchors, &o[0], self.work)
-        return out
-
-    def checked(self, const double[::1] v):
-        """f at v (8,) if every component is finite, else None (`pdw.rhs`'s fast path)."""
-        cdef Py_ssize_t i
-        cdef double[::1] o
-        if v.shape[0] != PDW_NX:
-            return None
-        for i in range(PDW_NX):
-            if not (v[i] - v[i] == 0.0):
-                return None
-        out = np.empty(PDW_NX)
-        o = out
-        self.kern.rhs(&v[0], self.p, self._flags, self._anchors, &o[0], self.work)
-        return out
-
-    def jac(self, t, x):
-        """df/dx at x, shape (8, 8) (the symbolic Jacobian of the kernel)."""
-        cdef const double[::1] v
-        cdef double[:, ::1] o
-        try:
-            v = x
-        except (ValueError, TypeError, BufferError):
-            v = _real_states(x, False)
-        if v.shape[0] != PDW_NX:
-            raise ValueError("x must have shape (8,), got (%d,)" % v.shape[0])
-        out = np.empty((PDW_NX, PDW_NX))
-        o = out
-        self.kern.jacobian(&v[0], self.p, self._flags, self._anchors, &o[0, 0], self.work)
-        return out
-
-    def batch(self, const double[:, ::1] X, double[:, ::1] out=None):
-        """f for each row of X (N, 8) -> (N, 8), one compiled loop (GIL released)."""
-        cdef Py_ssize_t i, n = X.shape[0]
-        if X.shape[1] != PDW_NX:
-            raise ValueError("X must have shape (N, 8), got (%d, %d)" % (n, X.shape[1]))
-        if out is None:
-            out = np.empty((n, PDW_NX))
-        elif out.shape[0] != n or out.shape[1] != PDW_NX:
-            raise ValueError("out must have shape (%d, %d), got (%d, %d)"
-                             % (n, PDW_NX, out.shape[0], out.shape[1]))
-        cdef double w[PDW_NWORK]
-        with nogil:
-            for i in range(n):
-                self.kern.rhs(&X[i, 0], self.p, self._flags, self._anchors, &out[i, 0], w)
-        return np.asarray(out)
+include "_ode.pxi"

@@ -7,6 +7,7 @@ foreign file is a `pdw.InvalidInputError` naming the field, never a Result that 
 from __future__ import annotations
 
 import json
+import os
 import zipfile
 
 import numpy as np
@@ -140,10 +141,20 @@ def _check(arrays, meta):
         features=tuple(features))
 
 
-def load(path) -> Result:
-    """Read a Result written by `Result.save` (``.npz`` or ``.nc``); ``res.provenance`` holds
-    the metadata (pdw version, INPUT_HASH, pdw's source revision, settings, scene, time of
-    writing).
+def load(path: str | os.PathLike) -> Result:
+    """Read a Result written by `Result.save`.
+
+    Parameters
+    ----------
+    path : str or path-like
+        An ``.npz`` file, or ``.nc`` (NetCDF, needs xarray).
+
+    Returns
+    -------
+    Result
+        The run's recorded arrays (t (M,) [s], x (M, 8), flags (M, 2), Fn, Ft (M, 2) [N]),
+        events, gait descriptors and settings; ``res.provenance`` holds the metadata (pdw
+        version, INPUT_HASH, pdw's source revision, settings, scene, time of writing).
 
     Raises
     ------
