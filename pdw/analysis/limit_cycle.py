@@ -80,6 +80,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+from ..core.contact import Contact
 from ..core.errors import FellError, InvalidInputError, SimulationError
 from ..core.integrators import INTEGRATORS, METHODS
 from ..core.params import X0_DISTURBED, X0_PAPER, Params
@@ -141,6 +142,18 @@ def _foot_height(x, leg, p):
     return x[1] - p.r - (p.l - p.r) * math.cos(th)
 
 
+def _section_contact(contact):
+    """The section carries the mechanical state only: refuse a friction law with more state."""
+    c = Contact.coerce(contact)
+    if c.friction != "coulomb":
+        raise InvalidInputError(
+            "contact.friction = %r: the Poincare section (%s) carries the mechanical state only; "
+            "the trailing foot's bristle state would be re-initialised at every section, so the "
+            "map would not be the continuous run's. Use simulate(..., contact=...) with "
+            "periodic_steps to settle a LuGre gait instead" % (c.friction, ", ".join(SECTION)))
+    return c
+
+
 # --- one step -----------------------------------------------------------------------------------
 
 def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max=2.5,
@@ -159,6 +172,7 @@ def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max
     ``result`` (the `Result`, legs not relabelled, time from the section).
     """
     p = _params(params)
+    _section_contact(contact)
     nan6 = np.full(6, np.nan)
     out = dict(status="ok", z=nan6, x_touch=np.full(8, np.nan), period=np.nan,
                double_support=np.nan, swing_period=np.nan, step_length=np.nan, travel=np.nan,

@@ -21,14 +21,20 @@ _KERNELS = {name: i for i, (name, _, _) in enumerate(_core.kernel_table())}
 _IX = {n: i for i, n in enumerate(STATE)}
 
 
-def kernel_index(variant: str = "paper", features=None, normal: str = "hunt_crossley") -> int:
-    """Index of the generated kernel for ``variant`` with the given force elements and normal
-    contact law (`pdw.core._layout.NORMAL_LAWS`).
+def kernel_index(variant: str = "paper", features=None, normal: str = "hunt_crossley",
+                 friction: str = "coulomb") -> int:
+    """Index of the generated kernel for ``variant`` with the given force elements, normal
+    contact law (`pdw.core._layout.NORMAL_LAWS`) and friction law (`FRICTION_LAWS`).
 
     ``features=None`` means every element (`pdw.core._layout.FEATURES`). A combination without
     a specialized kernel falls back to the general one (of its normal law).
     """
     check_variant(variant)
+    if friction != "coulomb":
+        if friction not in _layout.FRICTION_LAWS or normal not in _layout.NORMAL_LAWS:
+            raise ValueError("no kernel for normal law %r with friction law %r" % (normal, friction))
+        law = "" if normal == "hunt_crossley" else "_" + normal
+        return _KERNELS[variant + law + "_" + friction]
     if normal != "hunt_crossley":
         if normal not in _layout.NORMAL_LAWS:
             raise ValueError("normal law must be one of %s, got %r"

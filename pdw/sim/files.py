@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core import _layout
+from ..core.contact import Contact
 from ..core.params import Params
 from . import io as _io
 from .gait import Steps
@@ -32,5 +33,7 @@ def load(path) -> Result:
                  event_counts=meta["event_counts"], events_recorded=meta["events_recorded"],
                  stop_reason=meta["stop_reason"], energies=energies,
                  features=tuple(s["features"]))
+    if s.get("contact"):
+        res.contact = Contact(**s["contact"])
     res.provenance = meta
     return res

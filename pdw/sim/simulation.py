@@ -74,8 +74,9 @@ class Result:
     ----------
     t : ndarray (N,)
         Recorded times [s] (every ``record_every``-th step).
-    x : ndarray (N, 8)
-        Recorded states, layout `pdw.STATE`.
+    x : ndarray (N, nx)
+        Recorded states, columns `state_names`: layout `pdw.STATE` (nx = 8), with LuGre's
+        bristle states z1, z2 [m] after it (nx = 10).
     flags : ndarray (N, 2)
         Support flags of legs 1, 2 at those times.
     Fn, Ft : ndarray (N, 2)
@@ -147,9 +148,15 @@ class Result:
         """Did the walker keep walking to the end of the run (t_end or a stop condition)?"""
         return self.status in ("walked", "periodic")
 
+    @property
+    def state_names(self) -> tuple:
+        """Names of the columns of `x`: `pdw.STATE`, and the bristle states z1, z2 under the
+        LuGre friction law (`pdw.core._layout.STATE_LAYOUTS`)."""
+        return self.contact.state_names if self.contact is not None else STATE
+
     def state(self, name: str) -> np.ndarray:
         """Recorded time series of one state component by name, e.g. ``"thetad1"``."""
-        return self.x[:, STATE.index(name)]
+        return self.x[:, self.state_names.index(name)]
 
     def __repr__(self):
         counts = self.event_counts or {}
@@ -196,6 +203,12 @@ def _check_positive(name, value):
 
 
 def check_state(x0, name="x0"):
+    """x0 as an array: the mechanical state (`pdw.STATE`) or a friction law's whole state
+    (`pdw.core._layout.STATE_LAYOUTS`; a mechanical x0 gives bristle states 0)."""
+    sizes = sorted({len(v) for v in _layout.STATE_LAYOUTS.values()})
+    x = np.asarray(x0, dtype=float) if isinstance(x0, (list, tuple, np.ndarray)) else None
+    if x is not None and x.ndim == 1 and len(x) in sizes and len(x) != _core.NX:
+        return checks.real_array(name, x0, [(len(x),)])
     return checks.real_array(name, x0, [(_core.NX,)], labels=STATE)
 
 
@@ -369,20 +382,26 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
                                 "record_every must be 1, got %r" % (record_every,))
 
     contact = _contact.Contact.coerce(contact)
+    if contact.friction != "coulomb":
+        _check_friction_law(contact, feats, t_eval, dense_output, out)
+        x = np.concatenate([x, np.zeros(contact.nx - len(x))]) if len(x) < contact.nx else x
+    elif len(x) != _core.NX:
+        raise InvalidInputError("x0 has %d entries: the state of the %s friction law has %d (%s)"
+                                % (len(x), contact.friction, contact.nx, ", ".join(contact.state_names)))
     if (t_eval is not None or dense_output) and contact.normal != "hunt_crossley":
         raise InvalidInputError("t_eval and dense_output interpolate with the default contact law's "
                                 "f(x); with contact.normal = %r they are not available yet: record "
                                 "every step (record_every=1) instead" % (contact.normal,))
     params = contact.parameters(params)
-    k = kernel_index(variant, feats, contact.normal)
+    k = kernel_index(variant, feats, contact.normal, contact.friction)
     if feats != _layout.FEATURES:
         params = params.without(feats)
-    if contact.normal == "hunt_crossley":
+    if contact.normal == "hunt_crossley" and contact.friction == "coulomb":
         try:
             _stepsize.check_step(dt, params, method, variant, check_step)
         except (np.linalg.LinAlgError, FloatingPointError, OverflowError) as e:
             _step_unknown(dt, method, check_step, e)
-    p = contact.vector(parameter_vector(params), feats)
+    p = contact.vector(parameter_vector(params), feats, params)
     start = time.perf_counter()
     buffers = None
     if out is not None and not isinstance(out, RecordBuffer):
@@ -412,6 +431,24 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
         res = _dense.attach(res, t_eval, dense_output, params, variant, feats,
                             _integrators.get(method).order, record_energies)
     return res
+
+
+def _check_friction_law(contact, feats, t_eval, dense_output, out):
+    """What a run with a friction law beyond the paper's (LuGre: bristle states) cannot do yet:
+    refuse it, saying why."""
+    if feats != _layout.FEATURES:
+        raise InvalidInputError("features: the %s friction law has a kernel with every force "
+                                "element only; leave features unset (or set the parameters of "
+                                "the elements to 0)" % contact.friction)
+    if t_eval is not None or dense_output:
+        raise InvalidInputError("t_eval and dense_output interpolate the mechanical state "
+                                "[q, qd] only; with contact.friction = %r (state %s) record "
+                                "every step (record_every=1) instead"
+                                % (contact.friction, ", ".join(contact.state_names)))
+    if out is not None:
+        raise InvalidInputError("out: a pdw.RecordBuffer holds %d-wide states; the %s friction "
+                                "law's state has %d entries: leave out unset"
+                                % (_core.NX, contact.friction, contact.nx))
 
 
 def _step_unknown(dt, method, mode, e):
@@ -459,7 +496,7 @@ def _honest(raw, status, params, x0, energies):
     sample); no touch-down at all in a long enough run makes it "no_steps"."""
     if status != "done":
         return status
-    X = raw["x"] if len(raw["x"]) else np.empty((0, _core.NX))
+    X = raw["x"] if len(raw["x"]) else np.empty((0, len(raw["x_final"])))
     T = raw["t"]
     X = np.vstack([X, raw["x_final"][None, :]])
     T = np.append(T, raw["t_final"])
