@@ -227,6 +227,33 @@ class Contact:
         """Names of the state components under this friction law."""
         return _layout.STATE_LAYOUTS[self.friction]
 
+    def run_state(self, x, all_features=True, interpolate=False, buffer=False) -> np.ndarray:
+        """The initial state of a run under this friction law from a checked x0: a mechanical
+        x0 (`pdw.STATE`) gets bristle states 0 (relaxed). Refuses, saying why, what a run
+        with bristle states cannot do yet: a kernel without every force element
+        (``all_features=False``), interpolation (t_eval, dense_output), a `RecordBuffer`."""
+        x = np.asarray(x, dtype=float)
+        if self.friction == "coulomb":
+            if len(x) != len(_layout.STATE):
+                raise InvalidInputError("x0 has %d entries: the state of the %s friction law has "
+                                        "%d (%s)" % (len(x), self.friction, self.nx,
+                                                     ", ".join(self.state_names)))
+            return x
+        if not all_features:
+            raise InvalidInputError("features: the %s friction law has a kernel with every force "
+                                    "element only; leave features unset (or set the parameters "
+                                    "of the elements to 0)" % self.friction)
+        if interpolate:
+            raise InvalidInputError("t_eval and dense_output interpolate the mechanical state "
+                                    "[q, qd] only; with contact.friction = %r (state %s) record "
+                                    "every step (record_every=1) instead"
+                                    % (self.friction, ", ".join(self.state_names)))
+        if buffer:
+            raise InvalidInputError("out: a pdw.RecordBuffer holds %d-wide states; the %s "
+                                    "friction law's state has %d entries: leave out unset"
+                                    % (len(_layout.STATE), self.friction, self.nx))
+        return np.concatenate([x, np.zeros(self.nx - len(x))]) if len(x) < self.nx else x
+
     def lugre_parameters(self, params: Params) -> dict:
         """LuGre's six parameters with the defaults filled in (sigma0, sigma1, sigma2, mu_s,
         mu_c, v_s)."""

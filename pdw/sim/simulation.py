@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import math
 import time
-import warnings
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
@@ -21,8 +20,6 @@ from ..core.errors import (
     DivergedError,
     InvalidInputError,
     SingularSystemError,
-    StepSizeError,
-    StepSizeWarning,
 )
 from ..core.integrators import METHODS
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
@@ -203,13 +200,10 @@ def _check_positive(name, value):
 
 
 def check_state(x0, name="x0"):
-    """x0 as an array: the mechanical state (`pdw.STATE`) or a friction law's whole state
-    (`pdw.core._layout.STATE_LAYOUTS`; a mechanical x0 gives bristle states 0)."""
-    sizes = sorted({len(v) for v in _layout.STATE_LAYOUTS.values()})
-    x = np.asarray(x0, dtype=float) if isinstance(x0, (list, tuple, np.ndarray)) else None
-    if x is not None and x.ndim == 1 and len(x) in sizes and len(x) != _core.NX:
-        return checks.real_array(name, x0, [(len(x),)])
-    return checks.real_array(name, x0, [(_core.NX,)], labels=STATE)
+    """x0: the mechanical state (`pdw.STATE`) or a friction law's (`Contact.run_state`)."""
+    n = np.shape(x0)[0] if np.ndim(x0) == 1 else _core.NX
+    shape = (n,) if n in {len(v) for v in _layout.STATE_LAYOUTS.values()} else (_core.NX,)
+    return checks.real_array(name, x0, [shape], labels=STATE if shape == (_core.NX,) else None)
 
 
 _DEFAULTS = dict(t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm", flags0=(0, 1),
@@ -382,12 +376,8 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
                                 "record_every must be 1, got %r" % (record_every,))
 
     contact = _contact.Contact.coerce(contact)
-    if contact.friction != "coulomb":
-        _check_friction_law(contact, feats, t_eval, dense_output, out)
-        x = np.concatenate([x, np.zeros(contact.nx - len(x))]) if len(x) < contact.nx else x
-    elif len(x) != _core.NX:
-        raise InvalidInputError("x0 has %d entries: the state of the %s friction law has %d (%s)"
-                                % (len(x), contact.friction, contact.nx, ", ".join(contact.state_names)))
+    x = contact.run_state(x, feats == _layout.FEATURES, t_eval is not None or dense_output,
+                          out is not None)
     if (t_eval is not None or dense_output) and contact.normal != "hunt_crossley":
         raise InvalidInputError("t_eval and dense_output interpolate with the default contact law's "
                                 "f(x); with contact.normal = %r they are not available yet: record "
@@ -400,7 +390,7 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
         try:
             _stepsize.check_step(dt, params, method, variant, check_step)
         except (np.linalg.LinAlgError, FloatingPointError, OverflowError) as e:
-            _step_unknown(dt, method, check_step, e)
+            _stepsize.step_unknown(dt, method, check_step, e)
     p = contact.vector(parameter_vector(params), feats, params)
     start = time.perf_counter()
     buffers = None
@@ -431,35 +421,6 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
         res = _dense.attach(res, t_eval, dense_output, params, variant, feats,
                             _integrators.get(method).order, record_energies)
     return res
-
-
-def _check_friction_law(contact, feats, t_eval, dense_output, out):
-    """What a run with a friction law beyond the paper's (LuGre: bristle states) cannot do yet:
-    refuse it, saying why."""
-    if feats != _layout.FEATURES:
-        raise InvalidInputError("features: the %s friction law has a kernel with every force "
-                                "element only; leave features unset (or set the parameters of "
-                                "the elements to 0)" % contact.friction)
-    if t_eval is not None or dense_output:
-        raise InvalidInputError("t_eval and dense_output interpolate the mechanical state "
-                                "[q, qd] only; with contact.friction = %r (state %s) record "
-                                "every step (record_every=1) instead"
-                                % (contact.friction, ", ".join(contact.state_names)))
-    if out is not None:
-        raise InvalidInputError("out: a pdw.RecordBuffer holds %d-wide states; the %s friction "
-                                "law's state has %d entries: leave out unset"
-                                % (_core.NX, contact.friction, contact.nx))
-
-
-def _step_unknown(dt, method, mode, e):
-    """`pdw.stability.check_step` could not estimate the limit (a force law so stiff that the
-    linearisation is not finite, e.g. v_s <= 1e-150): say so (warning or error)."""
-    msg = ("the stability limit of %s at these parameters could not be estimated (%s): a force "
-           "law is too stiff to linearise in double precision; dt = %g is probably far too large "
-           "(use an adaptive method, or check_step='off')" % (method, e, dt))
-    if mode == "error":
-        raise StepSizeError(msg, dt=dt, limit=0.0, force="unknown") from None
-    warnings.warn(StepSizeWarning(msg, dt=dt, limit=0.0, force="unknown"), stacklevel=3)
 
 
 def _same(a, b):
