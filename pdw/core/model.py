@@ -71,10 +71,13 @@ def _states(x, name="x", width=_core.NX):
 
 
 def _discrete(flags, anchors, n):
+    """Flags (n, 2) and anchors (n, 2) (s0 only) or (n, NANCHOR) (`pdw.core._layout.ANCHORS`:
+    s0 and the approach speeds)."""
     f = checks.flags("flags", flags, n)
     f = np.ascontiguousarray(np.broadcast_to(np.asarray(f, dtype=np.intc), (n, 2)))
-    a = checks.real_array("anchors", anchors, [(2,), (n, 2)])
-    return f, np.ascontiguousarray(np.broadcast_to(a, (n, 2)))
+    na = len(_layout.ANCHORS)
+    a = checks.real_array("anchors", anchors, [(2,), (n, 2), (na,), (n, na)])
+    return f, np.ascontiguousarray(np.broadcast_to(a, (n, a.shape[-1])))
 
 
 def _folded(params, features):
@@ -84,11 +87,16 @@ def _folded(params, features):
     return params if features is None else params.without(features)
 
 
-def _evaluate(x, params, flags, anchors, variant, features=None):
+def _evaluate(x, params, flags, anchors, variant, features=None, contact=None):
     X, single = _states(x)
-    k = kernel_index(variant, features)
     f, a = _discrete(flags, anchors, len(X))
-    p = parameter_vector(_folded(params, features))
+    if contact is None or contact.is_default:
+        k = kernel_index(variant, features)
+        p = parameter_vector(_folded(params, features))
+    else:                                       # a normal law beyond the paper's (Coulomb friction)
+        params = contact.parameters(_folded(params, features))
+        k = kernel_index(variant, features, contact.normal)
+        p = contact.vector(parameter_vector(params), features, params)
     xdot = np.empty_like(X)
     work = np.empty((len(X), _core.NWORK))
     _core.rhs_batch(k, X, p, f, a, xdot, work)
@@ -194,12 +202,14 @@ class ContactState:
 
 
 def contact_forces(x, params=None, flags=(0, 1), anchors=(0.0, 0.0), variant="paper",
-                   features=None) -> ContactState:
+                   features=None, contact=None) -> ContactState:
     """Contact kinematics (Eqs. 4-9) and forces (Eqs. 3, 6, 7, 10, 11) of both feet.
 
     Forces act only on a support foot (flag 1) that penetrates (y_D < 0); otherwise 0.
+    ``contact``: a `pdw.Contact` with another normal law (the smooth Coulomb friction); its
+    anchors then include the approach speeds, (4,) or (N, 4) (`pdw.core._layout.ANCHORS`).
     """
-    X, single, *_, work = _evaluate(x, params, flags, anchors, variant, features)
+    X, single, *_, work = _evaluate(x, params, flags, anchors, variant, features, contact)
     k0, nk = _layout.WORK["kin"]
     c0, nc = _layout.WORK["contact"]
     kin = work[:, k0:k0 + nk].reshape(-1, 2, len(_layout.KIN))

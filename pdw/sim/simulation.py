@@ -378,10 +378,6 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     contact = _contact.Contact.coerce(contact)
     x = contact.run_state(x, feats == _layout.FEATURES, t_eval is not None or dense_output,
                           out is not None)
-    if (t_eval is not None or dense_output) and contact.normal != "hunt_crossley":
-        raise InvalidInputError("t_eval and dense_output interpolate with the default contact law's "
-                                "f(x); with contact.normal = %r they are not available yet: record "
-                                "every step (record_every=1) instead" % (contact.normal,))
     params = contact.parameters(params)
     k = kernel_index(variant, feats, contact.normal, contact.friction)
     if feats != _layout.FEATURES:
@@ -419,7 +415,7 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     res.contact = contact
     if t_eval is not None or dense_output:
         res = _dense.attach(res, t_eval, dense_output, params, variant, feats,
-                            _integrators.get(method).order, record_energies)
+                            _integrators.get(method).order, record_energies, contact)
     return res
 
 
