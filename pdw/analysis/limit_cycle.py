@@ -154,6 +154,20 @@ def _section_contact(contact):
     return c
 
 
+def _approach_speeds(x0, p, variant, law):
+    """The approach speeds of both feet at the section (laws whose damping uses them): leg 2
+    has just touched down with max(-v_y, 0) (what the loop captures); the trailing leg 1 landed
+    one step earlier, and on a period-1 gait with the same speed, which the section point does
+    not otherwise hold. So a period-1 fixed point of the map is exactly the continuous run's
+    periodic orbit (tests/test_contact_laws.py); off it, the trailing foot's damping during the
+    double support uses this step's landing speed instead of the previous step's."""
+    if law.normal not in ("lankarani_nikravesh", "flores"):
+        return None
+    from ..core.model import contact_forces
+    v2 = max(-float(contact_forces(x0, p, flags=(1, 1), variant=variant).v_y[1]), 0.0)
+    return (v2, v2)
+
+
 # --- one step -----------------------------------------------------------------------------------
 
 def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max=2.5,
@@ -172,7 +186,7 @@ def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max
     ``result`` (the `Result`, legs not relabelled, time from the section).
     """
     p = _params(params)
-    _section_contact(contact)
+    law = _section_contact(contact)
     nan6 = np.full(6, np.nan)
     out = dict(status="ok", z=nan6, x_touch=np.full(8, np.nan), period=np.nan,
                double_support=np.nan, swing_period=np.nan, step_length=np.nan, travel=np.nan,
@@ -185,13 +199,15 @@ def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max
     if method not in METHODS:
         raise InvalidInputError("method must be one of %s, got %r" % (", ".join(METHODS), method))
     adaptive = INTEGRATORS[method].adaptive
+    v_in0 = _approach_speeds(x0, p, variant, law)
     t_first = 1.3 * (0.75 if t_hint is None or not np.isfinite(t_hint) else float(t_hint)) + 0.05
     ends = [min(t_first, t_max), t_max] if t_first < t_max else [t_max]
     for t_end in ends:
         t_end = max(t_end, 10 * dt)
         res = simulate(x0, t_end=t_end, dt=dt, params=p, variant=variant, method=method,
                        flags0=(1, 1), record_every=1, record_forces=record, on_failure="return",
-                       rtol=rtol, atol=atol, event_tol=event_tol, contact=contact)
+                       rtol=rtol, atol=atol, event_tol=event_tol, contact=contact,
+                       approach_speeds0=v_in0)
         out["stats"] = dict(res.stats)
         lo = next((e for e in res.events if e.leg == 1 and e.kind == "lift_off"), None)
         td = next((e for e in res.events if e.leg == 1 and e.kind == "touch_down"), None)
@@ -436,9 +452,9 @@ def find_gait(params=None, variant="paper", guess=None, method="rodas4", *, peri
         Threads for the Jacobian's 13 map evaluations (default: all cores).
     options
         Step-map options: rtol, atol, event_tol (default `TIGHT`), t_max, dt, and
-        ``contact`` (`pdw.Contact`: the contact laws; the section re-initialises both feet's
-        approach speeds, so with lankarani_nikravesh or flores the trailing foot's damping
-        during the double support differs from a continuous run's).
+        ``contact`` (`pdw.Contact`: the normal law; with lankarani_nikravesh or flores both feet
+        get the section's landing speed as their approach speed, `_approach_speeds`: exact at
+        a period-1 fixed point. LuGre friction is refused).
 
     Returns
     -------

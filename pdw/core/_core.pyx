@@ -405,7 +405,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         double rtol=1e-6, double atol=1e-8, double h_max=0.0, long max_records=0,
         long event_capacity=256, double event_tol=1e-9, bint record_events=True,
         long stop_steps=0, int periodic_k=0, double periodic_tol=0.0, double t_end=0.0,
-        long max_steps=0, long poll_every=POLL_EVERY, buffers=None):
+        long max_steps=0, long poll_every=POLL_EVERY, buffers=None, approach_speeds0=None):
     """Run one simulation in compiled code (GIL released). Returns a dict of arrays and status.
 
     The online gait analysis runs for every method: the result's "gait" holds the last
@@ -424,7 +424,10 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     loop returns PDW_STATUS_POLL: signals are checked here (GIL held); on Ctrl-C the run stops
     and the result (so far) is returned with "interrupted" set to the KeyboardInterrupt.
 
-    Shapes (checked): x0 (NX,), p (NP,).
+    approach_speeds0: (v1, v2) [m/s] replaces the approach speeds of the feet that start in
+    support (default: pdw_discrete_init's max(-v_y, 0)).
+
+    Shapes (checked): x0 (kernel_nx(k),), p (NP,).
     """
     cdef pdw_sim s
     cdef int flags0[2]
@@ -505,6 +508,11 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     memcpy(s.x, &x0[0], nx * sizeof(double))
     flags0[0] = f1; flags0[1] = f2
     pdw_discrete_init(s.kernel, s.p, s.x, flags0, &s.disc, s.work)
+    if approach_speeds0 is not None:        # feet that start in support: given approach speeds
+        if f1:
+            s.disc.anchors[PDW_ANCHOR_V_IN1] = approach_speeds0[0]
+        if f2:
+            s.disc.anchors[PDW_ANCHOR_V_IN2] = approach_speeds0[1]
     cdef int status
     interrupted = None
     while True:

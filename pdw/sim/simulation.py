@@ -212,7 +212,7 @@ _DEFAULTS = dict(t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
                  features=None, record_events=True, record_energies=False, stop_steps=0,
                  periodic_steps=0, periodic_tol=1e-3, check_step="warn", t_eval=None,
                  dense_output=False, out=None, max_steps=None,
-                 contact=None)
+                 contact=None, approach_speeds0=None)
 
 
 def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
@@ -221,7 +221,7 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
              h_max=None, event_tol=1e-9, *, features=None, record_events=True,
              record_energies=False, stop_steps=0, periodic_steps=0, periodic_tol=1e-3,
              check_step="warn", t_eval=None, dense_output=False, out=None, max_steps=None,
-             contact=None):
+             contact=None, approach_speeds0=None):
     """Simulate the walker from ``x0`` for ``t_end`` seconds (or run a `pdw.Scene`).
 
     ``simulate(scene)`` runs the scene (as `pdw.run`); no other argument may be given then.
@@ -305,6 +305,9 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     contact : pdw.Contact, dict or str, optional
         Normal and friction contact laws and their parameters (`pdw.Contact`,
         docs/contact_laws.md); default the paper's Hunt-Crossley and smooth Coulomb laws.
+    approach_speeds0 : (float, float), optional
+        Approach speeds [m/s] (>= 0) of the feet that start in support (the damping of
+        lankarani_nikravesh and flores); default max(-v_y(x0), 0) of each.
 
     Returns
     -------
@@ -356,7 +359,7 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     atol = _check_positive("atol", atol)
     h_max = 0.0 if h_max is None else _check_positive("h_max", h_max)
     event_tol = _check_positive("event_tol", event_tol)
-    feats = _check_features(features)
+    feats = checks.features(features, _layout.FEATURES)
     for name, flag in (("record_forces", record_forces), ("record_events", record_events),
                        ("record_energies", record_energies)):
         if not isinstance(flag, (bool, np.bool_)):
@@ -388,6 +391,8 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
         except (np.linalg.LinAlgError, FloatingPointError, OverflowError) as e:
             _stepsize.step_unknown(dt, method, check_step, e)
     p = contact.vector(parameter_vector(params), feats, params)
+    v_in0 = None if approach_speeds0 is None else tuple(checks.real_array(
+        "approach_speeds0", approach_speeds0, [(2,)], lo=0.0))
     start = time.perf_counter()
     buffers = None
     if out is not None and not isinstance(out, RecordBuffer):
@@ -401,7 +406,7 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
                     bool(record_forces), hip, depth, max_speed, rtol, atol, h_max,
                     event_tol=event_tol, record_events=bool(record_events), stop_steps=stop_steps,
                     periodic_k=periodic_steps, periodic_tol=periodic_tol, t_end=t_end,
-                    max_steps=budget, buffers=buffers)
+                    max_steps=budget, buffers=buffers, approach_speeds0=v_in0)
     wall = time.perf_counter() - start
     energies = None
     if record_energies and raw["interrupted"] is None:
@@ -431,20 +436,6 @@ def _same(a, b):
 
 def _check_count(name, value):
     return checks.count(name, value)
-
-
-def _check_features(features):
-    if features is None:
-        return _layout.FEATURES
-    if isinstance(features, str):
-        raise InvalidInputError("features must be a collection of names, got the string %r"
-                                % features)
-    feats = set(features)
-    unknown = feats - set(_layout.FEATURES)
-    if unknown:
-        raise InvalidInputError("unknown feature(s) %s; allowed: %s"
-                                % (", ".join(sorted(map(str, unknown))), ", ".join(_layout.FEATURES)))
-    return tuple(f for f in _layout.FEATURES if f in feats)
 
 
 def _honest(raw, status, params, x0, energies):

@@ -75,7 +75,7 @@ int pdw_cdm_update(pdw_sim *s, const double *M, const double *C, const double *Q
     if (s->nx > PDW_NX) bristle_update(s, dt, xnew);
     if (pdw_check_state(s, xnew, t)) return 1;
     for (int i = 0; i < PDW_NQ; ++i) s->u_prev[i] = s->x[i];
-    memcpy(s->x, xnew, s->nx * sizeof(double));
+    pdw_copy_state(s, s->x, xnew);
     s->n++;
     s->t = s->n * dt;
     s->n_rhs++;

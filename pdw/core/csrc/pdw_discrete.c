@@ -248,7 +248,7 @@ void pdw_record_now(pdw_sim *s, double t)
     if (s->n_rec >= s->rec_capacity) return;
     const long r = s->n_rec++;
     s->rec_t[r] = t;
-    memcpy(s->rec_x + r*s->nx, s->x, s->nx * sizeof(double));
+    pdw_copy_state(s, s->rec_x + r*s->nx, s->x);
     s->rec_flags[2*r] = s->disc.flags[0];
     s->rec_flags[2*r + 1] = s->disc.flags[1];
     if (s->rec_contact) {

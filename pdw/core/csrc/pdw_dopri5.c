@@ -16,7 +16,7 @@ static double dopri5_step(pdw_sim *s, void *ctx, const double *fx, double h, int
     (void)ctx; (void)new_point;
     memcpy(k[0], fx, sizeof k[0]);
     pdw_rk_stages(s, &pdw_tableau_dopri5, s->x, h, k, xnew, errv);
-    memcpy(fnew, k[6], s->nx * sizeof(double));
+    pdw_copy_state(s, fnew, k[6]);
     *fnew_valid = 1;
     return pdw_err_norm(s, s->x, xnew, errv);
 }

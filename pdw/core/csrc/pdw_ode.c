@@ -4,10 +4,11 @@
 #include <string.h>
 #include "pdw_ode.h"
 
-void pdw_rk_stages(pdw_sim *s, const pdw_rk_tableau *T, const double *x, double h,
-                   double (*k)[PDW_NX_MAX], double *xnew, double *errv)
+/* The stages for a state of nx entries; inlined with nx = PDW_NX a compile-time constant
+ * (pdw_rk_stages), so that the common size keeps its unrolled loops. */
+static inline void rk_stages(pdw_sim *s, const pdw_rk_tableau *T, const double *x, double h,
+                             double (*k)[PDW_NX_MAX], double *xnew, double *errv, const int nx)
 {
-    const int nx = s->nx;
     double xs[PDW_NX_MAX];
     for (int i = 1; i < T->stages; ++i) {
         for (int c = 0; c < nx; ++c) {
@@ -28,7 +29,14 @@ void pdw_rk_stages(pdw_sim *s, const pdw_rk_tableau *T, const double *x, double 
     }
     /* FSAL: the last stage point is the new solution up to rounding; use that exact point so
      * that k[stages-1] is f(xnew) bit for bit */
-    if (T->fsal) memcpy(xnew, xs, nx * sizeof(double));
+    if (T->fsal) pdw_copy_state(s, xnew, xs);
+}
+
+void pdw_rk_stages(pdw_sim *s, const pdw_rk_tableau *T, const double *x, double h,
+                   double (*k)[PDW_NX_MAX], double *xnew, double *errv)
+{
+    if (s->nx == PDW_NX) rk_stages(s, T, x, h, k, xnew, errv, PDW_NX);
+    else rk_stages(s, T, x, h, k, xnew, errv, s->nx);
 }
 
 double pdw_err_norm(const pdw_sim *s, const double *x, const double *xnew, const double *errv)
@@ -93,7 +101,7 @@ int pdw_fixed_advance(pdw_sim *s, pdw_fixed_step_fn step)
         }
         if (step(s, dt, xnew)) return s->status;
         if (pdw_check_state(s, xnew, s->t)) return s->status;
-        memcpy(s->x, xnew, s->nx * sizeof(double));
+        pdw_copy_state(s, s->x, xnew);
         s->n++;
         s->t = s->n * dt;
     }
@@ -246,8 +254,8 @@ int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx)
             }
         }
         if (pdw_check_state(s, xnew, s->t)) return s->status;
-        memcpy(s->x, xnew, s->nx * sizeof(double));
-        memcpy(s->cache, fnew, s->nx * sizeof(double));
+        pdw_copy_state(s, s->x, xnew);
+        pdw_copy_state(s, s->cache, fnew);
         s->cache_valid = 1;
         s->t = last ? t_end : s->t + h_acc;
         s->n++;

@@ -90,7 +90,7 @@ static double rodas4_step(pdw_sim *s, void *vctx, const double *fx, double h, in
         c->lu_h = h;
     }
     const double ih = 1.0 / h;
-    memcpy(u[0], fx, nx * sizeof(double));
+    pdw_copy_state(s, u[0], fx);
     rodas_solve(c, u[0]);
     for (int i = 1; i < T->stages; ++i) {
         for (int k = 0; k < nx; ++k) {

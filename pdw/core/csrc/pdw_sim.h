@@ -7,6 +7,7 @@
 #ifndef PDW_SIM_H
 #define PDW_SIM_H
 
+#include <string.h>
 #include "pdw_model.h"
 
 /* Discrete state carried by every loop (docs/model.md sections 5 and 6). */
@@ -125,6 +126,14 @@ typedef struct pdw_sim {
     long max_steps;             /* adaptive methods: fail (PDW_REASON_BUDGET) once accepted +
                                  * rejected steps reach this; 0: no budget */
 } pdw_sim;
+
+/* Copy a state of s's size (s->nx); the common size PDW_NX as a compile-time constant, so that
+ * the copy stays inline in the time loops. */
+static inline void pdw_copy_state(const pdw_sim *s, double *dst, const double *src)
+{
+    if (s->nx == PDW_NX) memcpy(dst, src, PDW_NX * sizeof(double));
+    else memcpy(dst, src, (size_t)s->nx * sizeof(double));
+}
 
 /* Is a poll due (counts one loop iteration)? Sets s->status = PDW_STATUS_POLL when it is. */
 static inline int pdw_poll_due(pdw_sim *s)
