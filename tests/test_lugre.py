@@ -214,6 +214,8 @@ def test_x0_mechanical_or_full():
     (dict(contact=dict(friction="lugre", mu_c=0.0)), "contact.mu_c"),
     (dict(contact=dict(friction="lugre"), t_eval=[0.005]), "t_eval and dense_output"),
     (dict(contact=dict(friction="lugre"), features=("friction", "tangential")), "features"),
+    (dict(approach_speeds0=(-1.0, 0.0)), r"approach_speeds0\[0\] must be >= 0"),
+    (dict(approach_speeds0=(0.1,)), "approach_speeds0 must have shape"),
 ])
 def test_refused_with_reasons(kwargs, match):
     with pytest.raises(pdw.InvalidInputError, match=match):
