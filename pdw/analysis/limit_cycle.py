@@ -80,6 +80,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+from ..core import _layout
 from ..core.contact import Contact
 from ..core.errors import FellError, InvalidInputError, SimulationError
 from ..core.integrators import INTEGRATORS, METHODS
@@ -188,7 +189,7 @@ def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max
     p = _params(params)
     law = _section_contact(contact)
     nan6 = np.full(6, np.nan)
-    out = dict(status="ok", z=nan6, x_touch=np.full(8, np.nan), period=np.nan,
+    out = dict(status="ok", z=nan6, x_touch=np.full(len(_layout.STATE), np.nan), period=np.nan,
                double_support=np.nan, swing_period=np.nan, step_length=np.nan, travel=np.nan,
                n_events=0, stats={})
     try:
@@ -383,7 +384,7 @@ def _guess_z(guess, params):
         x = hybrid.full_state(guess.details["y_minus"], params)
         return section_coordinates(x, 2)
     g = np.asarray(guess, dtype=float).reshape(-1)
-    if g.shape == (8,):
+    if g.shape == (len(_layout.STATE),):
         return section_coordinates(g, 2 if g[3] >= g[2] else 1)
     return _z(g, "guess")
 

@@ -69,13 +69,13 @@ class DenseOutput:
         self._fl, self._an, self._k, self._p = fl, an, k, p
         ends = []
         for xs in (np.ascontiguousarray(self.x[:-1]), np.ascontiguousarray(self.x[1:])):
-            f = np.empty((n, 8))
+            f = np.empty((n, _core.NX))
             _core.rhs_batch(k, xs, p, fl, an, f, np.empty((n, _core.NWORK)))
             a = None
             if order == 5:
-                J = np.empty((n, 64))
+                J = np.empty((n, _core.NX * _core.NX))
                 _core.jacobian_batch(k, xs, p, fl, an, J, np.empty((n, _core.NWORK)))
-                a = np.einsum("nij,nj->ni", J.reshape(n, 8, 8), f)
+                a = np.einsum("nij,nj->ni", J.reshape(n, _core.NX, _core.NX), f)
             ends.append((f, a))
         (self.f0, self.a0), (self.f1, self.a1) = ends
 
@@ -139,7 +139,7 @@ def resample(res, sol, t_eval, params, variant):
     """Replace the Result's records (t, x, flags, Fn, Ft) by their values at t_eval (those up to
     the run's last recorded time); the steps stay in ``res.sol``."""
     te = t_eval[t_eval <= sol.t[-1]]
-    x = sol(te) if len(te) else np.zeros((0, 8))
+    x = sol(te) if len(te) else np.zeros((0, _core.NX))
     fl = sol.flags_at(te) if len(te) else np.zeros((0, 2), dtype=np.intc)
     res.t, res.x, res.flags = te, x, fl
     if len(res.Fn):
