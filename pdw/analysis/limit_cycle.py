@@ -143,32 +143,6 @@ def _foot_height(x, leg, p):
     return x[1] - p.r - (p.l - p.r) * math.cos(th)
 
 
-def _section_contact(contact):
-    """The section carries the mechanical state only: refuse a friction law with more state."""
-    c = Contact.coerce(contact)
-    if c.friction != "coulomb":
-        raise InvalidInputError(
-            "contact.friction = %r: the Poincare section (%s) carries the mechanical state only; "
-            "the trailing foot's bristle state would be re-initialised at every section, so the "
-            "map would not be the continuous run's. Use simulate(..., contact=...) with "
-            "periodic_steps to settle a LuGre gait instead" % (c.friction, ", ".join(SECTION)))
-    return c
-
-
-def _approach_speeds(x0, p, variant, law):
-    """The approach speeds of both feet at the section (laws whose damping uses them): leg 2
-    has just touched down with max(-v_y, 0) (what the loop captures); the trailing leg 1 landed
-    one step earlier, and on a period-1 gait with the same speed, which the section point does
-    not otherwise hold. So a period-1 fixed point of the map is exactly the continuous run's
-    periodic orbit (tests/test_contact_laws.py); off it, the trailing foot's damping during the
-    double support uses this step's landing speed instead of the previous step's."""
-    if law.normal not in ("lankarani_nikravesh", "flores"):
-        return None
-    from ..core.model import contact_forces
-    v2 = max(-float(contact_forces(x0, p, flags=(1, 1), variant=variant).v_y[1]), 0.0)
-    return (v2, v2)
-
-
 # --- one step -----------------------------------------------------------------------------------
 
 def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max=2.5,
@@ -187,7 +161,7 @@ def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max
     ``result`` (the `Result`, legs not relabelled, time from the section).
     """
     p = _params(params)
-    law = _section_contact(contact)
+    law = Contact.coerce(contact).for_section(SECTION)
     nan6 = np.full(6, np.nan)
     out = dict(status="ok", z=nan6, x_touch=np.full(len(_layout.STATE), np.nan), period=np.nan,
                double_support=np.nan, swing_period=np.nan, step_length=np.nan, travel=np.nan,
@@ -200,7 +174,7 @@ def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max
     if method not in METHODS:
         raise InvalidInputError("method must be one of %s, got %r" % (", ".join(METHODS), method))
     adaptive = INTEGRATORS[method].adaptive
-    v_in0 = _approach_speeds(x0, p, variant, law)
+    v_in0 = law.section_approach_speeds(x0, p, variant)
     t_first = 1.3 * (0.75 if t_hint is None or not np.isfinite(t_hint) else float(t_hint)) + 0.05
     ends = [min(t_first, t_max), t_max] if t_first < t_max else [t_max]
     for t_end in ends:
@@ -454,8 +428,9 @@ def find_gait(params=None, variant="paper", guess=None, method="rodas4", *, peri
     options
         Step-map options: rtol, atol, event_tol (default `TIGHT`), t_max, dt, and
         ``contact`` (`pdw.Contact`: the normal law; with lankarani_nikravesh or flores both feet
-        get the section's landing speed as their approach speed, `_approach_speeds`: exact at
-        a period-1 fixed point. LuGre friction is refused).
+        get the section's landing speed as their approach speed
+        (`Contact.section_approach_speeds`: exact at a period-1 fixed point). LuGre friction is
+        refused).
 
     Returns
     -------
