@@ -27,6 +27,8 @@ continue_gait, Branch   continuation of gaits in one parameter: branches, Floque
                         ``pdw continue``)
 sweep                   parameter studies from TOML files: run_study, load_study (``pdw sweep``)
 examples                the scenes and studies shipped with pdw (``pdw run --list-examples``)
+Progress                the progress bar of long jobs (``progress=`` of sweeps, cell maps, basins,
+                        continuation, figures; tqdm when installed, quiet off a terminal)
 PdwError, SimulationError, DivergedError, InvalidInputError   the error hierarchy
 STATE, VARIANTS         the state layout and the contact variants (docs/model.md section 6)
 """
@@ -64,6 +66,7 @@ from .core.model import (
 )
 from .core.ode import OdeFunction, ode_function
 from .core.params import X0_DISTURBED, X0_PAPER, Params
+from .core.progress import Progress
 from .sim import scene
 from .sim.batch import BatchResult, simulate_batch
 from .sim.buffers import RecordBuffer
@@ -88,5 +91,5 @@ __all__ = [
     "limit_cycle", "cell_mapping", "find_gait", "sweep",
     "StepSizeWarning", "StepSizeError", "examples", "continue_gait", "Branch", "Bifurcation",
     "ode_function", "OdeFunction", "load", "RecordBuffer",
-    "Contact",
+    "Contact", "Progress",
 ]

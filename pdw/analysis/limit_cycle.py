@@ -76,15 +76,17 @@ from __future__ import annotations
 
 import math
 import os
-from concurrent.futures import ThreadPoolExecutor
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-from ..core import _layout
+from ..core import _layout, interrupt
 from ..core.contact import Contact
 from ..core.errors import FellError, InvalidInputError, SimulationError
 from ..core.integrators import INTEGRATORS, METHODS
 from ..core.params import X0_DISTURBED, X0_PAPER, Params
+from ..core.progress import progress_bar
 from ..sim.simulation import simulate
 from .gait_types import Gait, GaitNotFoundError
 
@@ -247,15 +249,14 @@ def _workers(workers):
     return max(1, int(workers if workers is not None else (os.cpu_count() or 1)))
 
 
-def map_batch(Z, params=None, variant="paper", method="rodas4", *, workers=None, **options):
-    """Steps from every row of Z (N, 6), in ``workers`` threads: list of step dicts."""
+def map_batch(Z, params=None, variant="paper", method="rodas4", *, workers=None,
+              progress=False, **options):
+    """Steps from every row of Z (N, 6), in ``workers`` threads: list of step dicts
+    (``progress``: False, True or a `pdw.Progress`, one unit per row)."""
     Z = np.atleast_2d(np.asarray(Z, dtype=float))
+    bar = progress_bar(progress, len(Z), "step map")
     fn = lambda z: step(z, params, variant, method, **options)   # noqa: E731
-    nw = min(_workers(workers), len(Z))
-    if nw <= 1:
-        return [fn(z) for z in Z]
-    with ThreadPoolExecutor(nw) as ex:
-        return list(ex.map(fn, Z))
+    return interrupt.thread_map(fn, Z, min(_workers(workers), len(Z)), bar)
 
 
 def _compose(z, n, params, variant, method, options):
@@ -279,12 +280,8 @@ def jacobian(z, params=None, variant="paper", method="rodas4", *, fd_step=1e-5, 
     E = np.eye(6) * fd_step
     pts = [z] + [z + e for e in E] + [z - e for e in E]
     fn = lambda zz: _compose(zz, period, params, variant, method, options)  # noqa: E731
-    nw = min(_workers(workers), len(pts))
-    if nw <= 1:
-        outs = [fn(q) for q in pts]
-    else:
-        with ThreadPoolExecutor(nw) as ex:
-            outs = list(ex.map(fn, pts))
+    # Ctrl-C stops every thread at its next poll (pdw.core.interrupt)
+    outs = interrupt.thread_map(fn, pts, min(_workers(workers), len(pts)))
     val = [o[0] if o[0] is not None else np.full(6, np.nan) for o in outs]
     J = np.column_stack([(val[1 + k] - val[7 + k]) / (2 * fd_step) for k in range(6)])
     return J, val[0], outs[0][1]
@@ -399,8 +396,10 @@ def _newton(z, period, params, variant, method, opts, tol, max_iter, fd_step, wo
                       iterations=max_iter)
 
 
-def find_gait(params=None, variant="paper", guess=None, method="rodas4", *, period=1, tol=1e-9,
-              max_iter=20, fd_step=1e-5, settle_time=8.0, workers=None, **options) -> Gait:
+def find_gait(params: Params | None = None, variant: str = "paper",
+              guess: ArrayLike | Gait | None = None, method: str = "rodas4", *, period: int = 1,
+              tol: float = 1e-9, max_iter: int = 20, fd_step: float = 1e-5,
+              settle_time: float = 8.0, workers: int | None = None, **options: Any) -> Gait:
     """The period-``period`` gait of the continuous (compliant-ground) walker by Newton shooting
     on the touch-down Poincaré map (module docstring).
 
@@ -419,6 +418,8 @@ def find_gait(params=None, variant="paper", guess=None, method="rodas4", *, peri
         Solve P^period(z) = z (2 for a period-two gait, ...).
     tol : float
         Newton converges when max|P^n(z) - z| < tol.
+    max_iter : int
+        Newton iterations per guess.
     fd_step : float
         Absolute step of the central-difference Jacobian.
     settle_time : float

@@ -7,8 +7,13 @@ C headers). Time loops release the GIL and are entered once per simulation.
 """
 import numpy as np
 
+from pdw.core import interrupt as _interrupt
+from pdw.core.errors import InvalidInputError
+
 from cpython.exc cimport PyErr_CheckSignals
 from libc.string cimport memset, memcpy
+from cpython.buffer cimport (PyObject_GetBuffer, PyBuffer_Release, PyBUF_C_CONTIGUOUS,
+                            PyBUF_FORMAT)
 
 
 cdef extern from "pdw_model.h":
@@ -474,12 +479,17 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         # caller-owned record arrays (reused between runs: no fresh pages to fault in);
         # an adaptive run that fills them continues in fresh, larger copies
         rec_t, rec_x, rec_flags, rec_contact = buffers
-        if rec_x.shape[1] != nx:
-            raise ValueError("buffers: x must have %d columns for this kernel, got %d"
-                             % (nx, rec_x.shape[1]))
         n_rec_cap = rec_t.shape[0]
         if not record_contact:
             rec_contact = np.zeros((0, PDW_NREC))
+        # every buffer as long as rec_t, checked before a pointer is taken (issue 16)
+        _rows("buffers[1] (x)", rec_x.shape[0], rec_x.shape[1] if rec_x.ndim == 2 else -1,
+              n_rec_cap, nx)
+        _rows("buffers[2] (flags)", rec_flags.shape[0],
+              rec_flags.shape[1] if rec_flags.ndim == 2 else -1, n_rec_cap, 2)
+        if record_contact:
+            _rows("buffers[3] (contact)", rec_contact.shape[0],
+                  rec_contact.shape[1] if rec_contact.ndim == 2 else -1, n_rec_cap, PDW_NREC)
     else:
         rec_t = np.zeros(n_rec_cap)
         rec_x = np.zeros((n_rec_cap, nx))
@@ -521,6 +531,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         if status == PDW_STATUS_POLL:
             try:
                 PyErr_CheckSignals()
+                _interrupt.check()          # a worker thread's task of an interrupted pool
             except KeyboardInterrupt as e:
                 interrupted = e
                 break
@@ -584,104 +595,24 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     }
 
 
-cdef class OdeFunction:
-    """f(t, x) of Eq. A.4 with the discrete state fixed: the model object for external solvers.
+def _real_states(x, bint allow_rows):
+    """x as a C-contiguous float64 array of shape (8,) (or (N, 8) when allow_rows): real
+    numbers only, no strings, complex, booleans or reshaping (`pdw.core.checks.real_array`;
+    finiteness is not checked per call)."""
+    if isinstance(x, (str, bytes)):
+        raise InvalidInputError("x must be an array of numbers, got the string %r" % (x,))
+    try:
+        arr = np.asarray(x)
+    except (TypeError, ValueError):
+        raise InvalidInputError("x must be an array of numbers, got %r" % (x,)) from None
+    if arr.dtype.kind not in "iuf":
+        raise InvalidInputError("x must hold real numbers (not %s)" % arr.dtype)
+    if not (arr.shape == (PDW_NX,) or (allow_rows and arr.ndim == 2 and arr.shape[1] == PDW_NX)):
+        raise InvalidInputError("x must have shape (%d,)%s, got %s"
+                                % (PDW_NX, " or (N, %d)" % PDW_NX if allow_rows else "", arr.shape))
+    return np.ascontiguousarray(arr, dtype=np.float64)
 
-    Built (and validated) by `pdw.ode_function`; every call goes straight to the compiled
-    kernel. ``x`` must be a C-contiguous float64 array of shape (8,) (what ``solve_ivp`` passes);
-    anything else takes a slower converting path. No check of finiteness is made per call.
-    """
-    cdef const pdw_kernel *kern
-    cdef double p[PDW_NP]
-    cdef int _flags[2]
-    cdef double _anchors[PDW_NANCHOR]      # s0_1, s0_2 given; the approach speeds stay 0
-    cdef double work[PDW_NWORK]
 
-    def __cinit__(self, int k, const double[::1] p, int f1, int f2, double a1, double a2):
-        self.kern = _kernel(k)
-        if self.kern.nx != PDW_NX:
-            raise ValueError("OdeFunction takes the kernels of the smooth Coulomb law only")
-        if p.shape[0] != PDW_NP:
-            raise ValueError("p must have %d entries" % PDW_NP)
-        memcpy(self.p, &p[0], PDW_NP * sizeof(double))
-        memset(self._anchors, 0, PDW_NANCHOR * sizeof(double))
-        self._flags[0] = f1
-        self._flags[1] = f2
-        self._anchors[0] = a1
-        self._anchors[1] = a2
+# --- the model object for external solvers (pdw.ode_function) ----------------------------
 
-    def set_discrete(self, int f1, int f2, double a1, double a2):
-        """Replace the support flags and anchors (already validated by the caller)."""
-        self._flags[0] = f1
-        self._flags[1] = f2
-        self._anchors[0] = a1
-        self._anchors[1] = a2
-
-    @property
-    def flags(self):
-        return (self._flags[0], self._flags[1])
-
-    @property
-    def anchors(self):
-        return (self._anchors[0], self._anchors[1])
-
-    def __call__(self, t, x):
-        cdef const double[::1] v
-        cdef double[::1] o
-        try:
-            v = x
-        except (ValueError, TypeError, BufferError):
-            arr = np.ascontiguousarray(x, dtype=np.float64)
-            if arr.ndim == 2:
-                return self.batch(arr)
-            v = arr.ravel()
-        if v.shape[0] != PDW_NX:
-            raise ValueError("x must have shape (8,), got (%d,)" % v.shape[0])
-        out = np.empty(PDW_NX)
-        o = out
-        self.kern.rhs(&v[0], self.p, self._flags, self._anchors, &o[0], self.work)
-        return out
-
-    def checked(self, const double[::1] v):
-        """f at v (8,) if every component is finite, else None (`pdw.rhs`'s fast path)."""
-        cdef Py_ssize_t i
-        cdef double[::1] o
-        if v.shape[0] != PDW_NX:
-            return None
-        for i in range(PDW_NX):
-            if not (v[i] - v[i] == 0.0):
-                return None
-        out = np.empty(PDW_NX)
-        o = out
-        self.kern.rhs(&v[0], self.p, self._flags, self._anchors, &o[0], self.work)
-        return out
-
-    def jac(self, t, x):
-        """df/dx at x, shape (8, 8) (the symbolic Jacobian of the kernel)."""
-        cdef const double[::1] v
-        cdef double[:, ::1] o
-        try:
-            v = x
-        except (ValueError, TypeError, BufferError):
-            v = np.ascontiguousarray(x, dtype=np.float64).ravel()
-        if v.shape[0] != PDW_NX:
-            raise ValueError("x must have shape (8,), got (%d,)" % v.shape[0])
-        out = np.empty((PDW_NX, PDW_NX))
-        o = out
-        self.kern.jacobian(&v[0], self.p, self._flags, self._anchors, &o[0, 0], self.work)
-        return out
-
-    def batch(self, const double[:, ::1] X, double[:, ::1] out=None):
-        """f for each row of X (N, 8) -> (N, 8), one compiled loop (GIL released)."""
-        cdef Py_ssize_t i, n = X.shape[0]
-        if X.shape[1] != PDW_NX:
-            raise ValueError("X must have shape (N, 8), got (%d, %d)" % (n, X.shape[1]))
-        if out is None:
-            out = np.empty((n, PDW_NX))
-        elif out.shape[0] != n or out.shape[1] != PDW_NX:
-            raise ValueError("out must have shape (%d, 8)" % n)
-        cdef double w[PDW_NWORK]
-        with nogil:
-            for i in range(n):
-                self.kern.rhs(&X[i, 0], self.p, self._flags, self._anchors, &out[i, 0], w)
-        return np.asarray(out)
+include "_ode.pxi"

@@ -132,7 +132,11 @@ def features(value, allowed):
     if isinstance(value, str):
         raise InvalidInputError("features must be a collection of names, got the string %r"
                                 % value)
-    unknown = set(value) - set(allowed)
+    try:
+        unknown = set(value) - set(allowed)
+    except TypeError:
+        raise InvalidInputError("features must be a collection of names from %s, got %r"
+                                % (", ".join(allowed), value)) from None
     if unknown:
         raise InvalidInputError("unknown feature(s) %s; allowed: %s"
                                 % (", ".join(sorted(map(str, unknown))), ", ".join(allowed)))

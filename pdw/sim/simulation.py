@@ -3,15 +3,23 @@
 The loop (C, GIL released) carries the support flags, the arming of the scuffing
 guard and the tangential anchors as discrete state, updated once per step (paper
 Fig. 3, docs/model.md sections 5-7). Python is entered once per simulation.
+
+Why this module is long: `simulate` is the one entry point of a run, with about 30
+parameters, each typed, documented (numpydoc, units) and checked here before the compiled
+loop is entered, and `Result` is what it returns; the checks stay next to the documentation
+of what they check.
 """
 from __future__ import annotations
 
 import math
+import os
+import pathlib
 import time
 from dataclasses import dataclass, field
-from typing import NamedTuple
+from typing import TYPE_CHECKING, Iterable, Literal, NamedTuple, Protocol
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..core import _core, _layout, checks
 from ..core import contact as _contact
@@ -29,6 +37,16 @@ from . import io as _io
 from . import stepsize as _stepsize
 from .buffers import RecordBuffer
 from .gait import Steps, steps_from_rows
+
+if TYPE_CHECKING:                       # annotations only: optional dependencies
+    import pandas
+    import xarray
+
+
+class SceneLike(Protocol):
+    """What `simulate` takes in place of ``x0``: a `pdw.Scene` (duck-typed, scene.py is above)."""
+
+    def simulate_kwargs(self) -> dict: ...
 
 _STATUS = {i: s for i, s in enumerate(_layout.STATUS)}
 _REASONS = {
@@ -152,7 +170,8 @@ class Result:
         return self.contact.state_names if self.contact is not None else STATE
 
     def state(self, name: str) -> np.ndarray:
-        """Recorded time series of one state component by name, e.g. ``"thetad1"``."""
+        """Recorded time series of one state component by name (`state_names`), e.g.
+        ``res.state("thetad1")``: ndarray (M,) aligned with ``res.t`` [m, rad, m/s or rad/s]."""
         return self.x[:, self.state_names.index(name)]
 
     def __repr__(self):
@@ -172,19 +191,37 @@ class Result:
             lines.append("  failure: %s at t = %.6g s" % (self.failure["reason"], self.failure["t"]))
         return "\n".join(lines) + ">"
 
-    def to_dataframe(self):
-        """The recorded samples as a pandas DataFrame (`pdw.sim.io.result_to_dataframe`)."""
+    def to_dataframe(self) -> pandas.DataFrame:
+        """The recorded samples as a pandas DataFrame (`pdw.sim.io.result_to_dataframe`; needs
+        pandas): one row per sample, index t [s], columns the state (`pdw.STATE`), the flags,
+        the forces and (if recorded) the energies; units in ``df.attrs["units"]``."""
         return _io.result_to_dataframe(self)
 
-    def to_xarray(self):
-        """The run as an xarray Dataset with units and provenance (`pdw.sim.io`)."""
+    def to_xarray(self) -> xarray.Dataset:
+        """The run as an xarray Dataset (`pdw.sim.io.result_to_xarray`; needs xarray):
+        ``x`` (time x state), ``flags`` and forces (time x leg), units in each variable's
+        ``attrs["units"]``, provenance and settings in ``ds.attrs``."""
         return _io.result_to_xarray(self)
 
-    def save(self, path):
-        """Write to ``path`` (.npz or .nc) with provenance; read back with `pdw.load`."""
+    def save(self, path: str | os.PathLike) -> pathlib.Path:
+        """Write the run with its provenance (pdw version, INPUT_HASH, source revision,
+        settings, scene, time); `pdw.load` reads it back.
+
+        Parameters
+        ----------
+        path : str or path-like
+            ``.npz`` (NumPy, compressed, metadata as JSON) or ``.nc`` (NetCDF through xarray).
+
+        Returns
+        -------
+        pathlib.Path
+            The file written.
+        """
         return _io.save(self, path)
 
     def summary(self) -> str:
+        """One line: method, status, steps and step size, end time, events, gait steps (and the
+        stop condition that ended the run)."""
         n_ev = sum(self.event_counts.values()) if self.event_counts else len(self.events)
         s = "%s: %s, %d steps of %.3g s to t = %.4f s, %d events, %d gait steps" % (
             self.method, self.status, self.n_steps, self.dt, self.t_final, n_ev, self.n_gait_steps)
@@ -215,13 +252,20 @@ _DEFAULTS = dict(t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
                  contact=None, approach_speeds0=None)
 
 
-def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
-             flags0=(0, 1), record_every=1, record_forces=True, on_failure="raise",
-             fall_hip_height=None, fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8,
-             h_max=None, event_tol=1e-9, *, features=None, record_events=True,
-             record_energies=False, stop_steps=0, periodic_steps=0, periodic_tol=1e-3,
-             check_step="warn", t_eval=None, dense_output=False, out=None, max_steps=None,
-             contact=None, approach_speeds0=None):
+def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float = 1e-4,
+             params: Params | None = None, variant: Literal["paper", "consistent"] = "paper",
+             method: str = "cdm", flags0: tuple[int, int] = (0, 1), record_every: int = 1,
+             record_forces: bool = True, on_failure: Literal["raise", "return"] = "raise",
+             fall_hip_height: float | None = None, fall_depth: float | None = None,
+             max_speed: float = 1e3, rtol: float = 1e-6, atol: float = 1e-8,
+             h_max: float | None = None, event_tol: float = 1e-9, *,
+             features: Iterable[str] | None = None, record_events: bool = True,
+             record_energies: bool = False, stop_steps: int = 0, periodic_steps: int = 0,
+             periodic_tol: float = 1e-3, check_step: Literal["warn", "error", "off"] = "warn",
+             t_eval: ArrayLike | None = None, dense_output: bool = False,
+             out: RecordBuffer | None = None, max_steps: int | None = None,
+             contact: _contact.Contact | dict | str | None = None,
+             approach_speeds0: tuple[float, float] | None = None) -> Result:
     """Simulate the walker from ``x0`` for ``t_end`` seconds (or run a `pdw.Scene`).
 
     ``simulate(scene)`` runs the scene (as `pdw.run`); no other argument may be given then.
@@ -302,6 +346,10 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
         Record into these reusable arrays (`pdw.sim.buffers.RecordBuffer`) instead of fresh
         ones: no page faults on a repeated run. The Result's t, x, flags, Fn, Ft are then views
         into ``out``, overwritten by the next run that uses it.
+    max_steps : int, optional
+        Budget of integration steps of the adaptive methods (default 10^6 + 2 10^6 t_end/s);
+        a run that uses it up stops early, saying so. Fixed-step methods take t_end/dt steps
+        and refuse a budget below that.
     contact : pdw.Contact, dict or str, optional
         Normal and friction contact laws and their parameters (`pdw.Contact`,
         docs/contact_laws.md); default the paper's Hunt-Crossley and smooth Coulomb laws.
@@ -410,11 +458,11 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     wall = time.perf_counter() - start
     energies = None
     if record_energies and raw["interrupted"] is None:
-        e = np.empty((len(raw["x"]), len(_layout.ENERGY)))
-        if len(e):
-            _core.energies_batch(k, np.ascontiguousarray(raw["x"]), p, e)
-        energies = {name: e[:, i] for i, name in enumerate(_layout.ENERGY)}
-        energies["E"] = e.sum(axis=1)
+        en = np.empty((len(raw["x"]), len(_layout.ENERGY)))
+        if len(en):
+            _core.energies_batch(k, np.ascontiguousarray(raw["x"]), p, en)
+        energies = {name: en[:, i] for i, name in enumerate(_layout.ENERGY)}
+        energies["E"] = en.sum(axis=1)
     res = _result(raw, params, variant, method, dt, t_end, wall, on_failure, feats,
                   bool(record_events), energies, x)
     res.contact = contact

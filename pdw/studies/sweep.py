@@ -50,7 +50,7 @@ import numpy as np
 
 from ..core.errors import InvalidInputError, PdwError
 from ..core.params import Params
-from ..core.progress import Progress  # noqa: F401 (pdw.sweep.Progress)
+from ..core.progress import Progress, progress_bar  # noqa: F401 (pdw.sweep.Progress)
 from ..core.provenance import source_revision
 from .study import COLUMNS, Study, check_name, load_study, parse_study, settings_hash  # noqa: F401 (pdw.sweep.parse_study)
 
@@ -336,8 +336,8 @@ def run_study(study, out=None, *, executor=None, workers=None, backend="thread",
     resume : bool
         Keep the points already in the CSV and compute only the others (default). False
         starts afresh (the CSV is overwritten).
-    progress : bool
-        Progress bar on stderr.
+    progress : bool or pdw.Progress
+        Progress bar over points on stderr when it is a terminal (`pdw.core.progress.progress_bar`).
     figures : callable, optional
         ``figures(study, rows, path) -> path`` draws the study's figure into ``path``
         (``<name>.png``); `pdw.present.study_plots.plot_study` is the standard one (``pdw sweep``
@@ -380,7 +380,7 @@ def _run_locked(study, out, executor, workers, backend, resume, progress, figure
         exec_desc = "%s.%s" % (type(executor).__module__, type(executor).__qualname__)
     else:
         exec_desc = "serial"
-    bar = Progress(len(points), len(done), label=study.name, enabled=progress)
+    bar = progress_bar(progress, len(points), study.name, done=len(done))
     computed = []
     error = None
     with open(csv_path, "a", newline="") as f:
