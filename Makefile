@@ -67,6 +67,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_integrators.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_scenes.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_batch.py $(UPDATE_DOCS)
+	$(PY) benchmarks/bench_sweep_batch.py $(UPDATE_DOCS)
 	$(PY) benchmarks/work_precision.py $(UPDATE_DOCS)
 
 ## study: slow studies (marked slow in tests/), written to out/ (UPDATE_DOCS as for bench)
@@ -74,6 +75,7 @@ study: $(STAMP)
 	PDW_UPDATE_DOCS=$(if $(UPDATE_DOCS),1,0) $(PY) -m pytest -q -m slow
 	$(PY) benchmarks/stability_maps.py $(UPDATE_DOCS)
 	$(PY) benchmarks/step_edge_grid.py $(UPDATE_DOCS)
+	$(PY) benchmarks/basin_study.py 400 200 $(UPDATE_DOCS)
 
 ## sanitize: the compiled core built with AddressSanitizer + UndefinedBehaviorSanitizer (in
 ## build/sanitize, the normal build untouched), and the tests of the compiled boundary, the loops
@@ -82,7 +84,10 @@ SAN_DIR   := build/sanitize
 SAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined -g
 SAN_TESTS ?= tests/test_hardening_boundary.py tests/test_hardening_status.py \
              tests/test_hardening_input.py tests/test_hardening_fuzz.py tests/test_simulation.py \
-             tests/test_hybrid.py tests/test_integrators.py tests/test_features.py
+             tests/test_hybrid.py tests/test_integrators.py tests/test_features.py \
+             tests/test_hardening_entry.py tests/test_hardening_interrupt.py tests/test_batch.py \
+             tests/test_contact_laws.py tests/test_ode_function.py tests/test_export.py \
+             tests/test_dense_output.py
 sanitize: $(STAMP)
 	rm -rf $(SAN_DIR) && mkdir -p $(SAN_DIR)
 	PDW_DEBUG=1 PDW_CFLAGS="$(SAN_FLAGS)" LDFLAGS="-fsanitize=address,undefined" \

@@ -15,8 +15,9 @@ lane evaluates the force law and keeps it only where its foot is one (``on ? for
 
 The functions are ``static``: the header is included by each instruction-set variant of the
 lane loop (pdw/core/csrc/pdw_batch_soa.inc), compiled once per target (run-time dispatch,
-docs/ensemble.md). Kernels with a normal law other than Hunt-Crossley have no batched stages
-(NULL in the table): the lane loop then runs them through the scalar stages.
+docs/ensemble.md). Kernels with a normal law other than Hunt-Crossley or a friction law other
+than the smooth Coulomb one have no batched stages (NULL in the table): the lane loop then runs
+them through the scalar stages (or the batch refuses them).
 
 Deterministic, stamped with `derive.emit.input_hash` like the other generated files.
 """
@@ -151,7 +152,7 @@ def header(banner, h, kernels, names_of, c_block, nforces):
     """The text of generated/pdw_batch_gen.h."""
     body, rows = [], []
     for spec in kernels:
-        if spec.normal != "hunt_crossley":
+        if spec.normal != "hunt_crossley" or getattr(spec, "friction", "coulomb") != "coulomb":
             rows.append("    {NULL, NULL, NULL},   /* %s */" % spec.name)
             continue
         body.append(emit_kernel(spec, names_of(spec), c_block, nforces))

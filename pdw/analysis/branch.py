@@ -68,6 +68,8 @@ class Bifurcation:
                                                         self.reason)
 
     def as_dict(self) -> dict:
+        """JSON-able fields: kind, value, tolerance, index, reason, z (or None), and the
+        multipliers as ``multipliers_re`` and ``multipliers_im`` lists."""
         m = [] if self.multipliers is None else np.asarray(self.multipliers)
         return {"kind": self.kind, "value": self.value, "tolerance": self.tolerance,
                 "index": self.index, "reason": self.reason,

@@ -10,9 +10,9 @@ rows of an (N, 8) array in one compiled loop. The discrete state of MODEL.md sec
 """
 from __future__ import annotations
 
-import math
+from typing import Iterable
 
-from . import _core, _layout
+from . import _core, _layout, checks
 from .errors import InvalidInputError
 from .model import check_variant, kernel_index, parameter_vector
 from .params import Params
@@ -21,18 +21,10 @@ OdeFunction = _core.OdeFunction
 
 
 def _check_discrete(flags, anchors):
-    try:
-        f = tuple(flags)
-        a = tuple(float(v) for v in anchors)
-    except (TypeError, ValueError):
-        raise InvalidInputError("flags must be two values in {0, 1} and anchors two finite "
-                                "numbers [m], got %r, %r" % (flags, anchors)) from None
-    if len(f) != 2 or any(isinstance(v, bool) or v not in (0, 1) for v in f):
-        raise InvalidInputError("flags must be two values in {0, 1} (1 support, 0 swing), "
-                                "got %r" % (flags,))
-    if len(a) != 2 or not all(math.isfinite(v) for v in a):
-        raise InvalidInputError("anchors must be two finite numbers [m], got %r" % (anchors,))
-    return (int(f[0]), int(f[1])), a
+    """Flags: two integers in {0, 1}; anchors: two finite real numbers [m] (`checks`)."""
+    f = checks.flags("flags", flags)
+    a = checks.real_array("anchors", anchors, [(2,)])
+    return f, (float(a[0]), float(a[1]))
 
 
 def _check_features(features):
@@ -41,7 +33,11 @@ def _check_features(features):
     if isinstance(features, str):
         raise InvalidInputError("features must be a collection of names, got the string %r"
                                 % features)
-    unknown = set(features) - set(_layout.FEATURES)
+    try:
+        unknown = set(features) - set(_layout.FEATURES)
+    except TypeError:
+        raise InvalidInputError("features must be a collection of names from %s, got %r"
+                                % (", ".join(_layout.FEATURES), features)) from None
     if unknown:
         raise InvalidInputError("unknown feature(s) %s; allowed: %s"
                                 % (", ".join(sorted(map(str, unknown))),
@@ -50,7 +46,8 @@ def _check_features(features):
 
 
 def ode_function(params: Params | None = None, variant: str = "paper",
-                 flags=(0, 1), anchors=(0.0, 0.0), features=None) -> OdeFunction:
+                 flags: tuple[int, int] = (0, 1), anchors: tuple[float, float] = (0.0, 0.0),
+                 features: Iterable[str] | None = None) -> OdeFunction:
     """The right-hand side f(t, x) of Eq. A.4 as a fast callable for external solvers.
 
     Parameters
@@ -71,14 +68,19 @@ def ode_function(params: Params | None = None, variant: str = "paper",
     -------
     OdeFunction
         ``f(t, x)`` -> ndarray (8,) for a float64 state x of shape (8,) [m, rad, m/s, rad/s]
-        (t is ignored: the model is autonomous); ``f.jac(t, x)`` -> (8, 8);
+        (t is ignored: the model is autonomous); ``f.jac(t, x)`` -> (8, 8). Both return a
+        fresh array every call (a copy of an internal buffer): keeping it is safe, as
+        ``solve_ivp`` does;
         ``f.batch(X, out=None)`` -> (N, 8) for X of shape (N, 8); ``f.set_discrete(f1, f2,
         a1, a2)`` changes the flags and anchors (unchecked: use `ode_function` to validate).
 
     Notes
     -----
-    Inputs are validated here, once; a call does no checking beyond the shape of x (a
-    non-finite state gives a non-finite derivative). ``solve_ivp(f, (0, T), x0,
+    Inputs are validated here, once; a call checks only that x is a C-contiguous float64
+    array of shape (8,) (its raw buffer is then read in place: about 0.5 us over the kernel,
+    docs/benchmarks.md) and converts anything else (a list, another dtype, a strided view);
+    a wrong shape is `pdw.InvalidInputError` naming x. A non-finite state gives a non-finite
+    derivative. ``solve_ivp(f, (0, T), x0,
     method="Radau", jac=f.jac)`` integrates one stretch of constant support flags; see
     docs/benchmarks.md for the cost per call (benchmarks/bench_io.py).
 

@@ -13,22 +13,22 @@ from __future__ import annotations
 
 import math
 import os
-from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core import _batch, _layout
+from ..core import _batch, _layout, checks, interrupt
 from ..core.errors import InvalidInputError
 from ..core.integrators import METHODS
 from ..core.integrators import get as _method_info
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
 from ..core.params import Params
 from . import stepsize as _stepsize
+from .chunks import honest, record_subset, run_chunked
 from .gait import Steps, steps_from_rows
 from .simulation import _REASONS, _check_count, _check_positive
 
-_STATUS = {0: "running", 1: "walked", 2: "fell", 3: "diverged", 5: "diverged", 6: "periodic"}
+_STATUS = {0: "interrupted", 1: "walked", 2: "fell", 3: "diverged", 5: "diverged", 6: "periodic"}
 _STOP = {0: "t_end", 1: "steps", 2: "periodic"}
 LANES = 8
 """Default lanes per block (walkers advanced in lockstep by one thread)."""
@@ -82,6 +82,10 @@ class BatchResult:
         `pdw.core._layout.STEP`, legs 0/1), NaN beyond; `steps(i)` gives them as `Steps`.
     dt, t_end : float
         Step and end time [s]; ``method``, ``variant``: as given.
+    recorded : dict
+        ``{i: Result}`` for the walkers listed in ``record`` (`simulate_batch`), else empty.
+    engine : str
+        ``"batch"`` (the compiled lanes) or ``"scalar"`` (`pdw.sim.ensemble.scalar_batch`).
     """
 
     status: np.ndarray
@@ -102,6 +106,8 @@ class BatchResult:
     t_end: float
     method: str
     variant: str
+    recorded: dict = field(default_factory=dict)
+    engine: str = "batch"
 
     def __len__(self) -> int:
         return len(self.status)
@@ -138,41 +144,44 @@ class BatchResult:
 
 
 def _rows(x0):
-    try:
-        x = np.array(x0, dtype=float, order="C")
-    except (TypeError, ValueError):
-        raise InvalidInputError("x0 must be an (N, 8) array of numbers") from None
-    if x.ndim != 2 or x.shape[1] != len(STATE):
-        raise InvalidInputError("x0 must have shape (N, 8) (columns %s), got %s"
-                                % (STATE, np.shape(x0)))
-    bad = ~np.isfinite(x)
-    if bad.any():
-        r, c = np.argwhere(bad)[0]
+    """x0 as a C-contiguous float (N, 8) array: real numbers only (no strings, complex or
+    booleans), finite (`pdw.core.checks.real_array`)."""
+    x = np.asarray(x0) if not isinstance(x0, (str, bytes)) else x0
+    if isinstance(x, np.ndarray) and x.dtype.kind in "iuf" and x.ndim == 2 \
+            and x.shape[1] == len(STATE) and not np.isfinite(x).all():
+        r, c = np.argwhere(~np.isfinite(x))[0]
         raise InvalidInputError("x0 row %d, column %d (%s) must be finite, got %r"
                                 % (r, c, STATE[c], x[r, c]))
-    return x
+    return checks.real_array("x0", x0, [(-1, len(STATE))], STATE)
 
 
 def _flags(flags0, n):
-    f = np.array(flags0, dtype=np.intc)
-    if f.shape == (2,):
-        f = np.tile(f, (n, 1))
-    if f.shape != (n, 2):
-        raise InvalidInputError("flags0 must be (2,) or (N, 2) = (%d, 2), got %s"
-                                % (n, np.shape(flags0)))
-    bad = (f != 0) & (f != 1)
-    if bad.any():
-        r = np.argwhere(bad)[0][0]
-        raise InvalidInputError("flags0 row %d must be two values in {0, 1}, got %r"
-                                % (r, tuple(f[r])))
-    return np.ascontiguousarray(f)
+    """(N, 2) intc flags from a pair or an (N, 2) array of integers in {0, 1} (no 0.9, no
+    strings: `pdw.core.checks.flags`)."""
+    try:
+        rows = not isinstance(flags0, (str, bytes)) and np.shape(flags0) == (n, 2)
+    except ValueError:                        # a ragged sequence
+        rows = False
+    f = None if rows else checks.flags("flags0", flags0, n)
+    if f is None:                             # name the first bad row
+        for r, row in enumerate(np.asarray(flags0)):
+            try:
+                checks.flags("flags0 row %d" % r, row)
+            except InvalidInputError as e:
+                raise InvalidInputError("%s (flags0 must be (2,) or (N, 2) = (%d, 2))"
+                                        % (e, n)) from None
+        f = checks.flags("flags0", flags0, n)
+    if isinstance(f, tuple):
+        f = np.tile(np.array(f, dtype=np.intc), (n, 1))
+    return np.ascontiguousarray(f, dtype=np.intc)
 
 
 def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
                    flags0=(0, 1), threads=None, lanes=LANES, vector=False, stop_steps=0,
                    periodic_steps=0, periodic_tol=1e-3, fall_hip_height=None, fall_depth=None,
                    max_speed=1e3, check_step="warn", rtol=1e-6, atol=1e-8, h_max=None,
-                   event_tol=1e-9, max_steps=None) -> BatchResult:
+                   event_tol=1e-9, max_steps=None, *, executor=None, chunk_size=None,
+                   record=None, record_every=1) -> BatchResult:
     """Simulate N walkers at once: the result of `pdw.simulate` for each, without recording.
 
     Parameters
@@ -204,16 +213,53 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
         not to 1e-12 (docs/ensemble.md).
     stop_steps, periodic_steps, periodic_tol, fall_hip_height, fall_depth, max_speed, check_step
     rtol, atol, h_max, event_tol, max_steps
-        As `simulate` (adaptive methods; max_steps is the budget of each walker); fall_hip_height and fall_depth default to 0.5 l and 0.25 l of each
-        walker's parameters. A divergence is a status here (``"diverged"``), never an error.
+        As `simulate` (adaptive methods; max_steps is the budget of each walker).
+        As `simulate`; fall_hip_height and fall_depth default to 0.5 l and 0.25 l of each
+        walker's parameters. A divergence is a status here (``"diverged"``), never an error;
+        the end-of-run checks of `simulate` (runaway, ``"no_steps"``) are applied to the final
+        states (`pdw.sim.chunks.honest`).
+    executor : concurrent.futures.Executor-like, optional
+        Cut the batch into chunks of ``chunk_size`` consecutive walkers, each one task
+        ``executor.submit`` (a thread or process pool, Dask's ``client.get_executor()``), the
+        results put back in order: bitwise the unchunked batch. Each chunk runs ``threads``
+        threads (give ``threads=1`` with a pool of one worker per core).
+    chunk_size : int, optional
+        Walkers per chunk (default: N / 8 with an executor); without an executor the chunks
+        run one after the other in this thread.
+    record : sequence of int, optional
+        Walkers whose trajectories are wanted: they are run again through the **scalar**
+        `pdw.simulate` in this call (the compiled lane loop records nothing), with
+        ``record_every`` and the same inputs (forces and events recorded,
+        ``on_failure="return"``), and returned in ``BatchResult.recorded`` as `Result`s. On the
+        bitwise path (``vector=False``) those runs are the lanes' arithmetic: same ``x_final``.
+    record_every : int
+        Sampling of the recorded walkers (every k-th step, >= 1).
 
     Returns
     -------
     BatchResult
         Per-walker arrays (status, x_final, t_final, failure, event counts, last gait steps).
+
+    Raises
+    ------
+    KeyboardInterrupt
+        On Ctrl-C, within a second (the lane loops poll every 512 lockstep steps, in every
+        thread): ``.result`` is the partial `BatchResult`, whose unfinished walkers have status
+        ``"interrupted"`` and their state when stopped (or at t = 0 if never started).
     """
     x = _rows(x0)
     n = len(x)
+    if executor is not None or chunk_size is not None:
+        kw = dict(x0=x, t_end=t_end, dt=dt, params=params, variant=variant, method=method,
+                  flags0=flags0, threads=threads, lanes=lanes, vector=vector,
+                  stop_steps=stop_steps, periodic_steps=periodic_steps,
+                  periodic_tol=periodic_tol, fall_hip_height=fall_hip_height,
+                  fall_depth=fall_depth, max_speed=max_speed, check_step=check_step,
+                  rtol=rtol, atol=atol, h_max=h_max, event_tol=event_tol, max_steps=max_steps,
+                  record=record, record_every=record_every)
+        if chunk_size is None:
+            chunk_size = max(1, math.ceil(n / 8))
+        return run_chunked(simulate_batch, kw, executor, chunk_size)
     t_end = _check_positive("t_end", t_end)
     dt = _check_positive("dt", dt)
     if dt > t_end:
@@ -241,7 +287,16 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
     if params is None or isinstance(params, Params):
         plist = [Params.paper() if params is None else params]
     else:
-        plist = list(params)
+        if isinstance(params, (str, bytes, dict)):
+            plist = None
+        else:
+            try:
+                plist = list(params)
+            except TypeError:
+                plist = None
+        if plist is None:
+            raise InvalidInputError("params must be a pdw.Params or a sequence of N = %d Params, "
+                                    "got %r" % (n, params))
         if len(plist) != n:
             raise InvalidInputError("params must be one Params or a sequence of N = %d, got %d"
                                     % (n, len(plist)))
@@ -250,7 +305,9 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
             raise InvalidInputError("params row %d must be a pdw.Params, got %s"
                                     % (i, type(p).__name__))
     f0 = _flags(flags0, n)
-    n_steps = int(round(t_end / dt))
+    n_steps = checks.count("t_end / dt", round(t_end / dt))
+    if not isinstance(vector, (bool, np.bool_)):
+        raise InvalidInputError("vector must be True or False, got %r" % (vector,))
     stop_steps = _check_count("stop_steps", stop_steps)
     periodic_steps = _check_count("periodic_steps", periodic_steps)
     if periodic_steps == 1 or periodic_steps > _layout.STEP_RING:
@@ -272,7 +329,8 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
             _stepsize.check_step(dt, p, method, variant, check_step)
     pvec = np.ascontiguousarray([parameter_vector(p) for p in plist])
     ls = np.array([p.l for p in plist], dtype=float)
-    hip = np.broadcast_to(0.5 * ls if fall_hip_height is None else float(fall_hip_height), (n,))
+    hip = np.broadcast_to(0.5 * ls if fall_hip_height is None
+                          else checks.number("fall_hip_height", fall_hip_height), (n,))
     depth = np.broadcast_to(0.25 * ls if fall_depth is None
                             else _check_positive("fall_depth", fall_depth), (n,))
     hip = np.ascontiguousarray(hip, dtype=float)
@@ -288,13 +346,30 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
         chunks = _chunks(n, threads, lanes)
         args = (k, x, pvec, f0, hip, depth, dt, n_steps, max_speed, stop_steps, periodic_steps,
                 periodic_tol, out)
-        if len(chunks) == 1:
-            _batch.run_range(*args, chunks[0][0], chunks[0][1], lanes, bool(vector), **opts)
-        else:
-            with ThreadPoolExecutor(min(threads, len(chunks))) as ex:
-                list(ex.map(lambda c: _batch.run_range(*args, c[0], c[1], lanes, bool(vector),
-                                                       **opts), chunks))
-    return _result(out, dt, t_stop, method, variant)
+        try:
+            interrupt.thread_map(lambda c: _batch.run_range(*args, c[0], c[1], lanes,
+                                                            bool(vector), **opts),
+                                 chunks, threads)
+        except KeyboardInterrupt as e:
+            # Ctrl-C: the walkers finished so far, the running ones as they are, the others at
+            # their start; every unfinished one "interrupted"
+            unstarted = np.isnan(out["t_final"])
+            out["x_final"][unstarted] = x[unstarted]
+            out["t_final"][unstarted] = 0.0
+            e.result = _result(out, dt, t_stop, method, variant)
+            raise
+    res = _result(out, dt, t_stop, method, variant)
+    honest(res, x, plist if len(plist) == n else plist[0])
+    if record is not None:
+        res.recorded = record_subset(
+            res, record, record_every, x, plist if len(plist) == n else plist[0], f0,
+            dict(t_end=t_end, dt=dt, variant=variant, method=method, stop_steps=stop_steps,
+                 periodic_steps=periodic_steps, periodic_tol=periodic_tol,
+                 fall_hip_height=fall_hip_height, fall_depth=fall_depth, max_speed=max_speed,
+                 check_step=check_step, rtol=rtol, atol=atol,
+                 h_max=None if h_max == 0.0 else h_max, event_tol=event_tol,
+                 max_steps=max_steps))
+    return res
 
 
 def _chunks(n, threads, lanes):
@@ -309,7 +384,7 @@ def _outputs(n):
     ring, nstep = _layout.STEP_RING, len(_layout.STEP)
     return {"status": np.zeros(n, np.intc), "stop_reason": np.zeros(n, np.intc),
             "flags_final": np.zeros((n, 2), np.intc), "x_final": np.zeros((n, len(STATE))),
-            "t_final": np.zeros(n), "n_steps": np.zeros(n, np.int_),
+            "t_final": np.full(n, np.nan), "n_steps": np.zeros(n, np.int_),
             "n_gait_steps": np.zeros(n, np.int_), "n_touch_down": np.zeros(n, np.int_),
             "n_lift_off": np.zeros(n, np.int_), "gait": np.zeros((n, ring, nstep)),
             "fail_reason": np.zeros(n, np.intc), "fail_leg": np.zeros(n, np.intc),
@@ -318,7 +393,7 @@ def _outputs(n):
 
 def _result(out, dt, t_end, method, variant):
     status = np.array([_STATUS[s] for s in out["status"]], dtype=object)
-    stop = np.array([_STOP[r] if r else (s if s in ("fell", "diverged") else "t_end")
+    stop = np.array([_STOP[r] if r else (s if s in ("fell", "diverged", "interrupted") else "t_end")
                      for r, s in zip(out["stop_reason"], status)], dtype=object)
     return BatchResult(
         status=status, stop_reason=stop, x_final=out["x_final"], t_final=out["t_final"],

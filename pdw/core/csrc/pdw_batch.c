@@ -19,7 +19,7 @@ static void finish(const pdw_batch_job *job, long i, const pdw_sim *s)
     job->stop_reason[i] = s->stop_reason;
     job->flags_final[2*i] = s->disc.flags[0];
     job->flags_final[2*i + 1] = s->disc.flags[1];
-    memcpy(job->x_final + i*PDW_NX, s->x, sizeof s->x);
+    memcpy(job->x_final + i*PDW_NX, s->x, PDW_NX * sizeof(double));
     job->t_final[i] = s->t;
     job->n_taken[i] = s->n;
     job->n_gait[i] = s->gait.n_steps;
@@ -48,6 +48,7 @@ static int start(const pdw_batch_job *job, long i, pdw_sim *s)
     int flags0[2];
     memset(s, 0, sizeof *s);
     s->kernel = job->kernel;
+    s->nx = PDW_NX;             /* the smooth Coulomb law only (_batch.pyx checks) */
     memcpy(s->p, job->p + i*job->p_stride, PDW_NP * sizeof(double));
     s->dt = dt;
     s->n_steps = job->n_steps;
@@ -59,7 +60,7 @@ static int start(const pdw_batch_job *job, long i, pdw_sim *s)
     s->periodic_k = job->periodic_k;
     s->periodic_tol = job->periodic_tol;
     pdw_gait_init(&s->gait);
-    memcpy(s->x, job->x0 + i*PDW_NX, sizeof s->x);
+    memcpy(s->x, job->x0 + i*PDW_NX, PDW_NX * sizeof(double));
     flags0[0] = job->flags0[2*i];
     flags0[1] = job->flags0[2*i + 1];
     pdw_discrete_init(s->kernel, s->p, s->x, flags0, &s->disc, s->work);
@@ -96,6 +97,7 @@ long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *l
     long walker[PDW_BATCH_MAXW], next = i0;
     double a[2*PDW_BATCH_MAXW], sn[2*PDW_BATCH_MAXW], cs[2*PDW_BATCH_MAXW];
     int running = 0;
+    long since_poll = 0, done = 0;
     if (W < 1) W = 1;
     if (W > PDW_BATCH_MAXW) W = PDW_BATCH_MAXW;
     /* fill every lane (a walker that finishes at its start-up is written out at once) */
@@ -105,9 +107,18 @@ long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *l
             const long i = next++;
             if (start(job, i, &lanes[l])) { walker[l] = i; running++; break; }
             finish(job, i, &lanes[l]);
+            done++;
         }
     }
     while (running > 0) {
+        if (job->poll && ++since_poll >= PDW_BATCH_POLL) {
+            since_poll = 0;
+            if (job->poll(job->poll_ctx)) {      /* stopped: write the running walkers as they are */
+                for (int l = 0; l < W; ++l)
+                    if (walker[l] >= 0) finish(job, walker[l], &lanes[l]);
+                return done;
+            }
+        }
         /* (1) trig of every lane past its first step (at n = 0 the start-up left it in work) */
         if (vector) {
             for (int l = 0; l < W; ++l) {
@@ -134,14 +145,16 @@ long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *l
             finish(job, walker[l], &lanes[l]);
             walker[l] = -1;
             running--;
+            done++;
             while (next < i1) {
                 const long i = next++;
                 if (start(job, i, &lanes[l])) { walker[l] = i; running++; break; }
                 finish(job, i, &lanes[l]);
+                done++;
             }
         }
     }
-    return i1 - i0;
+    return done;
 }
 
 /* Load walker i into lane s with the settings pdw/core/_core.pyx's run gives pdw.simulate's
@@ -152,6 +165,7 @@ static void start_method(const pdw_batch_job *job, long i, pdw_sim *s)
     const pdw_method *m = &pdw_methods[job->method];
     memset(s, 0, sizeof *s);
     s->kernel = job->kernel;
+    s->nx = PDW_NX;             /* the smooth Coulomb law only (_batch.pyx checks) */
     memcpy(s->p, job->p + i*job->p_stride, PDW_NP * sizeof(double));
     s->t_end = job->t_end;
     s->rtol = job->rtol;
@@ -172,10 +186,23 @@ static void start_method(const pdw_batch_job *job, long i, pdw_sim *s)
     s->periodic_k = job->periodic_k;
     s->periodic_tol = job->periodic_tol;
     pdw_gait_init(&s->gait);
-    memcpy(s->x, job->x0 + i*PDW_NX, sizeof s->x);
+    memcpy(s->x, job->x0 + i*PDW_NX, PDW_NX * sizeof(double));
     flags0[0] = job->flags0[2*i];
     flags0[1] = job->flags0[2*i + 1];
     pdw_discrete_init(s->kernel, s->p, s->x, flags0, &s->disc, s->work);
+}
+
+/* Every PDW_BATCH_POLL rounds: job->poll; if it says stop, write the running walkers as they
+ * are (status running) and return 1. */
+static int poll_stop(const pdw_batch_job *job, long *since_poll, const long *walker, int W,
+                     const pdw_sim *lanes)
+{
+    if (!job->poll || ++*since_poll < PDW_BATCH_POLL) return 0;
+    *since_poll = 0;
+    if (!job->poll(job->poll_ctx)) return 0;
+    for (int l = 0; l < W; ++l)
+        if (walker[l] >= 0) finish(job, walker[l], &lanes[l]);
+    return 1;
 }
 
 long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes)
@@ -183,6 +210,7 @@ long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim
     long walker[PDW_BATCH_MAXW], next = i0;
     const pdw_advance_fn advance = pdw_methods[job->method].advance;
     int running = 0;
+    long since_poll = 0, done = 0;
     if (W < 1) W = 1;
     if (W > PDW_BATCH_MAXW) W = PDW_BATCH_MAXW;
     for (int l = 0; l < W; ++l) {
@@ -190,6 +218,12 @@ long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim
         if (next < i1) { walker[l] = next; start_method(job, next++, &lanes[l]); running++; }
     }
     while (running > 0) {
+        if (poll_stop(job, &since_poll, walker, W, lanes)) {
+            /* a lane stopped inside its round holds the state of its last accepted step */
+            for (int l = 0; l < W; ++l)
+                if (walker[l] >= 0) job->status[walker[l]] = PDW_STATUS_RUNNING;
+            return done;
+        }
         for (int l = 0; l < W; ++l) {
             if (walker[l] < 0) continue;
             /* nothing recorded and events not stored: RECORDS_FULL and EVENTS_FULL cannot
@@ -198,10 +232,11 @@ long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim
             finish(job, walker[l], &lanes[l]);
             walker[l] = -1;
             running--;
+            done++;
             if (next < i1) { walker[l] = next; start_method(job, next++, &lanes[l]); running++; }
         }
     }
-    return i1 - i0;
+    return done;
 }
 
 /* ---- the structure-of-arrays lane loop ------------------------------------------------ */
@@ -273,12 +308,13 @@ static int soa_start(const pdw_batch_job *job, long i, pdw_sim *s, pdw_soa_state
 
 /* Fill lane l with the next walker of [next, i1) that does not finish at its start. */
 static long soa_refill(const pdw_batch_job *job, long *next, long i1, pdw_sim *s,
-                       pdw_soa_state *S, int l)
+                       pdw_soa_state *S, int l, long *done)
 {
     while (*next < i1) {
         const long i = (*next)++;
         if (soa_start(job, i, s, S, l)) return i;
         finish(job, i, s);
+        ++*done;
     }
     return -1;
 }
@@ -296,11 +332,12 @@ long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_si
         return pdw_batch_cdm(job, i0, i1, W, lanes, vector);
     long walker[PDW_BATCH_MAXW], next = i0;
     int running = 0;
+    long since_poll = 0, done = 0;
     if (W < 1) W = 1;
     if (W > PDW_BATCH_MAXW) W = PDW_BATCH_MAXW;
     memset(S, 0, sizeof *S);
     for (int l = 0; l < W; ++l) {
-        walker[l] = soa_refill(job, &next, i1, &lanes[l], S, l);
+        walker[l] = soa_refill(job, &next, i1, &lanes[l], S, l, &done);
         if (walker[l] >= 0) running++;
     }
     /* lanes without a walker and the padding lanes up to a multiple of 8 (computed, never
@@ -314,6 +351,17 @@ long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_si
         soa_load(S, l, &lanes[0]);
     }
     while (running > 0) {
+        if (job->poll && ++since_poll >= PDW_BATCH_POLL) {
+            since_poll = 0;
+            if (job->poll(job->poll_ctx)) {   /* stopped: the running walkers as they are */
+                for (int l = 0; l < W; ++l) {
+                    if (walker[l] < 0) continue;
+                    soa_store(S, l, &lanes[l]);
+                    finish(job, walker[l], &lanes[l]);
+                }
+                return done;
+            }
+        }
         stepfn((int)kid, S, W, job->dt, job->max_speed, vector);
         for (int l = 0; l < W; ++l) {
             if (walker[l] < 0) continue;
@@ -342,9 +390,10 @@ long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_si
             if (more) continue;
             finish(job, walker[l], s);
             running--;
-            walker[l] = soa_refill(job, &next, i1, s, S, l);
+            done++;
+            walker[l] = soa_refill(job, &next, i1, s, S, l, &done);
             if (walker[l] >= 0) running++;
         }
     }
-    return i1 - i0;
+    return done;
 }

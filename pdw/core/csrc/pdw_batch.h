@@ -52,7 +52,13 @@ typedef struct pdw_batch_job {
     int *fail_reason, *fail_leg;/* (n,) PDW_REASON_*, leg (-1: none) */
     double *fail_t;             /* (n,) */
     double *fail_x;             /* (n, PDW_NX) */
+    /* --- interruptibility --- */
+    int (*poll)(void *ctx);     /* called every PDW_BATCH_POLL lockstep steps (NULL: never); nonzero
+                                 * stops: the running walkers are written with status running */
+    void *poll_ctx;
 } pdw_batch_job;
+
+enum { PDW_BATCH_POLL = 512 };
 
 /* The lanes of a block as structure of arrays: element i of lane l at a[i*PDW_SOA_STRIDE + l],
  * caller-allocated (64-byte aligned: a row's first 8 lanes are one cache line). The lane's pdw_sim holds everything else
@@ -85,7 +91,7 @@ int pdw_batch_isa_supported(int isa);
 /* Advance walkers [i0, i1) of job as pdw_batch_cdm does, the ordinary steps of a block through
  * the structure-of-arrays step compiled for isa (S: caller-allocated). Falls back to
  * pdw_batch_cdm when the kernel has no batched stages or isa is PDW_ISA_SCALAR or unsupported.
- * Bitwise pdw_batch_cdm (and `pdw.simulate`) with vector = 0. */
+ * Bitwise pdw_batch_cdm (and `pdw.simulate`) with vector = 0. Returns as pdw_batch_cdm. */
 long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
                        int vector, int isa, pdw_soa_state *S);
 
@@ -94,7 +100,7 @@ void pdw_batch_sincos(int n, const double *a, double *s, double *c);
 
 /* Advance walkers [i0, i1) of job with W lanes (1 <= W <= PDW_BATCH_MAXW); lanes: W
  * caller-allocated pdw_sim. vector: 1 = vector sin/cos, 0 = scalar (bitwise `pdw.simulate`).
- * Returns the number of walkers finished (i1 - i0). */
+ * Returns the number of walkers finished (i1 - i0; fewer when job->poll stopped the range). */
 long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes, int vector);
 
 /* Advance walkers [i0, i1) of job with any method of pdw_methods (job->method), W lanes in
@@ -102,7 +108,7 @@ long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *l
  * through the method's own advance (pdw_sim.h's contract, resumed exactly through
  * PDW_STATUS_POLL), so that each lane keeps its own time, step size, accept/reject, flags and
  * located events and every walker is bitwise its `pdw.simulate` run; a finished lane takes the
- * next walker. Returns i1 - i0. */
+ * next walker. Returns the walkers finished (fewer when job->poll stopped the range). */
 long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes);
 
 #endif /* PDW_BATCH_H */
