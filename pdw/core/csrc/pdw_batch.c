@@ -267,10 +267,14 @@ void pdw_soa_trig_libm(pdw_soa_state *S, int W, int only_first)
     double *trig = S->trig;
     for (int l = 0; l < W; ++l) {
         if (only_first && S->upd[l]) continue;
-        trig[PDW_TRIG_SIN_THETA1*PDW_SOA_STRIDE + l] = sin(x[PDW_X_THETA1*PDW_SOA_STRIDE + l]);
-        trig[PDW_TRIG_COS_THETA1*PDW_SOA_STRIDE + l] = cos(x[PDW_X_THETA1*PDW_SOA_STRIDE + l]);
-        trig[PDW_TRIG_SIN_THETA2*PDW_SOA_STRIDE + l] = sin(x[PDW_X_THETA2*PDW_SOA_STRIDE + l]);
-        trig[PDW_TRIG_COS_THETA2*PDW_SOA_STRIDE + l] = cos(x[PDW_X_THETA2*PDW_SOA_STRIDE + l]);
+        /* both angles first: GCC then fuses each sin/cos pair into one sincos call, as in
+         * pdw_trig (the same results: glibc's sincos is its sin and cos) */
+        const double a1 = x[PDW_X_THETA1*PDW_SOA_STRIDE + l], a2 = x[PDW_X_THETA2*PDW_SOA_STRIDE + l];
+        const double s1 = sin(a1), c1 = cos(a1), s2 = sin(a2), c2 = cos(a2);
+        trig[PDW_TRIG_SIN_THETA1*PDW_SOA_STRIDE + l] = s1;
+        trig[PDW_TRIG_COS_THETA1*PDW_SOA_STRIDE + l] = c1;
+        trig[PDW_TRIG_SIN_THETA2*PDW_SOA_STRIDE + l] = s2;
+        trig[PDW_TRIG_COS_THETA2*PDW_SOA_STRIDE + l] = c2;
     }
 }
 
