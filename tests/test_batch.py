@@ -276,3 +276,38 @@ def test_isa_choice_is_checked(monkeypatch):
         monkeypatch.setenv(ISA_ENV, missing[0])
         with pytest.raises(pdw.InvalidInputError, match="does not run"):
             simulate_batch(_states(2), t_end=0.1)
+
+
+@pytest.mark.parametrize("method, isa", [("rodas4", None), ("cdm", ISAS[-1])])
+def test_lane_loops_stop_on_a_cancel_token(method, isa, monkeypatch):
+    """The per-method rounds and the SoA loop poll like the first loop: a cancelled token stops
+    them within a second; finished walkers keep their rows, the others are "interrupted" at a
+    finite state."""
+    import threading
+    import time
+
+    from pdw.core import interrupt
+    if isa:
+        monkeypatch.setenv(ISA_ENV, isa)
+    token, out = interrupt.Token(), {}
+
+    def worker():
+        interrupt._local.token = token
+        t0 = time.monotonic()
+        try:
+            simulate_batch(np.tile(pdw.X0_PAPER, (3000, 1)), t_end=3.5, method=method,
+                           threads=1, check_step="off")
+            out["r"] = ("finished", time.monotonic() - t0, None)
+        except KeyboardInterrupt as e:
+            out["r"] = ("interrupted", time.monotonic() - t0, e.result)
+
+    t = threading.Thread(target=worker)
+    t.start()
+    time.sleep(1.0)
+    token.set()
+    t.join(30)
+    what, seconds, res = out["r"]
+    assert what == "interrupted" and seconds < 3.0, out["r"]
+    stopped = res.status == "interrupted"
+    assert stopped.any() and np.isfinite(res.x_final).all()
+    assert set(res.status[~stopped]) <= {"walked", "periodic", "fell", "diverged", "no_steps"}
