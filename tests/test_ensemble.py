@@ -250,3 +250,16 @@ def test_sweep_with_a_method_the_engine_refuses_runs_point_by_point(tmp_path, mo
     off = run_study(st, tmp_path / "off", backend="serial", progress=False, batch=False)
     assert off.engine == "scalar"
     _rows_equal(off.rows, b.rows)
+
+
+def test_chunks_over_a_dask_executor():
+    """The same interface as sweeps: a Dask client's executor takes the chunks."""
+    distributed = pytest.importorskip("distributed")
+    x = _states(9, seed=8)
+    ref = simulate_batch(x, t_end=T_END, threads=1, check_step="off")
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        b = simulate_batch(x, t_end=T_END, threads=1, check_step="off",
+                           executor=client.get_executor(), chunk_size=4)
+    _assert_identical(ref, b)
