@@ -158,6 +158,7 @@ def test_basin_chunks_checkpoint_and_resume(tmp_path, monkeypatch):
     a = B.basin(**kw, chunk_size=5, checkpoint=ck)
     np.testing.assert_array_equal(a.outcome, ref.outcome)
     np.testing.assert_array_equal(a.n_steps, ref.n_steps)
+    assert a.cpu_time > 0 and a.wall_time > 0
     # an interrupted run: the last chunk missing from the checkpoint
     with np.load(ck) as c:
         d = {k: c[k] for k in c.files}
@@ -168,6 +169,7 @@ def test_basin_chunks_checkpoint_and_resume(tmp_path, monkeypatch):
     monkeypatch.setattr(B, "simulate_batch", lambda x0, **o: calls.append(len(x0)) or real(x0, **o))
     r = B.basin(**kw, chunk_size=5, checkpoint=ck)
     assert calls == [1, 2]                      # the reference walker, then only chunk [10, 12)
+    assert r.cpu_time > 0 and r.wall_time > 0        # times carried over the resume
     np.testing.assert_array_equal(r.outcome, ref.outcome)
     np.testing.assert_array_equal(r.n_steps, ref.n_steps)
     # other settings: the checkpoint is not reused
