@@ -1,7 +1,8 @@
 """The basin of attraction of the `paper_steady` gait on the (phi, thetad2) slice of the
 touch-down section, with the ensemble engine (pdw.analysis.basin), and the scalar path's time
 for the same grid extrapolated from a random sample of grid points run with scalar
-`pdw.simulate` in the same run (same threads), with the verdict agreement on that sample.
+`pdw.simulate` in the same run (same threads), with the verdict agreement on that sample; on
+that sample, scalar and batch runs are also timed against each other in interleaved rounds.
 
 Run: `.venv/bin/python benchmarks/basin_study.py [N] [SAMPLE] [--update-docs]` (N x N grid,
 default 400; SAMPLE scalar runs, default 200). Resumable: the grid is computed in chunks and
@@ -29,6 +30,7 @@ from pdw.analysis import limit_cycle as lc  # noqa: E402
 
 N = int(sys.argv[1]) if len(sys.argv) > 1 else 400
 SAMPLE = int(sys.argv[2]) if len(sys.argv) > 2 else 200
+ROUNDS = 3
 PHI, THD2, T_END = (0.55, 0.95), (-4.0, 0.0), 8.0
 FIG = FIGURES / "basin_paper_steady.png"
 THREADS = os.cpu_count() or 1
@@ -46,10 +48,8 @@ def scalar_outcome(r, b):
 def main():
     load0 = os.getloadavg()
     ckpt = ROOT / "out" / "benchmarks" / ("basin_%d.ckpt.npz" % N)
-    cpu0 = time.process_time()
     b = B.basin(phi=PHI + (N,), thetad2=THD2 + (N,), t_end=T_END, chunk_size=8000,
                 checkpoint=ckpt, progress=True)
-    cpu_batch = time.process_time() - cpu0
     # the scalar path on a random sample of the same grid points: pdw.simulate, same threads
     p = pdw.Params.paper_steady()
     rest = cmap.rest_of(b.reference, p)
@@ -57,16 +57,33 @@ def main():
     flat = rng.choice(N * N, size=min(SAMPLE, N * N), replace=False)
     jb, ia = np.divmod(flat, N)                  # row: thetad2 (j), column: phi (i)
 
+    X = np.array([lc.embed(cmap.cell_state(b.phi[ia[k]], b.thetad2[jb[k]], rest, p), p)
+                  for k in range(len(flat))])
+
     def one(k):
-        x = lc.embed(cmap.cell_state(b.phi[ia[k]], b.thetad2[jb[k]], rest, p), p)
-        return pdw.simulate(x, t_end=T_END, params=p, flags0=(1, 1), record_every=0,
+        return pdw.simulate(X[k], t_end=T_END, params=p, flags0=(1, 1), record_every=0,
                             record_forces=False, record_events=False, periodic_steps=4,
                             on_failure="return", check_step="off")
-    t0, c0 = time.perf_counter(), time.process_time()
-    with ThreadPoolExecutor(THREADS) as ex:
-        runs = list(ex.map(one, range(len(flat))))
-    wall_s, cpu_s = time.perf_counter() - t0, time.process_time() - c0
-    per_scalar, cpu_scalar = wall_s / len(flat), cpu_s / len(flat)
+
+    def scalar():
+        with ThreadPoolExecutor(THREADS) as ex:
+            return list(ex.map(one, range(len(flat))))
+
+    def batch():
+        return pdw.simulate_batch(X, t_end=T_END, params=p, flags0=(1, 1), periodic_steps=4,
+                                  threads=THREADS, check_step="off")
+    # the sample, scalar and batch interleaved (ROUNDS rounds, medians)
+    times = {"scalar": [], "batch": []}
+    for _ in range(ROUNDS):
+        for name, fn in (("scalar", scalar), ("batch", batch)):
+            t0, c0 = time.perf_counter(), time.process_time()
+            out = fn()
+            times[name].append((time.perf_counter() - t0, time.process_time() - c0))
+            if name == "scalar":
+                runs = out
+    med = {k: [sorted(t[j] for t in v)[len(v) // 2] / len(flat) for j in (0, 1)]
+           for k, v in times.items()}
+    per_scalar, cpu_scalar = med["scalar"]
     same_class = sum(scalar_outcome(r, b) == b.outcome[jb[k], ia[k]] for k, r in enumerate(runs))
     same_steps = sum(r.n_gait_steps == b.n_steps[jb[k], ia[k]] for k, r in enumerate(runs))
     load1 = os.getloadavg()
@@ -87,14 +104,20 @@ def main():
              "batch engine (simulate_batch, bitwise path, %d threads, chunks of 8000, "
              "checkpointed): %.1f s for %d walkers (%.3f ms each)"
              % (THREADS, b.wall_time, b.walkers, 1e3 * per_batch),
-             "  process CPU time of this call's chunks: %.1f s" % cpu_batch,
-             "scalar simulate, %d threads, %d random grid points: %.3f ms wall per walker, "
-             "%.3f ms CPU" % (THREADS, len(flat), 1e3 * per_scalar, 1e3 * cpu_scalar),
+             "  process CPU time of the grid's chunks: %.1f s (%.3f ms per walker)"
+             % (b.cpu_time, 1e3 * b.cpu_time / b.walkers),
+             "sample of %d random grid points, %d interleaved rounds, medians per walker, %d "
+             "threads: scalar simulate %.3f ms wall, %.3f ms CPU; simulate_batch %.3f ms wall, "
+             "%.3f ms CPU; batch/scalar speed-up %.2fx wall, %.2fx CPU"
+             % (len(flat), ROUNDS, THREADS, 1e3 * per_scalar, 1e3 * cpu_scalar,
+                1e3 * med["batch"][0], 1e3 * med["batch"][1], per_scalar / med["batch"][0],
+                cpu_scalar / med["batch"][1]),
              "verdict agreement on the sample: %d/%d same class, %d/%d same number of gait steps"
              % (same_class, len(flat), same_steps, len(flat)),
-             "scalar path for this grid, extrapolated from the sample: %.0f s wall (%d threads); "
-             "batch/scalar wall ratio %.2f"
-             % (per_scalar * b.walkers, THREADS, per_scalar / per_batch),
+             "scalar path for this grid, extrapolated from the sample's scalar median: %.0f s wall, "
+             "%.0f s CPU (%d threads); the grid's batch time over it: wall %.2fx, CPU %.2fx"
+             % (per_scalar * b.walkers, cpu_scalar * b.walkers, THREADS,
+                per_scalar / per_batch, cpu_scalar * b.walkers / b.cpu_time),
              "figure: %s" % FIG.relative_to(FIG.parents[2])]
     publish("basin.txt", lines)
     np.savez_compressed(RESULTS / "basin.npz", phi=b.phi, thetad2=b.thetad2, outcome=b.outcome,

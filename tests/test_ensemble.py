@@ -158,6 +158,7 @@ def test_basin_chunks_checkpoint_and_resume(tmp_path, monkeypatch):
     a = B.basin(**kw, chunk_size=5, checkpoint=ck)
     np.testing.assert_array_equal(a.outcome, ref.outcome)
     np.testing.assert_array_equal(a.n_steps, ref.n_steps)
+    assert a.cpu_time > 0 and a.wall_time > 0
     # an interrupted run: the last chunk missing from the checkpoint
     with np.load(ck) as c:
         d = {k: c[k] for k in c.files}
@@ -168,6 +169,7 @@ def test_basin_chunks_checkpoint_and_resume(tmp_path, monkeypatch):
     monkeypatch.setattr(B, "simulate_batch", lambda x0, **o: calls.append(len(x0)) or real(x0, **o))
     r = B.basin(**kw, chunk_size=5, checkpoint=ck)
     assert calls == [1, 2]                      # the reference walker, then only chunk [10, 12)
+    assert r.cpu_time > 0 and r.wall_time > 0        # times carried over the resume
     np.testing.assert_array_equal(r.outcome, ref.outcome)
     np.testing.assert_array_equal(r.n_steps, ref.n_steps)
     # other settings: the checkpoint is not reused
@@ -250,3 +252,16 @@ def test_sweep_with_a_method_the_engine_refuses_runs_point_by_point(tmp_path, mo
     off = run_study(st, tmp_path / "off", backend="serial", progress=False, batch=False)
     assert off.engine == "scalar"
     _rows_equal(off.rows, b.rows)
+
+
+def test_chunks_over_a_dask_executor():
+    """The same interface as sweeps: a Dask client's executor takes the chunks."""
+    distributed = pytest.importorskip("distributed")
+    x = _states(9, seed=8)
+    ref = simulate_batch(x, t_end=T_END, threads=1, check_step="off")
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        b = simulate_batch(x, t_end=T_END, threads=1, check_step="off",
+                           executor=client.get_executor(), chunk_size=4)
+    _assert_identical(ref, b)

@@ -57,6 +57,9 @@ class Basin:
         Step length [m] and period [s] of the reference gait (the reference point's own walk).
     wall_time : float
         Seconds for the whole grid; ``walkers`` its size.
+    cpu_time : float
+        Process CPU seconds of the grid's chunks (this process's, all threads; NaN for chunks
+        computed on an executor's workers or read from a checkpoint that did not keep it).
     """
 
     phi: np.ndarray
@@ -68,6 +71,7 @@ class Basin:
     gait_P: float
     wall_time: float
     walkers: int
+    cpu_time: float = float("nan")
 
     def fraction(self, outcome=GAIT) -> float:
         """Fraction of the grid with this outcome."""
@@ -187,32 +191,34 @@ def basin(params=None, phi=(0.69, 0.81, 100), thetad2=(-3.2, -0.4, 100), *, t_en
                          "match_tol": match_tol, "reference": z_ref.tolist()})
     outcome = np.full(n, -1, dtype=np.int8)
     steps = np.zeros(n, dtype=np.int64)
-    wall = 0.0
+    wall = cpu = 0.0
     if checkpoint is not None and os.path.exists(checkpoint):
         with np.load(checkpoint) as ck:
             if str(ck["key"]) == key and ck["outcome"].shape == (n,):
                 outcome, steps, wall = ck["outcome"].copy(), ck["n_steps"].copy(), float(ck["wall"])
+                cpu = float(ck["cpu"]) if "cpu" in ck.files else float("nan")
     bounds = [(lo, min(n, lo + chunk_size)) for lo in range(0, n, chunk_size)]
     todo = [(lo, hi) for lo, hi in bounds if (outcome[lo:hi] < 0).any()]
     bar = progress_bar(progress, n, "basin", done=n - sum(hi - lo for lo, hi in todo))
     nthreads = threads if threads is not None else (1 if executor is not None else None)
 
-    def finish(lo, hi, res, seconds):
-        nonlocal wall
+    def finish(lo, hi, res, seconds, cpu_seconds):
+        nonlocal wall, cpu
         outcome[lo:hi] = _classify(res, L0, P0, match_tol)
         steps[lo:hi] = res.n_gait_steps
         wall += seconds
+        cpu += cpu_seconds
         if checkpoint is not None:
             _save(checkpoint, key=np.array(key), outcome=outcome, n_steps=steps,
-                  wall=np.array(wall))
+                  wall=np.array(wall), cpu=np.array(cpu))
         bar.update(hi - lo)
 
     try:
         if executor is None:
             for lo, hi in todo:
-                t0 = time.perf_counter()
+                t0, c0 = time.perf_counter(), time.process_time()
                 res = simulate_batch(x0[lo:hi], threads=nthreads, **opts)
-                finish(lo, hi, res, time.perf_counter() - t0)
+                finish(lo, hi, res, time.perf_counter() - t0, time.process_time() - c0)
         else:
             t0 = time.perf_counter()
             futs = [executor.submit(simulate_batch, x0[lo:hi], threads=nthreads, **opts)
@@ -220,14 +226,14 @@ def basin(params=None, phi=(0.69, 0.81, 100), thetad2=(-3.2, -0.4, 100), *, t_en
             for (lo, hi), f in zip(todo, futs):
                 res = f.result()
                 t1 = time.perf_counter()
-                finish(lo, hi, res, t1 - t0)
+                finish(lo, hi, res, t1 - t0, float("nan"))
                 t0 = t1
     finally:
         bar.close()
     shape = (len(B), len(A))
     return Basin(phi=A, thetad2=B, outcome=outcome.astype(int).reshape(shape),
                  n_steps=steps.reshape(shape), reference=z_ref, gait_L=L0, gait_P=P0,
-                 wall_time=wall, walkers=n)
+                 wall_time=wall, walkers=n, cpu_time=cpu)
 
 
 def plot(b: Basin, ax=None, title=None):
