@@ -226,3 +226,14 @@ def test_find_gait_refuses_lugre_saying_why():
     from pdw.analysis import limit_cycle
     with pytest.raises(pdw.InvalidInputError, match="bristle state would be re-initialised"):
         limit_cycle.step(np.zeros(6), contact=Contact(friction="lugre"))
+
+
+def test_simulate_many_runs_lugre_on_the_scalar_path():
+    """The ensemble's scalar path carries the 10-entry state of a LuGre run."""
+    from pdw.sim.ensemble import simulate_many
+    c = calibrate_lugre().contact
+    x0 = np.tile(np.array(pdw.X0_PAPER), (2, 1))
+    out = simulate_many(x0, t_end=0.05, dt=2e-5, contact=c, check_step="off")
+    one = pdw.simulate(x0[0], t_end=0.05, dt=2e-5, contact=c, record_every=0, check_step="off")
+    assert out.x_final.shape == (2, len(_layout.STATE_LAYOUTS["lugre"]))
+    np.testing.assert_array_equal(out.x_final[0], one.x_final)
