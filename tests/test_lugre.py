@@ -222,6 +222,15 @@ def test_refused_with_reasons(kwargs, match):
         pdw.simulate(t_end=0.01, record_every=1, **kwargs)
 
 
+def test_a_frictionless_preset_needs_lugre_coefficients():
+    P = pdw.Params.paper().replace(mu_s=0.0, mu_d=0.0)
+    with pytest.raises(pdw.InvalidInputError, match=r"contact.mu_s .*Params.mu_s"):
+        pdw.simulate(params=P, t_end=0.01, contact=dict(friction="lugre"))
+    r = pdw.simulate(params=P, t_end=0.01, contact=dict(friction="lugre", mu_s=0.5, mu_c=0.4),
+                     check_step="off")
+    assert np.isfinite(r.x).all()
+
+
 def test_find_gait_refuses_lugre_saying_why():
     from pdw.analysis import limit_cycle
     with pytest.raises(pdw.InvalidInputError, match="bristle state would be re-initialised"):
