@@ -222,7 +222,27 @@ def test_refused_with_reasons(kwargs, match):
         pdw.simulate(t_end=0.01, record_every=1, **kwargs)
 
 
+def test_a_frictionless_preset_needs_lugre_coefficients():
+    P = pdw.Params.paper().replace(mu_s=0.0, mu_d=0.0)
+    with pytest.raises(pdw.InvalidInputError, match=r"contact.mu_s .*Params.mu_s"):
+        pdw.simulate(params=P, t_end=0.01, contact=dict(friction="lugre"))
+    r = pdw.simulate(params=P, t_end=0.01, contact=dict(friction="lugre", mu_s=0.5, mu_c=0.4),
+                     check_step="off")
+    assert np.isfinite(r.x).all()
+
+
 def test_find_gait_refuses_lugre_saying_why():
     from pdw.analysis import limit_cycle
     with pytest.raises(pdw.InvalidInputError, match="bristle state would be re-initialised"):
         limit_cycle.step(np.zeros(6), contact=Contact(friction="lugre"))
+
+
+def test_simulate_many_runs_lugre_on_the_scalar_path():
+    """The ensemble's scalar path carries the 10-entry state of a LuGre run."""
+    from pdw.sim.ensemble import simulate_many
+    c = calibrate_lugre().contact
+    x0 = np.tile(np.array(pdw.X0_PAPER), (2, 1))
+    out = simulate_many(x0, t_end=0.05, dt=2e-5, contact=c, check_step="off")
+    one = pdw.simulate(x0[0], t_end=0.05, dt=2e-5, contact=c, record_every=0, check_step="off")
+    assert out.x_final.shape == (2, len(_layout.STATE_LAYOUTS["lugre"]))
+    np.testing.assert_array_equal(out.x_final[0], one.x_final)

@@ -282,6 +282,12 @@ class Contact:
         mu_c, v_s)."""
         out = dict(LUGRE_DEFAULTS, **lugre_stribeck(params))
         out.update({n: getattr(self, n) for n in LUGRE_PARAMETERS if getattr(self, n) is not None})
+        for name in ("mu_s", "mu_c"):           # defaults from Params may be 0 (no friction)
+            if not out[name] > 0:
+                raise InvalidInputError(
+                    "contact.%s = %r (from Params.%s) is out of range; allowed: > 0 [-] (LuGre "
+                    "divides by its Stribeck curve): set contact.%s" % (
+                        name, out[name], "mu_s" if name == "mu_s" else "mu_d", name))
         return out
 
     def vector(self, p: np.ndarray, features=None, params: Params | None = None) -> np.ndarray:

@@ -112,7 +112,8 @@ def from_results(results, flags0, *, dt, t_end, method, variant) -> BatchResult:
     n = len(results)
     ring, nstep = _layout.STEP_RING, len(_layout.STEP)
     gait = np.full((n, ring, nstep), np.nan)
-    fx = np.full((n, len(STATE)), np.nan)
+    nx = len(results[0].x_final) if n else len(STATE)   # the friction law's state (LuGre: 10)
+    fx = np.full((n, nx), np.nan)
     ft = np.full(n, np.nan)
     fleg = np.zeros(n, dtype=np.intc)
     reason = np.array(["none"] * n, dtype=object)
@@ -130,7 +131,7 @@ def from_results(results, flags0, *, dt, t_end, method, variant) -> BatchResult:
     return BatchResult(
         status=np.array([r.status for r in results], dtype=object),
         stop_reason=np.array([r.stop_reason for r in results], dtype=object),
-        x_final=np.array([r.x_final for r in results], dtype=float).reshape(n, len(STATE)),
+        x_final=np.array([r.x_final for r in results], dtype=float).reshape(n, nx),
         t_final=np.array([r.t_final for r in results], dtype=float),
         n_steps=ints(lambda r: r.n_steps),
         flags_final=np.array([_final_flags(r, f) for r, f in zip(results, flags0)],

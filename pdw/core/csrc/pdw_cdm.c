@@ -37,6 +37,9 @@ void pdw_cdm_start(pdw_sim *s)
  * i.e. z relaxes toward z_ss = v/a with factor exp(-a dt). First order (v is held over the step,
  * as Eq. 17's velocity), exact for constant v, and unconditionally stable: 0 < phi <= 1. zdot_n
  * and a come from the contact stage of x_n, in s->work. */
+#if defined(__GNUC__)
+__attribute__((noinline))       /* off the default law's hot path (its registers stay as they were) */
+#endif
 static void bristle_update(const pdw_sim *s, double dt, double *xnew)
 {
     const double *contact = s->work + PDW_WORK_CONTACT;
