@@ -97,8 +97,8 @@ def rhs(x: ArrayLike, params: Params | None = None, flags: ArrayLike = (0, 1),
     """Right-hand side f(x) = [qd; M^-1 (Q_f - C qd - G)] of Eq. A.4.
 
     Every argument is checked (`pdw.InvalidInputError` naming it). One finite, C-contiguous
-    float64 state with default ``features`` takes a compiled fast path (about 1 us a call,
-    docs/benchmarks.md); for many calls with fixed arguments use `pdw.ode_function`.
+    float64 state with default ``features`` takes a compiled fast path (its cost per call is
+    in docs/benchmarks.md); for many calls with fixed arguments use `pdw.ode_function`.
 
     Parameters
     ----------
