@@ -3,11 +3,13 @@ of `Params`, `simulate`, scenes and studies (malformed input), and of long rando
 
 Every case either succeeds (with an honest result) or raises the documented error -- never a
 crash, a raw Python error, or a status that lies. A small budget runs in ``make test``; the
-``slow`` twins (``make study``) run about 10^5 cases in all (counts in docs/stability.md).
+``slow`` twins (``make study``) run about 1.6 10^5 cases in all (counts in docs/stability.md).
 ``PDW_FUZZ_EXAMPLES`` overrides the small budget per test.
 """
+import json
 import math
 import os
+import time
 import warnings
 
 import numpy as np
@@ -16,23 +18,50 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import pdw
-from pdw.core import _core, _hybrid
+from pdw.core import _batch, _core, _hybrid
 from pdw.core.model import parameter_vector
 from pdw.studies.study import parse_study
 
 SMALL = int(os.environ.get("PDW_FUZZ_EXAMPLES", "25"))
-#: the slow twins' examples per test (their sum is the study's count: 1.0e5)
+#: the slow twins' examples per test (their sum is the study's count: 1.56e5)
 LARGE = {"compiled": 40000, "hybrid": 15000, "params": 20000, "simulate": 5000,
-         "scene": 10000, "study": 9900, "long": 100}
+         "scene": 10000, "study": 9900, "long": 100,
+         # the entry points merged after issue 16's first pass
+         "batch": 5000, "batch_compiled": 20000, "ode": 20000, "contact": 3000, "load": 5000,
+         "buffer": 3000}
 _HC = [HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much]
 P = parameter_vector(pdw.Params.paper())
 X0 = np.array(pdw.X0_PAPER)
+
+
+#: ``PDW_FUZZ_COUNT_FILE``: a JSON file where the cases run so far (per target, with the seconds
+#: since its first case) are written every 50 cases, so that a budget cut by a deadline still
+#: has exact counts (docs/stability.md section 11).
+_COUNT_FILE = os.environ.get("PDW_FUZZ_COUNT_FILE")
+_COUNTS = {}
+
+
+def _count(kind):
+    n, t0 = _COUNTS.get(kind, (0, time.monotonic()))
+    _COUNTS[kind] = (n + 1, t0)
+    if _COUNT_FILE and (n + 1) % 50 == 0:
+        try:
+            with open(_COUNT_FILE) as f:
+                known = json.load(f)
+        except (OSError, ValueError):
+            known = {}
+        known.update({k: {"cases": c, "seconds": round(time.monotonic() - t, 1)}
+                      for k, (c, t) in _COUNTS.items()})
+        with open(_COUNT_FILE + ".tmp", "w") as f:
+            json.dump(known, f, indent=1)
+        os.replace(_COUNT_FILE + ".tmp", _COUNT_FILE)
 
 
 def _twin(kind, fn, strategy=None, small=None):
     """A small-budget test and its slow twin with LARGE[kind] examples: fn(data) draws its case
     from hypothesis' data, or fn(case) gets one case of ``strategy``."""
     def case(data):
+        _count(kind)
         fn(data if strategy is None else data.draw(strategy))
 
     def fast(data):
@@ -275,3 +304,199 @@ def _long(case):
 test_fuzz_long_runs, test_fuzz_long_runs_study = _twin(
     "long", _long, st.tuples(st.floats(5e4, 2e5), st.floats(0.015, 0.025),
                              st.sampled_from(["cdm", "rodas4"])), small=max(1, SMALL // 10))
+
+
+# --- the entry points merged after the first pass: batch, ode, contact, buffers, files --------
+
+def _batch_compiled(data):
+    """_batch.run_range with random shapes, dtypes, strides and values of every input and
+    output array, and random scalars: a refusal or a completed range, never a crash."""
+    from pdw.sim.batch import _outputs
+    n = data.draw(st.integers(0, 4))
+    out = _outputs(n)
+    if data.draw(st.integers(0, 3)) == 0:
+        key = data.draw(st.sampled_from(sorted(out)))
+        out[key] = data.draw(arrays(out[key].shape if out[key].ndim < 3 else (n, 3),
+                                    out[key].dtype.type))
+    try:
+        _batch.run_range(data.draw(st.integers(-1, len(_core.kernel_table()))),
+                         data.draw(arrays((n, _core.NX))), data.draw(arrays((1, _core.NP))),
+                         data.draw(arrays((n, 2), np.intc)), data.draw(arrays((n,))),
+                         data.draw(arrays((n,))), data.draw(st.sampled_from([1e-4, 0.0]) | ANY_FLOAT),
+                         data.draw(st.integers(-2, 30)), data.draw(st.sampled_from([1e3]) | ANY_FLOAT),
+                         data.draw(st.integers(-1, 3)), data.draw(st.integers(-1, 40)),
+                         data.draw(st.sampled_from([1e-3]) | ANY_FLOAT), out,
+                         data.draw(st.integers(-1, n + 1)), data.draw(st.integers(-1, n + 1)),
+                         data.draw(st.integers(-1, 70)), data.draw(st.booleans()))
+    except (ValueError, IndexError, TypeError, BufferError, KeyError):
+        pass
+
+
+BATCH_ARGS = {
+    "t_end": st.sampled_from([0.005, 0.02]) | JUNK,
+    "dt": st.sampled_from([1e-4, 1e-3]) | JUNK,
+    "flags0": st.sampled_from([(0, 1), (1, 1), [(0, 1), (1, 0)]]) | JUNK,
+    "fall_hip_height": st.floats(0.0, 0.4) | JUNK,
+    "lanes": st.integers(-1, 70) | JUNK,
+    "threads": st.integers(0, 3) | JUNK,
+    "vector": st.booleans() | JUNK,
+    "stop_steps": st.integers(0, 3) | JUNK,
+    "periodic_steps": st.integers(0, 3) | JUNK,
+    "max_speed": st.sampled_from([1e3, 10.0]) | JUNK,
+    "params": st.sampled_from([None, pdw.Params.paper(), [pdw.Params.paper()] * 2,
+                               [pdw.Params.paper_steady(k_n=2e5), pdw.Params.paper()]]) | JUNK,
+}
+
+
+def _batch_public(case):
+    x0, kw = case
+    kw = {**kw, "check_step": "off"}
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            b = pdw.simulate_batch(x0, **kw)
+    except pdw.InvalidInputError:
+        return
+    assert set(b.status) <= {"walked", "periodic", "fell", "diverged"}
+    assert np.isfinite(b.x_final).all() and np.isfinite(b.t_final).all()
+    walked = b.status == "walked"
+    assert (b.failure_reason[walked] == "none").all()
+
+
+BATCH_X0 = (st.integers(0, 3).flatmap(lambda n: st.lists(
+    st.lists(st.floats(-0.3, 0.3), min_size=8, max_size=8), min_size=n, max_size=n)).map(
+    lambda v: (X0 + np.array(v).reshape(-1, 8)).tolist()) | JUNK
+    | st.sampled_from([[X0.tolist()] * 2]) | arrays((2, 8)))
+
+test_fuzz_batch_entry_point, test_fuzz_batch_entry_point_study = _twin(
+    "batch_compiled", _batch_compiled)
+test_fuzz_simulate_batch, test_fuzz_simulate_batch_study = _twin(
+    "batch", _batch_public, st.tuples(BATCH_X0, st.fixed_dictionaries({}, optional=BATCH_ARGS)))
+
+
+def _ode(data):
+    """ode_function with junk arguments, then f, f.jac, f.batch with random arrays."""
+    kw = data.draw(st.fixed_dictionaries({}, optional={
+        "flags": st.sampled_from([(0, 1), (1, 1)]) | JUNK,
+        "anchors": st.sampled_from([(0.0, 0.0), (0.1, -0.2)]) | JUNK,
+        "variant": st.sampled_from(["paper", "consistent"]) | JUNK,
+        "features": st.sampled_from([None, ("hip_spring",), ()]) | JUNK}))
+    try:
+        f = pdw.ode_function(**kw)
+    except pdw.InvalidInputError:
+        return
+    x = data.draw(arrays((_core.NX,)) | JUNK)
+    for call in (lambda: f(0.0, x), lambda: f.jac(0.0, x),
+                 lambda: f.batch(data.draw(arrays((data.draw(st.integers(0, 3)), _core.NX))))):
+        try:
+            out = call()
+        except (ValueError, TypeError, BufferError):
+            continue
+        assert isinstance(out, np.ndarray) and out.dtype == np.float64
+        assert out.shape in ((_core.NX,), (_core.NX, _core.NX)) or out.shape[1:] == (_core.NX,)
+
+
+test_fuzz_ode_function, test_fuzz_ode_function_study = _twin("ode", _ode)
+
+
+def _contact(case):
+    kw, run = case
+    try:
+        c = pdw.Contact(**kw)
+    except pdw.InvalidInputError:
+        return
+    for name in ("k", "d", "e", "v_in_min"):
+        v = getattr(c, name)
+        assert v is None or (type(v) is float and math.isfinite(v))
+    if run:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                r = pdw.simulate(t_end=0.02, contact=c, check_step="off", on_failure="return",
+                                 record_every=0)
+        except pdw.InvalidInputError:
+            return
+        assert r.status in ("walked", "fell", "diverged") and np.isfinite(r.x_final).all()
+
+
+test_fuzz_contact, test_fuzz_contact_study = _twin("contact", _contact, st.tuples(
+    st.fixed_dictionaries({}, optional={
+        "normal": st.sampled_from(list(pdw.core.contact.NORMAL_LAWS)) | JUNK,
+        "friction": st.sampled_from(list(pdw.core.contact.FRICTION_LAWS)) | JUNK,
+        "k": st.floats(1e3, 1e7) | JUNK, "d": st.floats(0, 1e7) | JUNK,
+        "e": st.floats(0.05, 1.0) | JUNK, "v_in_min": st.floats(1e-4, 1.0) | JUNK}),
+    st.integers(0, 9).map(lambda i: i == 0)))
+
+
+def _buffer(data):
+    """RecordBuffer with a random capacity, then random arrays put in place of its own."""
+    from pdw.sim.buffers import RecordBuffer
+    try:
+        b = RecordBuffer(data.draw(st.integers(0, 300) | JUNK))
+    except pdw.InvalidInputError:
+        return
+    n = b.capacity
+    for name, shape, dt in (("t", (n,), None), ("x", (n, 8), None), ("flags", (n, 2), np.intc),
+                            ("contact", (n, 4), None)):
+        if data.draw(st.integers(0, 3)) == 0:
+            setattr(b, name, data.draw(arrays(shape, dt)))
+    try:
+        r = pdw.simulate(t_end=0.005, out=b, check_step="off")
+    except pdw.InvalidInputError:
+        return
+    assert np.isfinite(r.x).all() and len(r.t) == len(r.x) == 51
+
+
+test_fuzz_record_buffer, test_fuzz_record_buffer_study = _twin("buffer", _buffer)
+
+_SAVED = {}
+
+
+def _saved():
+    if not _SAVED:
+        import json
+        import tempfile
+        d = tempfile.mkdtemp(prefix="pdw-fuzz-")
+        path = os.path.join(d, "good.npz")
+        pdw.simulate(t_end=0.02, record_energies=True).save(path)
+        with np.load(path) as z:
+            arrays_ = {k: z[k] for k in z.files}
+        _SAVED.update(dir=d, arrays=arrays_, meta=json.loads(str(arrays_.pop("meta"))))
+    return _SAVED
+
+
+def _load(data):
+    """A saved result with random arrays replaced, dropped or mutated and random metadata
+    fields replaced by junk: pdw.load gives an InvalidInputError or a Result whose arrays
+    are consistent and finite."""
+    import json
+    s = _saved()
+    a = {k: v.copy() for k, v in s["arrays"].items()}
+    m = json.loads(json.dumps(s["meta"]))
+    for _ in range(data.draw(st.integers(1, 3))):
+        key = data.draw(st.sampled_from(sorted(a)))
+        action = data.draw(st.sampled_from(["replace", "drop", "poke"]))
+        if action == "drop":
+            a.pop(key, None)
+        elif action == "replace" and key in a:
+            a[key] = data.draw(arrays(a[key].shape))
+        elif key in a and a[key].size:
+            flat = a[key].astype(float).reshape(-1)      # an integer array becomes float
+            flat[data.draw(st.integers(0, flat.size - 1))] = data.draw(ANY_FLOAT)
+            a[key] = flat.reshape(a[key].shape)
+    if data.draw(st.booleans()):
+        where = m if data.draw(st.booleans()) else m["settings"]
+        where[data.draw(st.sampled_from(sorted(where)))] = data.draw(
+            JUNK.filter(lambda v: not isinstance(v, complex)))
+    path = os.path.join(s["dir"], "case.npz")
+    np.savez(path, meta=np.array(json.dumps(m)), **a)
+    try:
+        r = pdw.load(path)
+    except pdw.InvalidInputError:
+        return
+    assert r.x.shape == (len(r.t), 8) and np.isfinite(r.x).all() and np.isfinite(r.t).all()
+    assert r.flags.shape == (len(r.t), 2) and set(np.unique(r.flags)) <= {0, 1}
+    assert r.status in ("walked", "periodic", "fell", "diverged", "no_steps", "interrupted")
+
+
+test_fuzz_load, test_fuzz_load_study = _twin("load", _load)

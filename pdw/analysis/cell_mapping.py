@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core import interrupt
 from ..core.errors import InvalidInputError
 from ..core.params import X0_PAPER, Params
 from ..core.progress import progress_bar
@@ -313,12 +314,7 @@ def point_mapping_basin(cm: CellMap, z_star, *, n_steps=12, tol=1e-4, workers=No
     fn = lambda z: _converge(z, z_star, n_steps, tol, p, cm.variant, cm.info.get("method", "rodas4"), opts)  # noqa: E731
     nw = min(lc._workers(workers), len(Z))
     bar = progress_bar(progress, len(Z), "point mapping")
-    if nw <= 1:
-        outs = [fn(z) for z in bar.track(Z)]
-    else:
-        from concurrent.futures import ThreadPoolExecutor
-        with ThreadPoolExecutor(nw) as ex:
-            outs = list(bar.track(ex.map(fn, Z)))
+    outs = interrupt.thread_map(fn, Z, nw, bar)        # Ctrl-C stops every thread
     return np.array([o[0] for o in outs]), np.array([o[1] for o in outs])
 
 

@@ -26,11 +26,10 @@ from __future__ import annotations
 
 import math
 import os
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from ..core import _hybrid
+from ..core import _hybrid, interrupt
 from ..core.errors import InvalidInputError
 from ..core.model import parameter_vector
 from ..core.params import Params
@@ -232,10 +231,7 @@ class ContinuousProblem(_Problem):
         fn = _ContinuousTask(self)
         if self.executor is not None:
             return list(self.executor.map(fn, tasks))
-        if self.workers <= 1 or len(tasks) == 1:
-            return [fn(t) for t in tasks]
-        with ThreadPoolExecutor(min(self.workers, len(tasks))) as ex:
-            return list(ex.map(fn, tasks))
+        return interrupt.thread_map(fn, tasks, self.workers)   # Ctrl-C stops every thread
 
     def evaluate(self, z, mu, jac=True) -> Evaluation:
         z = np.asarray(z, dtype=float)

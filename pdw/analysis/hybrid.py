@@ -417,7 +417,8 @@ def simulate_hybrid(params=None, state0=None, n_steps=10, *, dt_out=0.002, stanc
     in stance at the start (2: as at the paper's initial condition, docs/model.md section 5), ``s0``
     its rolling coordinate. Samples every ``dt_out`` seconds (0: every integrator step),
     plus each step's start and its pre-impact state. Does not raise when the walker falls:
-    ``status`` and ``steps`` say what happened.
+    ``status`` and ``steps`` say what happened. Ctrl-C stops the walk within a second
+    (`KeyboardInterrupt`, the partial trajectory as ``.result``, status "interrupted").
     """
     params = Params.paper_steady() if params is None else params
     if stance_leg not in (1, 2):
@@ -433,7 +434,7 @@ def simulate_hybrid(params=None, state0=None, n_steps=10, *, dt_out=0.002, stanc
     cap = int(n_steps) * min(per_step, 20000)
     if cap > 10 ** 6:       # a large record: walk unrecorded first (cheap) to size it
         cap = 0
-    res, t, y, k = _hybrid.walk(p, y0, float(s0), int(n_steps), opts, cap)
+    res, t, y, k = _walk(p, y0, float(s0), int(n_steps), opts, cap, params, stance_leg)
     if cap == 0 or any(r["rec_full"] for r in res):
         # size the record from the steps the walk took and walk again (the steps are
         # deterministic: the second walk is the first one, recorded whole)
@@ -444,13 +445,28 @@ def simulate_hybrid(params=None, state0=None, n_steps=10, *, dt_out=0.002, stanc
                 "simulate_hybrid: recording %d steps at dt_out = %g needs %d samples (%.3g GB, "
                 "more than %.3g GB): use a larger dt_out" % (n_steps, dt_out, need,
                                                              need * 48 / 1e9, MAX_RECORD_BYTES / 1e9))
-        res, t, y, k = _hybrid.walk(p, y0, float(s0), int(n_steps), opts, need)
+        res, t, y, k = _walk(p, y0, float(s0), int(n_steps), opts, need, params, stance_leg)
         if any(r["rec_full"] for r in res):      # cannot happen; never report it as ok
             raise SimulationError("simulate_hybrid: the record of %d samples was still too small"
                                   % need)
+    return _trajectory(params, res, t, y, k, stance_leg, n_steps)
+
+
+def _walk(p, y0, s0, n_steps, opts, cap, params, stance_leg):
+    """_hybrid.walk; on Ctrl-C the KeyboardInterrupt carries the partial trajectory
+    (``.result``, status "interrupted")."""
+    try:
+        return _hybrid.walk(p, y0, s0, n_steps, opts, cap)
+    except KeyboardInterrupt as e:
+        if getattr(e, "partial", None) is not None:
+            e.result = _trajectory(params, *e.partial, stance_leg, n_steps)
+        raise
+
+
+def _trajectory(params, res, t, y, k, stance_leg, n_steps):
     legs = np.where(k % 2 == 0, stance_leg, 3 - stance_leg)
     s0s = np.array([r["s0"] for r in res])
     x = full_state(y, params, s0=s0s[k], stance_leg=legs) if len(y) else np.empty((0, 8))
     status = "ok" if all(r["status"] == "ok" for r in res) and len(res) == n_steps \
-        else res[-1]["status"]
+        else res[-1]["status"] if res else "interrupted"
     return HybridTrajectory(t=t, y=y, x=x, stance_leg=legs, step=k, steps=res, status=status)

@@ -76,12 +76,12 @@ from __future__ import annotations
 
 import math
 import os
-from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..core import interrupt
 from ..core.errors import FellError, InvalidInputError, SimulationError
 from ..core.integrators import INTEGRATORS, METHODS
 from ..core.params import X0_DISTURBED, X0_PAPER, Params
@@ -252,11 +252,7 @@ def map_batch(Z, params=None, variant="paper", method="rodas4", *, workers=None,
     Z = np.atleast_2d(np.asarray(Z, dtype=float))
     bar = progress_bar(progress, len(Z), "step map")
     fn = lambda z: step(z, params, variant, method, **options)   # noqa: E731
-    nw = min(_workers(workers), len(Z))
-    if nw <= 1:
-        return [fn(z) for z in bar.track(Z)]
-    with ThreadPoolExecutor(nw) as ex:
-        return list(bar.track(ex.map(fn, Z)))
+    return interrupt.thread_map(fn, Z, min(_workers(workers), len(Z)), bar)
 
 
 def _compose(z, n, params, variant, method, options):
@@ -280,12 +276,8 @@ def jacobian(z, params=None, variant="paper", method="rodas4", *, fd_step=1e-5, 
     E = np.eye(6) * fd_step
     pts = [z] + [z + e for e in E] + [z - e for e in E]
     fn = lambda zz: _compose(zz, period, params, variant, method, options)  # noqa: E731
-    nw = min(_workers(workers), len(pts))
-    if nw <= 1:
-        outs = [fn(q) for q in pts]
-    else:
-        with ThreadPoolExecutor(nw) as ex:
-            outs = list(ex.map(fn, pts))
+    # Ctrl-C stops every thread at its next poll (pdw.core.interrupt)
+    outs = interrupt.thread_map(fn, pts, min(_workers(workers), len(pts)))
     val = [o[0] if o[0] is not None else np.full(6, np.nan) for o in outs]
     J = np.column_stack([(val[1 + k] - val[7 + k]) / (2 * fd_step) for k in range(6)])
     return J, val[0], outs[0][1]

@@ -5,7 +5,11 @@ lockstep, threads over disjoint ranges of walkers.
 Private: the public API is `pdw.sim.batch.simulate_batch`. Every array is caller-allocated,
 C-contiguous (typed memoryviews). `run_range` releases the GIL for the whole range.
 """
+from cpython.exc cimport PyErr_CheckSignals
+from libc.math cimport INFINITY
 from libc.stdlib cimport malloc, free
+
+from pdw.core import interrupt as _interrupt
 
 
 cdef extern from "pdw_model.h":
@@ -53,11 +57,33 @@ cdef extern from "pdw_batch.h":
         int *fail_leg
         double *fail_t
         double *fail_x
+        int (*poll)(void *ctx) noexcept nogil
+        void *poll_ctx
     long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
                        int vector) noexcept nogil
 
 
 MAX_LANES = PDW_BATCH_MAXW
+
+
+cdef int _poll(void *ctx) noexcept nogil:
+    """The lane loop's poll (every PDW_BATCH_POLL lockstep steps, GIL released): Python's
+    signal handlers (main thread) and the thread's cancel token (`pdw.core.interrupt`); an
+    exception is kept in ctx (a list) and stops the range."""
+    with gil:
+        pending = <list> ctx
+        if pending:
+            return 1
+        try:
+            PyErr_CheckSignals()
+            _interrupt.check()
+        except BaseException as e:
+            pending.append(e)
+            return 1
+    return 0
+_OUT_KEYS = ("status", "stop_reason", "flags_final", "x_final", "t_final", "n_steps",
+             "n_gait_steps", "n_touch_down", "n_lift_off", "gait", "fail_reason", "fail_leg",
+             "fail_t", "fail_x")
 
 
 def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[:, ::1] flags0,
@@ -70,6 +96,9 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     out: the dict of output arrays made by pdw.sim.batch (status, stop_reason, flags_final,
     x_final, t_final, n_steps, n_gait_steps, n_touch_down, n_lift_off, gait, fail_reason,
     fail_leg, fail_t, fail_x). Threads may call this at once on disjoint ranges of one `out`.
+    Every PDW_BATCH_POLL lockstep steps the loop polls for Ctrl-C (main thread) and the
+    thread's cancel token (`pdw.core.interrupt`); then it writes its running walkers as they
+    are (status 0, running) and KeyboardInterrupt is raised here.
     """
     if k < 0 or k >= PDW_NKERNELS:
         raise ValueError("kernel id %d out of range [0, %d)" % (k, PDW_NKERNELS))
@@ -80,6 +109,22 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
         raise ValueError("x0 must be (N, %d) and p (N or 1, %d)" % (PDW_NX, PDW_NP))
     if not (0 <= i0 <= i1 <= n):
         raise ValueError("range [%d, %d) not within [0, %d]" % (i0, i1, n))
+    if not (dt > 0 and dt < INFINITY) or n_steps < 0 or stop_steps < 0 or not (max_speed > 0):
+        raise ValueError("dt must be finite and > 0, n_steps and stop_steps >= 0, max_speed > 0; "
+                         "got dt = %r, n_steps = %d, stop_steps = %d, max_speed = %r"
+                         % (dt, n_steps, stop_steps, max_speed))
+    if periodic_k < 0 or periodic_k == 1 or periodic_k > PDW_STEP_RING or not (periodic_tol >= 0):
+        raise ValueError("periodic_k must be 0 (off) or in [2, %d] and periodic_tol >= 0, got %d, %r"
+                         % (PDW_STEP_RING, periodic_k, periodic_tol))
+    missing = [key for key in _OUT_KEYS if key not in out]
+    if missing:
+        raise ValueError("out lacks the array(s) %s" % ", ".join(missing))
+    cdef Py_ssize_t r
+    for r in range(flags0.shape[0]):
+        if flags0.shape[1] == 2 and ((flags0[r, 0] != 0 and flags0[r, 0] != 1)
+                                     or (flags0[r, 1] != 0 and flags0[r, 1] != 1)):
+            raise ValueError("flags0 row %d must be 0 or 1, got (%d, %d)"
+                             % (r, flags0[r, 0], flags0[r, 1]))
     cdef int[::1] status = out["status"]
     cdef int[::1] stop_reason = out["stop_reason"]
     cdef int[:, ::1] flags_final = out["flags_final"]
@@ -146,6 +191,9 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     job.fail_leg = &fail_leg[0]
     job.fail_t = &fail_t[0]
     job.fail_x = &fail_x[0, 0]
+    cdef list pending = []
+    job.poll = _poll
+    job.poll_ctx = <void *> pending
     cdef pdw_sim *sims = <pdw_sim *> malloc(lanes * sizeof(pdw_sim))
     if sims == NULL:
         raise MemoryError()
@@ -155,4 +203,6 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
             done = pdw_batch_cdm(&job, i0, i1, lanes, sims, vector)
     finally:
         free(sims)
+    if pending:             # Ctrl-C (or a cancelled pool): the rows written so far stay
+        raise pending[0]
     return done

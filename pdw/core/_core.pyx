@@ -7,12 +7,13 @@ C headers). Time loops release the GIL and are entered once per simulation.
 """
 import numpy as np
 
+from pdw.core import interrupt as _interrupt
+from pdw.core.errors import InvalidInputError
+
 from cpython.exc cimport PyErr_CheckSignals
 from libc.string cimport memset, memcpy
 from cpython.buffer cimport (PyObject_GetBuffer, PyBuffer_Release, PyBUF_C_CONTIGUOUS,
                             PyBUF_FORMAT)
-
-from .errors import InvalidInputError
 
 
 cdef extern from "pdw_model.h":
@@ -462,6 +463,14 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         n_rec_cap = rec_t.shape[0]
         if not record_contact:
             rec_contact = np.zeros((0, PDW_NREC))
+        # every buffer as long as rec_t, checked before a pointer is taken (issue 16)
+        _rows("buffers[1] (x)", rec_x.shape[0], rec_x.shape[1] if rec_x.ndim == 2 else -1,
+              n_rec_cap, PDW_NX)
+        _rows("buffers[2] (flags)", rec_flags.shape[0],
+              rec_flags.shape[1] if rec_flags.ndim == 2 else -1, n_rec_cap, 2)
+        if record_contact:
+            _rows("buffers[3] (contact)", rec_contact.shape[0],
+                  rec_contact.shape[1] if rec_contact.ndim == 2 else -1, n_rec_cap, PDW_NREC)
     else:
         rec_t = np.zeros(n_rec_cap)
         rec_x = np.zeros((n_rec_cap, PDW_NX))
@@ -498,6 +507,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         if status == PDW_STATUS_POLL:
             try:
                 PyErr_CheckSignals()
+                _interrupt.check()          # a worker thread's task of an interrupted pool
             except KeyboardInterrupt as e:
                 interrupted = e
                 break
@@ -559,6 +569,24 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         "failure": {"t": s.failure.t, "x": np.array(<double[:PDW_NX]> s.failure.x),
                     "leg": s.failure.leg, "reason": s.failure.reason},
     }
+
+
+def _real_states(x, bint allow_rows):
+    """x as a C-contiguous float64 array of shape (8,) (or (N, 8) when allow_rows): real
+    numbers only, no strings, complex, booleans or reshaping (`pdw.core.checks.real_array`;
+    finiteness is not checked per call)."""
+    if isinstance(x, (str, bytes)):
+        raise InvalidInputError("x must be an array of numbers, got the string %r" % (x,))
+    try:
+        arr = np.asarray(x)
+    except (TypeError, ValueError):
+        raise InvalidInputError("x must be an array of numbers, got %r" % (x,)) from None
+    if arr.dtype.kind not in "iuf":
+        raise InvalidInputError("x must hold real numbers (not %s)" % arr.dtype)
+    if not (arr.shape == (PDW_NX,) or (allow_rows and arr.ndim == 2 and arr.shape[1] == PDW_NX)):
+        raise InvalidInputError("x must have shape (%d,)%s, got %s"
+                                % (PDW_NX, " or (N, %d)" % PDW_NX if allow_rows else "", arr.shape))
+    return np.ascontiguousarray(arr, dtype=np.float64)
 
 
 # --- the model object for external solvers (pdw.ode_function) ----------------------------

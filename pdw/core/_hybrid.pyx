@@ -8,7 +8,10 @@ GIL released.
 """
 import numpy as np
 
+from cpython.exc cimport PyErr_CheckSignals
 from libc.string cimport memset
+
+from pdw.core import interrupt as _interrupt
 
 
 cdef extern from "pdw_hybrid.h":
@@ -29,6 +32,8 @@ cdef extern from "pdw_hybrid_sim.h":
         double rtol, atol, h0, h_max, t_max, event_tol, min_step_angle, fall_angle
         long max_steps
         double dt_out
+        int (*poll)(void *ctx) noexcept nogil
+        void *poll_ctx
     ctypedef struct pdw_hybrid_result:
         int status
         double t0, s0
@@ -63,7 +68,9 @@ cdef extern from "pdw_hybrid_sim.h":
 
 NY = PDW_NHY
 NFOOT = PDW_NHYFOOT
-STATUS = ("ok", "no_strike", "fell", "singular", "nonfinite", "max_steps", "step_tiny")
+STATUS = ("ok", "no_strike", "fell", "singular", "nonfinite", "max_steps", "step_tiny",
+          "interrupted")
+cdef int _INTERRUPTED = 7
 
 
 include "_shapes.pxi"
@@ -92,8 +99,35 @@ cdef dict _opts_dict(pdw_hybrid_opts *o):
             "fall_angle": o.fall_angle, "max_steps": o.max_steps, "dt_out": o.dt_out}
 
 
-cdef void _fill_opts(pdw_hybrid_opts *o, dict opts) except *:
+cdef int _poll(void *ctx) noexcept nogil:
+    """The step's poll (every PDW_HYBRID_POLL_RHS right-hand sides, GIL released): Python's
+    signal handlers (main thread) and the thread's cancel token (`pdw.core.interrupt`); an
+    exception is kept in ctx (a list) and stops the step."""
+    with gil:
+        pending = <list> ctx
+        if pending:
+            return 1
+        try:
+            PyErr_CheckSignals()
+            _interrupt.check()
+        except BaseException as e:
+            pending.append(e)
+            return 1
+    return 0
+
+
+cdef object _raised(list pending, partial=None):
+    """Re-raise what a poll caught, with the partial result as ``.partial``."""
+    if pending:
+        exc = pending[0]
+        exc.partial = partial
+        raise exc
+
+
+cdef void _fill_opts(pdw_hybrid_opts *o, dict opts, list pending) except *:
     pdw_hybrid_default_opts(o)
+    o.poll = _poll
+    o.poll_ctx = <void *> pending
     for k, v in opts.items():
         if k == "rtol": o.rtol = v
         elif k == "atol": o.atol = v
@@ -227,7 +261,8 @@ def step(const double[::1] p, const double[::1] y0, dict opts, double t0=0.0, do
     _py(p, y0, "y0")
     if rec_cap < 0:
         raise ValueError("rec_cap must be >= 0, got %d" % rec_cap)
-    _fill_opts(&o, opts)
+    cdef list pending = []
+    _fill_opts(&o, opts, pending)
     rec_t = np.zeros(max(rec_cap, 1))
     rec_y = np.zeros((max(rec_cap, 1), PDW_NHY))
     cdef double[::1] vt = rec_t
@@ -235,6 +270,7 @@ def step(const double[::1] p, const double[::1] y0, dict opts, double t0=0.0, do
     with nogil:
         pdw_hybrid_step(&p[0], &y0[0], t0, s0, &o, &r, &vt[0], &vy[0, 0], rec_cap)
     d = _result_dict(&r)
+    _raised(pending, (d, rec_t[:r.n_rec], rec_y[:r.n_rec]))
     return d, rec_t[:r.n_rec], rec_y[:r.n_rec]
 
 
@@ -248,13 +284,17 @@ def step_batch(const double[::1] p, const double[:, ::1] y0, dict opts, double[:
     _rows("y0", n, y0.shape[1], n, PDW_NHY)
     _rows("y_plus", y_plus.shape[0], y_plus.shape[1], n, PDW_NHY)
     _len("status", status.shape[0], n)
-    _fill_opts(&o, opts)
+    cdef list pending = []
+    _fill_opts(&o, opts, pending)
     with nogil:
         for i in range(n):
             pdw_hybrid_step(&p[0], &y0[i, 0], 0.0, 0.0, &o, &r, NULL, NULL, 0)
             status[i] = r.status
             for j in range(PDW_NHY):
                 y_plus[i, j] = r.y_plus[j]
+            if r.status == _INTERRUPTED:
+                break
+    _raised(pending)
 
 
 def walk(const double[::1] p, const double[::1] y0, double s0, long n_steps, dict opts,
@@ -264,7 +304,8 @@ def walk(const double[::1] p, const double[::1] y0, double s0, long n_steps, dic
     _py(p, y0, "y0")
     if rec_cap < 0:
         raise ValueError("rec_cap must be >= 0, got %d" % rec_cap)
-    _fill_opts(&o, opts)
+    cdef list pending = []
+    _fill_opts(&o, opts, pending)
     if n_steps < 1:
         raise ValueError("n_steps must be >= 1, got %d" % n_steps)
     results = np.zeros(n_steps * sizeof(pdw_hybrid_result), dtype=np.uint8)
@@ -284,6 +325,7 @@ def walk(const double[::1] p, const double[::1] y0, double s0, long n_steps, dic
     for k in range(min(done + 1, n_steps)):
         out.append(_result_dict(&res[k]))
         n_rec += res[k].n_rec
+    _raised(pending, (out, rec_t[:n_rec], rec_y[:n_rec], rec_step[:n_rec]))
     return out, rec_t[:n_rec], rec_y[:n_rec], rec_step[:n_rec]
 
 
@@ -331,12 +373,16 @@ def step_jac_batch(const double[::1] p, const double[:, ::1] y0, dict opts,
     if DP.shape[0] != n or DP.shape[1] != PDW_NHY or DP.shape[2] != PDW_NHY:
         raise ValueError("DP must have shape (%d, %d, %d), got (%d, %d, %d)"
                          % (n, PDW_NHY, PDW_NHY, DP.shape[0], DP.shape[1], DP.shape[2]))
-    _fill_opts(&o, opts)
+    cdef list pending = []
+    _fill_opts(&o, opts, pending)
     with nogil:
         for i in range(n):
             status[i] = pdw_hybrid_step_jac(&p[0], &y0[i, 0], &o, &r, &DP[i, 0, 0])
             for j in range(PDW_NHY):
                 y_plus[i, j] = r.y_plus[j]
+            if status[i] == _INTERRUPTED:
+                break
+    _raised(pending)
 
 
 def step_jac(const double[::1] p, const double[::1] y0, dict opts):
@@ -345,11 +391,13 @@ def step_jac(const double[::1] p, const double[::1] y0, dict opts):
     cdef pdw_hybrid_result r
     cdef int st
     _py(p, y0, "y0")
-    _fill_opts(&o, opts)
+    cdef list pending = []
+    _fill_opts(&o, opts, pending)
     DP = np.full((PDW_NHY, PDW_NHY), np.nan)
     cdef double[:, ::1] v = DP
     with nogil:
         st = pdw_hybrid_step_jac(&p[0], &y0[0], &o, &r, &v[0, 0])
+    _raised(pending)
     d = _result_dict(&r)
     if st != 0:
         d["status"] = STATUS[st] if 0 <= st < len(STATUS) else str(st)

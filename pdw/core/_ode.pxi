@@ -54,14 +54,10 @@ cdef class OdeFunction:
         cdef double[::1] fo
         cdef double[:, ::1] jo
         self.kern = _kernel(k)
-        if p.shape[0] != PDW_NP:
-            raise ValueError("p must have %d entries" % PDW_NP)
+        _len("p", p.shape[0], PDW_NP)
         memcpy(self.p, &p[0], PDW_NP * sizeof(double))
         memset(self._anchors, 0, PDW_NANCHOR * sizeof(double))
-        self._flags[0] = f1
-        self._flags[1] = f2
-        self._anchors[0] = a1
-        self._anchors[1] = a2
+        self.set_discrete(f1, f2, a1, a2)
         self._f_out = np.zeros(PDW_NX)
         self._j_out = np.zeros((PDW_NX, PDW_NX))
         fo = self._f_out
@@ -70,7 +66,11 @@ cdef class OdeFunction:
         self._j_ptr = &jo[0, 0]
 
     def set_discrete(self, int f1, int f2, double a1, double a2):
-        """Replace the support flags and anchors (already validated by the caller)."""
+        """Replace the support flags (0 or 1) and the anchors (finite) [m]."""
+        if (f1 != 0 and f1 != 1) or (f2 != 0 and f2 != 1):
+            raise ValueError("flags must be 0 or 1, got (%d, %d)" % (f1, f2))
+        if not (a1 - a1 == 0.0 and a2 - a2 == 0.0):
+            raise ValueError("anchors must be finite, got (%r, %r)" % (a1, a2))
         self._flags[0] = f1
         self._flags[1] = f2
         self._anchors[0] = a1
@@ -112,10 +112,10 @@ cdef class OdeFunction:
         try:
             v = x
         except (ValueError, TypeError, BufferError):
-            arr = np.ascontiguousarray(x, dtype=np.float64)
+            arr = _real_states(x, True)    # real numbers, (8,) or (N, 8), never reshaped
             if arr.ndim == 2:
                 return self.batch(arr)
-            v = arr.ravel()
+            v = arr
         if v.shape[0] != PDW_NX:
             _bad_state(v.shape[0])
         out = np.empty(PDW_NX)
@@ -159,7 +159,7 @@ cdef class OdeFunction:
                                self._j_ptr, self.work)
             PyBuffer_Release(&view)
             return self._j_out.copy()
-        v = np.ascontiguousarray(x, dtype=np.float64).ravel()
+        v = _real_states(x, False)
         if v.shape[0] != PDW_NX:
             _bad_state(v.shape[0])
         out = np.empty((PDW_NX, PDW_NX))

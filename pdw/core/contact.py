@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _layout
+from . import _layout, checks
 from .errors import InvalidInputError
 from .params import Params
 
@@ -103,10 +103,7 @@ class Contact:
             if name not in allowed:
                 raise InvalidInputError("contact.%s is not a parameter of the %s law (it takes %s)"
                                         % (name, self.normal, ", ".join(allowed)))
-            try:
-                v = float(v)
-            except (TypeError, ValueError):
-                raise InvalidInputError("contact.%s must be a number, got %r" % (name, v)) from None
+            v = checks._real("contact." + name, v)   # no strings, booleans or complex
             bad = not math.isfinite(v) or (v <= lo if lo_open else v < lo) or v > hi
             if bad:
                 raise InvalidInputError("contact.%s = %r is out of range; allowed: %s %g%s [%s]"

@@ -10,10 +10,9 @@ rows of an (N, 8) array in one compiled loop. The discrete state of MODEL.md sec
 """
 from __future__ import annotations
 
-import math
 from typing import Iterable
 
-from . import _core, _layout
+from . import _core, _layout, checks
 from .errors import InvalidInputError
 from .model import check_variant, kernel_index, parameter_vector
 from .params import Params
@@ -22,18 +21,10 @@ OdeFunction = _core.OdeFunction
 
 
 def _check_discrete(flags, anchors):
-    try:
-        f = tuple(flags)
-        a = tuple(float(v) for v in anchors)
-    except (TypeError, ValueError):
-        raise InvalidInputError("flags must be two values in {0, 1} and anchors two finite "
-                                "numbers [m], got %r, %r" % (flags, anchors)) from None
-    if len(f) != 2 or any(isinstance(v, bool) or v not in (0, 1) for v in f):
-        raise InvalidInputError("flags must be two values in {0, 1} (1 support, 0 swing), "
-                                "got %r" % (flags,))
-    if len(a) != 2 or not all(math.isfinite(v) for v in a):
-        raise InvalidInputError("anchors must be two finite numbers [m], got %r" % (anchors,))
-    return (int(f[0]), int(f[1])), a
+    """Flags: two integers in {0, 1}; anchors: two finite real numbers [m] (`checks`)."""
+    f = checks.flags("flags", flags)
+    a = checks.real_array("anchors", anchors, [(2,)])
+    return f, (float(a[0]), float(a[1]))
 
 
 def _check_features(features):
@@ -42,7 +33,11 @@ def _check_features(features):
     if isinstance(features, str):
         raise InvalidInputError("features must be a collection of names, got the string %r"
                                 % features)
-    unknown = set(features) - set(_layout.FEATURES)
+    try:
+        unknown = set(features) - set(_layout.FEATURES)
+    except TypeError:
+        raise InvalidInputError("features must be a collection of names from %s, got %r"
+                                % (", ".join(_layout.FEATURES), features)) from None
     if unknown:
         raise InvalidInputError("unknown feature(s) %s; allowed: %s"
                                 % (", ".join(sorted(map(str, unknown))),

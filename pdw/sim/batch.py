@@ -10,12 +10,11 @@ from __future__ import annotations
 
 import math
 import os
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..core import _batch, _layout
+from ..core import _batch, _layout, checks, interrupt
 from ..core.errors import InvalidInputError
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
 from ..core.params import Params
@@ -23,7 +22,7 @@ from . import stepsize as _stepsize
 from .gait import Steps, steps_from_rows
 from .simulation import _REASONS, _check_count, _check_positive
 
-_STATUS = {0: "running", 1: "walked", 2: "fell", 3: "diverged", 5: "diverged", 6: "periodic"}
+_STATUS = {0: "interrupted", 1: "walked", 2: "fell", 3: "diverged", 5: "diverged", 6: "periodic"}
 _STOP = {0: "t_end", 1: "steps", 2: "periodic"}
 LANES = 8
 """Default lanes per block (walkers advanced in lockstep by one thread)."""
@@ -113,34 +112,36 @@ class BatchResult:
 
 
 def _rows(x0):
-    try:
-        x = np.array(x0, dtype=float, order="C")
-    except (TypeError, ValueError):
-        raise InvalidInputError("x0 must be an (N, 8) array of numbers") from None
-    if x.ndim != 2 or x.shape[1] != len(STATE):
-        raise InvalidInputError("x0 must have shape (N, 8) (columns %s), got %s"
-                                % (STATE, np.shape(x0)))
-    bad = ~np.isfinite(x)
-    if bad.any():
-        r, c = np.argwhere(bad)[0]
+    """x0 as a C-contiguous float (N, 8) array: real numbers only (no strings, complex or
+    booleans), finite (`pdw.core.checks.real_array`)."""
+    x = np.asarray(x0) if not isinstance(x0, (str, bytes)) else x0
+    if isinstance(x, np.ndarray) and x.dtype.kind in "iuf" and x.ndim == 2 \
+            and x.shape[1] == len(STATE) and not np.isfinite(x).all():
+        r, c = np.argwhere(~np.isfinite(x))[0]
         raise InvalidInputError("x0 row %d, column %d (%s) must be finite, got %r"
                                 % (r, c, STATE[c], x[r, c]))
-    return x
+    return checks.real_array("x0", x0, [(-1, len(STATE))], STATE)
 
 
 def _flags(flags0, n):
-    f = np.array(flags0, dtype=np.intc)
-    if f.shape == (2,):
-        f = np.tile(f, (n, 1))
-    if f.shape != (n, 2):
-        raise InvalidInputError("flags0 must be (2,) or (N, 2) = (%d, 2), got %s"
-                                % (n, np.shape(flags0)))
-    bad = (f != 0) & (f != 1)
-    if bad.any():
-        r = np.argwhere(bad)[0][0]
-        raise InvalidInputError("flags0 row %d must be two values in {0, 1}, got %r"
-                                % (r, tuple(f[r])))
-    return np.ascontiguousarray(f)
+    """(N, 2) intc flags from a pair or an (N, 2) array of integers in {0, 1} (no 0.9, no
+    strings: `pdw.core.checks.flags`)."""
+    try:
+        rows = not isinstance(flags0, (str, bytes)) and np.shape(flags0) == (n, 2)
+    except ValueError:                        # a ragged sequence
+        rows = False
+    f = None if rows else checks.flags("flags0", flags0, n)
+    if f is None:                             # name the first bad row
+        for r, row in enumerate(np.asarray(flags0)):
+            try:
+                checks.flags("flags0 row %d" % r, row)
+            except InvalidInputError as e:
+                raise InvalidInputError("%s (flags0 must be (2,) or (N, 2) = (%d, 2))"
+                                        % (e, n)) from None
+        f = checks.flags("flags0", flags0, n)
+    if isinstance(f, tuple):
+        f = np.tile(np.array(f, dtype=np.intc), (n, 1))
+    return np.ascontiguousarray(f, dtype=np.intc)
 
 
 def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
@@ -181,6 +182,13 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
     -------
     BatchResult
         Per-walker arrays (status, x_final, t_final, failure, event counts, last gait steps).
+
+    Raises
+    ------
+    KeyboardInterrupt
+        On Ctrl-C, within a second (the lane loops poll every 512 lockstep steps, in every
+        thread): ``.result`` is the partial `BatchResult`, whose unfinished walkers have status
+        ``"interrupted"`` and their state when stopped (or at t = 0 if never started).
     """
     x = _rows(x0)
     n = len(x)
@@ -198,7 +206,16 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
     if params is None or isinstance(params, Params):
         plist = [Params.paper() if params is None else params]
     else:
-        plist = list(params)
+        if isinstance(params, (str, bytes, dict)):
+            plist = None
+        else:
+            try:
+                plist = list(params)
+            except TypeError:
+                plist = None
+        if plist is None:
+            raise InvalidInputError("params must be a pdw.Params or a sequence of N = %d Params, "
+                                    "got %r" % (n, params))
         if len(plist) != n:
             raise InvalidInputError("params must be one Params or a sequence of N = %d, got %d"
                                     % (n, len(plist)))
@@ -207,7 +224,9 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
             raise InvalidInputError("params row %d must be a pdw.Params, got %s"
                                     % (i, type(p).__name__))
     f0 = _flags(flags0, n)
-    n_steps = int(round(t_end / dt))
+    n_steps = checks.count("t_end / dt", round(t_end / dt))
+    if not isinstance(vector, (bool, np.bool_)):
+        raise InvalidInputError("vector must be True or False, got %r" % (vector,))
     stop_steps = _check_count("stop_steps", stop_steps)
     periodic_steps = _check_count("periodic_steps", periodic_steps)
     if periodic_steps == 1 or periodic_steps > _layout.STEP_RING:
@@ -229,7 +248,8 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
             _stepsize.check_step(dt, p, method, variant, check_step)
     pvec = np.ascontiguousarray([parameter_vector(p) for p in plist])
     ls = np.array([p.l for p in plist], dtype=float)
-    hip = np.broadcast_to(0.5 * ls if fall_hip_height is None else float(fall_hip_height), (n,))
+    hip = np.broadcast_to(0.5 * ls if fall_hip_height is None
+                          else checks.number("fall_hip_height", fall_hip_height), (n,))
     depth = np.broadcast_to(0.25 * ls if fall_depth is None
                             else _check_positive("fall_depth", fall_depth), (n,))
     hip = np.ascontiguousarray(hip, dtype=float)
@@ -239,12 +259,18 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
         chunks = _chunks(n, threads, lanes)
         args = (k, x, pvec, f0, hip, depth, dt, n_steps, max_speed, stop_steps, periodic_steps,
                 periodic_tol, out)
-        if len(chunks) == 1:
-            _batch.run_range(*args, chunks[0][0], chunks[0][1], lanes, bool(vector))
-        else:
-            with ThreadPoolExecutor(min(threads, len(chunks))) as ex:
-                list(ex.map(lambda c: _batch.run_range(*args, c[0], c[1], lanes, bool(vector)),
-                            chunks))
+        try:
+            interrupt.thread_map(lambda c: _batch.run_range(*args, c[0], c[1], lanes,
+                                                            bool(vector)),
+                                 chunks, threads)
+        except KeyboardInterrupt as e:
+            # Ctrl-C: the walkers finished so far, the running ones as they are, the others at
+            # their start; every unfinished one "interrupted"
+            unstarted = np.isnan(out["t_final"])
+            out["x_final"][unstarted] = x[unstarted]
+            out["t_final"][unstarted] = 0.0
+            e.result = _result(out, dt, n_steps * dt, method, variant)
+            raise
     return _result(out, dt, n_steps * dt, method, variant)
 
 
@@ -260,7 +286,7 @@ def _outputs(n):
     ring, nstep = _layout.STEP_RING, len(_layout.STEP)
     return {"status": np.zeros(n, np.intc), "stop_reason": np.zeros(n, np.intc),
             "flags_final": np.zeros((n, 2), np.intc), "x_final": np.zeros((n, len(STATE))),
-            "t_final": np.zeros(n), "n_steps": np.zeros(n, np.int_),
+            "t_final": np.full(n, np.nan), "n_steps": np.zeros(n, np.int_),
             "n_gait_steps": np.zeros(n, np.int_), "n_touch_down": np.zeros(n, np.int_),
             "n_lift_off": np.zeros(n, np.int_), "gait": np.zeros((n, ring, nstep)),
             "fail_reason": np.zeros(n, np.intc), "fail_leg": np.zeros(n, np.intc),
@@ -269,7 +295,7 @@ def _outputs(n):
 
 def _result(out, dt, t_end, method, variant):
     status = np.array([_STATUS[s] for s in out["status"]], dtype=object)
-    stop = np.array([_STOP[r] if r else (s if s in ("fell", "diverged") else "t_end")
+    stop = np.array([_STOP[r] if r else (s if s in ("fell", "diverged", "interrupted") else "t_end")
                      for r, s in zip(out["stop_reason"], status)], dtype=object)
     return BatchResult(
         status=status, stop_reason=stop, x_final=out["x_final"], t_final=out["t_final"],

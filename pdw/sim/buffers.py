@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core import _core, _layout
+from ..core import _core, _layout, checks
+from ..core.errors import InvalidInputError
 
 
 class RecordBuffer:
@@ -24,9 +25,16 @@ class RecordBuffer:
     """
 
     def __init__(self, capacity: int = 0):
-        self._alloc(int(capacity))
+        self._alloc(checks.count("capacity", capacity))
 
     def _alloc(self, n):
+        try:
+            self._make(n)
+        except MemoryError:
+            raise InvalidInputError("RecordBuffer capacity = %d rows needs %.3g GB; allowed: what "
+                                    "fits in memory" % (n, n * 8 * (1 + 8 + 2 + 4) / 1e9)) from None
+
+    def _make(self, n):
         self.t = np.zeros(n)
         self.x = np.zeros((n, _core.NX))
         self.flags = np.zeros((n, 2), dtype=np.intc)
@@ -41,4 +49,16 @@ class RecordBuffer:
         """(t, x, flags, contact) with at least ``rows`` rows (reallocated if smaller)."""
         if rows > self.capacity:
             self._alloc(rows)
+        n = self.capacity
+        for name, a, shape, dtype in (("t", self.t, (n,), np.float64),
+                                      ("x", self.x, (n, _core.NX), np.float64),
+                                      ("flags", self.flags, (n, 2), np.intc),
+                                      ("contact", self.contact, (n, len(_layout.RECORD_CONTACT)),
+                                       np.float64)):
+            if not (isinstance(a, np.ndarray) and a.shape == shape and a.dtype == dtype
+                    and a.flags.c_contiguous and a.flags.writeable):
+                raise InvalidInputError(
+                    "out.%s must be a writeable C-contiguous %s array of shape %s (out.t's "
+                    "length), got %s" % (name, np.dtype(dtype).name, shape,
+                                         getattr(a, "shape", type(a).__name__)))
         return self.t, self.x, self.flags, self.contact

@@ -492,7 +492,11 @@ def _check_features(features):
     if isinstance(features, str):
         raise InvalidInputError("features must be a collection of names, got the string %r"
                                 % features)
-    feats = set(features)
+    try:
+        feats = set(features)
+    except TypeError:
+        raise InvalidInputError("features must be a collection of names from %s, got %r"
+                                % (", ".join(_layout.FEATURES), features)) from None
     unknown = feats - set(_layout.FEATURES)
     if unknown:
         raise InvalidInputError("unknown feature(s) %s; allowed: %s"

@@ -96,6 +96,7 @@ long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *l
     long walker[PDW_BATCH_MAXW], next = i0;
     double a[2*PDW_BATCH_MAXW], sn[2*PDW_BATCH_MAXW], cs[2*PDW_BATCH_MAXW];
     int running = 0;
+    long since_poll = 0, done = 0;
     if (W < 1) W = 1;
     if (W > PDW_BATCH_MAXW) W = PDW_BATCH_MAXW;
     /* fill every lane (a walker that finishes at its start-up is written out at once) */
@@ -105,9 +106,18 @@ long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *l
             const long i = next++;
             if (start(job, i, &lanes[l])) { walker[l] = i; running++; break; }
             finish(job, i, &lanes[l]);
+            done++;
         }
     }
     while (running > 0) {
+        if (job->poll && ++since_poll >= PDW_BATCH_POLL) {
+            since_poll = 0;
+            if (job->poll(job->poll_ctx)) {      /* stopped: write the running walkers as they are */
+                for (int l = 0; l < W; ++l)
+                    if (walker[l] >= 0) finish(job, walker[l], &lanes[l]);
+                return done;
+            }
+        }
         /* (1) trig of every lane past its first step (at n = 0 the start-up left it in work) */
         if (vector) {
             for (int l = 0; l < W; ++l) {
@@ -134,12 +144,14 @@ long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *l
             finish(job, walker[l], &lanes[l]);
             walker[l] = -1;
             running--;
+            done++;
             while (next < i1) {
                 const long i = next++;
                 if (start(job, i, &lanes[l])) { walker[l] = i; running++; break; }
                 finish(job, i, &lanes[l]);
+                done++;
             }
         }
     }
-    return i1 - i0;
+    return done;
 }

@@ -44,14 +44,20 @@ typedef struct pdw_batch_job {
     int *fail_reason, *fail_leg;/* (n,) PDW_REASON_*, leg (-1: none) */
     double *fail_t;             /* (n,) */
     double *fail_x;             /* (n, PDW_NX) */
+    /* --- interruptibility --- */
+    int (*poll)(void *ctx);     /* called every PDW_BATCH_POLL lockstep steps (NULL: never); nonzero
+                                 * stops: the running walkers are written with status running */
+    void *poll_ctx;
 } pdw_batch_job;
+
+enum { PDW_BATCH_POLL = 512 };
 
 /* sin and cos of the n angles a into s and c through glibc's vector routines (libmvec). */
 void pdw_batch_sincos(int n, const double *a, double *s, double *c);
 
 /* Advance walkers [i0, i1) of job with W lanes (1 <= W <= PDW_BATCH_MAXW); lanes: W
  * caller-allocated pdw_sim. vector: 1 = vector sin/cos, 0 = scalar (bitwise `pdw.simulate`).
- * Returns the number of walkers finished (i1 - i0). */
+ * Returns the number of walkers finished (i1 - i0; fewer when job->poll stopped the range). */
 long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes, int vector);
 
 #endif /* PDW_BATCH_H */

@@ -29,6 +29,8 @@ void pdw_hybrid_default_opts(pdw_hybrid_opts *o)
     o->fall_angle = 1.4;
     o->max_steps = 100000;
     o->dt_out = 0.0;
+    o->poll = NULL;
+    o->poll_ctx = NULL;
 }
 
 /* ---- Dormand-Prince 5(4) ---------------------------------------------------------------- */
@@ -49,12 +51,15 @@ typedef struct stepper {
     const double *p;
     long n_rhs;
     int bad;        /* a singular mass matrix was met */
+    const pdw_hybrid_opts *o;
+    int stop;       /* o->poll asked to stop */
 } stepper;
 
 static void f(stepper *s, const double *y, double *dy)
 {
     if (pdw_hybrid_rhs(y, s->p, dy)) s->bad = 1;
-    s->n_rhs++;
+    if (++s->n_rhs % PDW_HYBRID_POLL_RHS == 0 && s->o && s->o->poll
+        && s->o->poll(s->o->poll_ctx)) s->stop = 1;
 }
 
 /* One step of size h from y with k1 = f(y): ynew, k7 = f(ynew), and (if err) the error
@@ -199,7 +204,7 @@ static void rec_dense(recorder *R, stepper *S, double dt_out, double ta, double 
 {
     double ys[NY], ks[NY];
     if (R->cap <= 0 || dt_out <= 0.0) return;
-    for (double k = floor(ta/dt_out) + 1.0; k*dt_out < tb; k += 1.0) {
+    for (double k = floor(ta/dt_out) + 1.0; k*dt_out < tb && !S->stop; k += 1.0) {
         const double tau = k*dt_out - ta;
         if (tau <= 0.0) continue;
         dopri(S, y, k1, tau, ys, ks, NULL);
@@ -229,7 +234,7 @@ int pdw_hybrid_step(const double *p, const double *y0, double t0, double s0,
                     const pdw_hybrid_opts *o, pdw_hybrid_result *r,
                     double *rec_t, double *rec_y, long rec_cap)
 {
-    stepper S = {p, 0, 0};
+    stepper S = {p, 0, 0, o, 0};
     recorder R = {rec_t, rec_y, rec_cap, 0, 0};
     double y[NY], k1[NY], ynew[NY], k7[NY], err[NY], foot[PDW_NHYFOOT], foot_new[PDW_NHYFOOT];
     double t = 0.0, h = o->h0 > 0.0 ? o->h0 : 1e-3;
@@ -240,6 +245,7 @@ int pdw_hybrid_step(const double *p, const double *y0, double t0, double s0,
     memcpy(r->y0, y0, sizeof r->y0);
     memcpy(y, y0, sizeof y);
     r->status = PDW_HYBRID_OK;
+    if (o->poll && o->poll(o->poll_ctx)) { r->status = PDW_HYBRID_INTERRUPTED; return r->status; }
     if (!finite4(y)) { r->status = PDW_HYBRID_NONFINITE; return r->status; }
     f(&S, y, k1);
     r->E0 = energy(p, y);
@@ -255,6 +261,7 @@ int pdw_hybrid_step(const double *p, const double *y0, double t0, double s0,
         if (h > o->h_max) h = o->h_max;
         if (h < 1e-14 * (1.0 + t)) { r->status = PDW_HYBRID_STEP_TINY; break; }
         dopri(&S, y, k1, h, ynew, k7, err);
+        if (S.stop) break;
         if (S.bad) { r->status = PDW_HYBRID_SINGULAR; break; }
         double en = 0.0;
         for (int i = 0; i < NY; ++i) {
@@ -333,6 +340,7 @@ int pdw_hybrid_step(const double *p, const double *y0, double t0, double s0,
         reject = 0;
         h *= fac;
     }
+    if (S.stop) r->status = PDW_HYBRID_INTERRUPTED;
     if (r->status != PDW_HYBRID_OK && r->t_strike == 0.0) r->t_strike = t;
     r->n_rhs = S.n_rhs;
     r->n_rec = R.n;

@@ -30,7 +30,13 @@ typedef struct pdw_hybrid_opts {
     long max_steps;           /* integrator steps per stance phase */
     double dt_out;            /* recording: sample every dt_out [s] of absolute time
                                  (dense, by re-stepping); 0 = every accepted step */
+    int (*poll)(void *ctx);   /* called at each step's start and every PDW_HYBRID_POLL_RHS
+                                 right-hand sides within it (NULL: never); nonzero stops the
+                                 step with PDW_HYBRID_INTERRUPTED (Ctrl-C) */
+    void *poll_ctx;
 } pdw_hybrid_opts;
+
+enum { PDW_HYBRID_POLL_RHS = 4096 };
 
 enum {
     PDW_HYBRID_OK = 0,
@@ -39,7 +45,8 @@ enum {
     PDW_HYBRID_SINGULAR = 3,      /* singular reduced mass matrix or KKT matrix */
     PDW_HYBRID_NONFINITE = 4,     /* NaN or infinity */
     PDW_HYBRID_MAX_STEPS = 5,     /* max_steps integrator steps without heel strike */
-    PDW_HYBRID_STEP_TINY = 6      /* step size underflow */
+    PDW_HYBRID_STEP_TINY = 6,     /* step size underflow */
+    PDW_HYBRID_INTERRUPTED = 7    /* opts->poll asked to stop (Ctrl-C) */
 };
 
 typedef struct pdw_hybrid_result {
