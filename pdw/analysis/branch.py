@@ -71,7 +71,7 @@ class Bifurcation:
     def as_dict(self) -> dict:
         """JSON-able fields: kind, value, tolerance, index, reason, z (or None), and the
         multipliers as ``multipliers_re`` and ``multipliers_im`` lists."""
-        m = [] if self.multipliers is None else np.asarray(self.multipliers)
+        m = np.zeros(0) if self.multipliers is None else np.asarray(self.multipliers)
         return {"kind": self.kind, "value": self.value, "tolerance": self.tolerance,
                 "index": self.index, "reason": self.reason,
                 "z": None if self.z is None else np.asarray(self.z).tolist(),
