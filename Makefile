@@ -67,6 +67,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_integrators.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_scenes.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_batch.py $(UPDATE_DOCS)
+	$(PY) benchmarks/bench_sweep_batch.py $(UPDATE_DOCS)
 	$(PY) benchmarks/work_precision.py $(UPDATE_DOCS)
 
 ## study: slow studies (marked slow in tests/), written to out/ (UPDATE_DOCS as for bench)
@@ -74,6 +75,7 @@ study: $(STAMP)
 	PDW_UPDATE_DOCS=$(if $(UPDATE_DOCS),1,0) $(PY) -m pytest -q -m slow
 	$(PY) benchmarks/stability_maps.py $(UPDATE_DOCS)
 	$(PY) benchmarks/step_edge_grid.py $(UPDATE_DOCS)
+	$(PY) benchmarks/basin_study.py 400 200 $(UPDATE_DOCS)
 
 ## sanitize: the compiled core built with AddressSanitizer + UndefinedBehaviorSanitizer (in
 ## build/sanitize, the normal build untouched), and the tests of the compiled boundary, the loops

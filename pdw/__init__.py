@@ -15,6 +15,7 @@ contact_forces          contact kinematics and forces of both feet (Eqs. 3-11)
 energies                kinetic and potential energies
 simulate, Result        one compiled simulation (support flags, events, status)
 simulate_batch          N walkers in one call, W lanes in lockstep (docs/ensemble.md): BatchResult
+simulate_many           N walkers: the batch engine when it runs the method, else pdw.simulate
 Contact                 the normal and friction contact laws of a run (docs/contact_laws.md)
 Scene, run              everything a simulation needs, as one object or TOML file (docs/scenes.md)
 steps                   per-step gait descriptors (docs/model.md section 8)
@@ -70,6 +71,7 @@ from .core.progress import Progress
 from .sim import scene
 from .sim.batch import BatchResult, simulate_batch
 from .sim.buffers import RecordBuffer
+from .sim.ensemble import simulate_many
 from .sim.files import load
 from .sim.gait import Steps, steps
 from .sim.scene import Scene, run
@@ -85,7 +87,8 @@ del _name, _module
 
 __all__ = [
     "Params", "rhs", "jacobian", "mass_matrix", "contact_forces", "ContactState", "energies",
-    "STATE", "VARIANTS", "INPUT_HASH", "simulate", "Result", "simulate_batch", "BatchResult", "Event", "METHODS", "X0_PAPER",
+    "STATE", "VARIANTS", "INPUT_HASH", "simulate", "Result", "simulate_batch", "simulate_many", "BatchResult",
+    "Event", "METHODS", "X0_PAPER",
     "X0_DISTURBED", "steps", "Steps", "PdwError", "SimulationError", "DivergedError",
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait", "Scene", "run",
     "limit_cycle", "cell_mapping", "find_gait", "sweep",

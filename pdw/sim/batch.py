@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -19,6 +19,7 @@ from ..core.errors import InvalidInputError
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
 from ..core.params import Params
 from . import stepsize as _stepsize
+from .chunks import honest, record_subset, run_chunked
 from .gait import Steps, steps_from_rows
 from .simulation import _REASONS, _check_count, _check_positive
 
@@ -56,6 +57,10 @@ class BatchResult:
         `pdw.core._layout.STEP`, legs 0/1), NaN beyond; `steps(i)` gives them as `Steps`.
     dt, t_end : float
         Step and end time [s]; ``method``, ``variant``: as given.
+    recorded : dict
+        ``{i: Result}`` for the walkers listed in ``record`` (`simulate_batch`), else empty.
+    engine : str
+        ``"batch"`` (the compiled lanes) or ``"scalar"`` (`pdw.sim.ensemble.scalar_batch`).
     """
 
     status: np.ndarray
@@ -76,6 +81,8 @@ class BatchResult:
     t_end: float
     method: str
     variant: str
+    recorded: dict = field(default_factory=dict)
+    engine: str = "batch"
 
     def __len__(self) -> int:
         return len(self.status)
@@ -147,7 +154,8 @@ def _flags(flags0, n):
 def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
                    flags0=(0, 1), threads=None, lanes=LANES, vector=False, stop_steps=0,
                    periodic_steps=0, periodic_tol=1e-3, fall_hip_height=None, fall_depth=None,
-                   max_speed=1e3, check_step="warn") -> BatchResult:
+                   max_speed=1e3, check_step="warn", *, executor=None, chunk_size=None,
+                   record=None, record_every=1) -> BatchResult:
     """Simulate N walkers at once: the result of `pdw.simulate` for each, without recording.
 
     Parameters
@@ -176,7 +184,25 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
         not to 1e-12 (docs/ensemble.md).
     stop_steps, periodic_steps, periodic_tol, fall_hip_height, fall_depth, max_speed, check_step
         As `simulate`; fall_hip_height and fall_depth default to 0.5 l and 0.25 l of each
-        walker's parameters. A divergence is a status here (``"diverged"``), never an error.
+        walker's parameters. A divergence is a status here (``"diverged"``), never an error;
+        the end-of-run checks of `simulate` (runaway, ``"no_steps"``) are applied to the final
+        states (`pdw.sim.chunks.honest`).
+    executor : concurrent.futures.Executor-like, optional
+        Cut the batch into chunks of ``chunk_size`` consecutive walkers, each one task
+        ``executor.submit`` (a thread or process pool, Dask's ``client.get_executor()``), the
+        results put back in order: bitwise the unchunked batch. Each chunk runs ``threads``
+        threads (give ``threads=1`` with a pool of one worker per core).
+    chunk_size : int, optional
+        Walkers per chunk (default: N / 8 with an executor); without an executor the chunks
+        run one after the other in this thread.
+    record : sequence of int, optional
+        Walkers whose trajectories are wanted: they are run again through the **scalar**
+        `pdw.simulate` in this call (the compiled lane loop records nothing), with
+        ``record_every`` and the same inputs (forces and events recorded,
+        ``on_failure="return"``), and returned in ``BatchResult.recorded`` as `Result`s. On the
+        bitwise path (``vector=False``) those runs are the lanes' arithmetic: same ``x_final``.
+    record_every : int
+        Sampling of the recorded walkers (every k-th step, >= 1).
 
     Returns
     -------
@@ -192,6 +218,16 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
     """
     x = _rows(x0)
     n = len(x)
+    if executor is not None or chunk_size is not None:
+        kw = dict(x0=x, t_end=t_end, dt=dt, params=params, variant=variant, method=method,
+                  flags0=flags0, threads=threads, lanes=lanes, vector=vector,
+                  stop_steps=stop_steps, periodic_steps=periodic_steps,
+                  periodic_tol=periodic_tol, fall_hip_height=fall_hip_height,
+                  fall_depth=fall_depth, max_speed=max_speed, check_step=check_step,
+                  record=record, record_every=record_every)
+        if chunk_size is None:
+            chunk_size = max(1, math.ceil(n / 8))
+        return run_chunked(simulate_batch, kw, executor, chunk_size)
     t_end = _check_positive("t_end", t_end)
     dt = _check_positive("dt", dt)
     if dt > t_end:
@@ -271,7 +307,16 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
             out["t_final"][unstarted] = 0.0
             e.result = _result(out, dt, n_steps * dt, method, variant)
             raise
-    return _result(out, dt, n_steps * dt, method, variant)
+    res = _result(out, dt, n_steps * dt, method, variant)
+    honest(res, x, plist if len(plist) == n else plist[0])
+    if record is not None:
+        res.recorded = record_subset(
+            res, record, record_every, x, plist if len(plist) == n else plist[0], f0,
+            dict(t_end=t_end, dt=dt, variant=variant, method=method, stop_steps=stop_steps,
+                 periodic_steps=periodic_steps, periodic_tol=periodic_tol,
+                 fall_hip_height=fall_hip_height, fall_depth=fall_depth, max_speed=max_speed,
+                 check_step=check_step))
+    return res
 
 
 def _chunks(n, threads, lanes):
