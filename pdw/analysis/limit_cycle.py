@@ -81,7 +81,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..core import interrupt
+from ..core import _layout, interrupt
+from ..core.contact import Contact
 from ..core.errors import FellError, InvalidInputError, SimulationError
 from ..core.integrators import INTEGRATORS, METHODS
 from ..core.params import X0_DISTURBED, X0_PAPER, Params
@@ -162,8 +163,9 @@ def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max
     ``result`` (the `Result`, legs not relabelled, time from the section).
     """
     p = _params(params)
+    law = Contact.coerce(contact).for_section(SECTION)
     nan6 = np.full(6, np.nan)
-    out = dict(status="ok", z=nan6, x_touch=np.full(8, np.nan), period=np.nan,
+    out = dict(status="ok", z=nan6, x_touch=np.full(len(_layout.STATE), np.nan), period=np.nan,
                double_support=np.nan, swing_period=np.nan, step_length=np.nan, travel=np.nan,
                n_events=0, stats={})
     try:
@@ -174,13 +176,15 @@ def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max
     if method not in METHODS:
         raise InvalidInputError("method must be one of %s, got %r" % (", ".join(METHODS), method))
     adaptive = INTEGRATORS[method].adaptive
+    v_in0 = law.section_approach_speeds(x0, p, variant)
     t_first = 1.3 * (0.75 if t_hint is None or not np.isfinite(t_hint) else float(t_hint)) + 0.05
     ends = [min(t_first, t_max), t_max] if t_first < t_max else [t_max]
     for t_end in ends:
         t_end = max(t_end, 10 * dt)
         res = simulate(x0, t_end=t_end, dt=dt, params=p, variant=variant, method=method,
                        flags0=(1, 1), record_every=1, record_forces=record, on_failure="return",
-                       rtol=rtol, atol=atol, event_tol=event_tol, contact=contact)
+                       rtol=rtol, atol=atol, event_tol=event_tol, contact=contact,
+                       approach_speeds0=v_in0)
         out["stats"] = dict(res.stats)
         lo = next((e for e in res.events if e.leg == 1 and e.kind == "lift_off"), None)
         td = next((e for e in res.events if e.leg == 1 and e.kind == "touch_down"), None)
@@ -351,7 +355,7 @@ def _guess_z(guess, params):
         x = hybrid.full_state(guess.details["y_minus"], params)
         return section_coordinates(x, 2)
     g = np.asarray(guess, dtype=float).reshape(-1)
-    if g.shape == (8,):
+    if g.shape == (len(_layout.STATE),):
         return section_coordinates(g, 2 if g[3] >= g[2] else 1)
     return _z(g, "guess")
 
@@ -424,9 +428,10 @@ def find_gait(params: Params | None = None, variant: str = "paper",
         Threads for the Jacobian's 13 map evaluations (default: all cores).
     options
         Step-map options: rtol, atol, event_tol (default `TIGHT`), t_max, dt, and
-        ``contact`` (`pdw.Contact`: the contact laws; the section re-initialises both feet's
-        approach speeds, so with lankarani_nikravesh or flores the trailing foot's damping
-        during the double support differs from a continuous run's).
+        ``contact`` (`pdw.Contact`: the normal law; with lankarani_nikravesh or flores both feet
+        get the section's landing speed as their approach speed
+        (`Contact.section_approach_speeds`: exact at a period-1 fixed point). LuGre friction is
+        refused).
 
     Returns
     -------

@@ -17,6 +17,7 @@ cdef extern from "pdw_model.h":
         PDW_NX, PDW_NP, PDW_NKERNELS, PDW_NSTEP, PDW_STEP_RING
     ctypedef struct pdw_kernel:
         int variant
+        int nx
     const pdw_kernel pdw_kernels[]
 
 
@@ -102,6 +103,9 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     """
     if k < 0 or k >= PDW_NKERNELS:
         raise ValueError("kernel id %d out of range [0, %d)" % (k, PDW_NKERNELS))
+    if pdw_kernels[k].nx != PDW_NX:
+        raise ValueError("kernel %d has a %d-entry state: the ensemble engine runs the smooth "
+                         "Coulomb law's kernels only" % (k, pdw_kernels[k].nx))
     if lanes < 1 or lanes > PDW_BATCH_MAXW:
         raise ValueError("lanes must be in [1, %d], got %d" % (PDW_BATCH_MAXW, lanes))
     cdef long n = x0.shape[0]

@@ -54,6 +54,8 @@ cdef class OdeFunction:
         cdef double[::1] fo
         cdef double[:, ::1] jo
         self.kern = _kernel(k)
+        if self.kern.nx != PDW_NX:
+            raise ValueError("OdeFunction takes the kernels of the smooth Coulomb law only")
         _len("p", p.shape[0], PDW_NP)
         memcpy(self.p, &p[0], PDW_NP * sizeof(double))
         memset(self._anchors, 0, PDW_NANCHOR * sizeof(double))

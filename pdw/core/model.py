@@ -23,14 +23,20 @@ _KERNELS = {name: i for i, (name, _, _) in enumerate(_core.kernel_table())}
 _IX = {n: i for i, n in enumerate(STATE)}
 
 
-def kernel_index(variant: str = "paper", features=None, normal: str = "hunt_crossley") -> int:
-    """Index of the generated kernel for ``variant`` with the given force elements and normal
-    contact law (`pdw.core._layout.NORMAL_LAWS`).
+def kernel_index(variant: str = "paper", features=None, normal: str = "hunt_crossley",
+                 friction: str = "coulomb") -> int:
+    """Index of the generated kernel for ``variant`` with the given force elements, normal
+    contact law (`pdw.core._layout.NORMAL_LAWS`) and friction law (`FRICTION_LAWS`).
 
     ``features=None`` means every element (`pdw.core._layout.FEATURES`). A combination without
     a specialized kernel falls back to the general one (of its normal law).
     """
     check_variant(variant)
+    if friction != "coulomb":
+        if friction not in _layout.FRICTION_LAWS or normal not in _layout.NORMAL_LAWS:
+            raise ValueError("no kernel for normal law %r with friction law %r" % (normal, friction))
+        law = "" if normal == "hunt_crossley" else "_" + normal
+        return _KERNELS[variant + law + "_" + friction]
     if normal != "hunt_crossley":
         if normal not in _layout.NORMAL_LAWS:
             raise ValueError("normal law must be one of %s, got %r"
@@ -67,10 +73,13 @@ def _states(x, name="x", width=_core.NX):
 
 
 def _discrete(flags, anchors, n):
+    """Flags (n, 2) and anchors (n, 2) (s0 only) or (n, NANCHOR) (`pdw.core._layout.ANCHORS`:
+    s0 and the approach speeds)."""
     f = checks.flags("flags", flags, n)
     f = np.ascontiguousarray(np.broadcast_to(np.asarray(f, dtype=np.intc), (n, 2)))
-    a = checks.real_array("anchors", anchors, [(2,), (n, 2)])
-    return f, np.ascontiguousarray(np.broadcast_to(a, (n, 2)))
+    na = len(_layout.ANCHORS)
+    a = checks.real_array("anchors", anchors, [(2,), (n, 2), (na,), (n, na)])
+    return f, np.ascontiguousarray(np.broadcast_to(a, (n, a.shape[-1])))
 
 
 def _folded(params, features):
@@ -80,11 +89,16 @@ def _folded(params, features):
     return params if features is None else params.without(features)
 
 
-def _evaluate(x, params, flags, anchors, variant, features=None):
+def _evaluate(x, params, flags, anchors, variant, features=None, contact=None):
     X, single = _states(x)
-    k = kernel_index(variant, features)
     f, a = _discrete(flags, anchors, len(X))
-    p = parameter_vector(_folded(params, features))
+    if contact is None or contact.is_default:
+        k = kernel_index(variant, features)
+        p = parameter_vector(_folded(params, features))
+    else:                                       # a normal law beyond the paper's (Coulomb friction)
+        params = contact.parameters(_folded(params, features))
+        k = kernel_index(variant, features, contact.normal)
+        p = contact.vector(parameter_vector(params), features, params)
     xdot = np.empty_like(X)
     work = np.empty((len(X), _core.NWORK))
     _core.rhs_batch(k, X, p, f, a, xdot, work)
@@ -244,7 +258,7 @@ class ContactState:
 
 def contact_forces(x: ArrayLike, params: Params | None = None, flags: ArrayLike = (0, 1),
                    anchors: ArrayLike = (0.0, 0.0), variant: str = "paper",
-                   features: Iterable[str] | None = None) -> ContactState:
+                   features: Iterable[str] | None = None, contact=None) -> ContactState:
     """Contact kinematics (Eqs. 4-9) and forces (Eqs. 3, 6, 7, 10, 11) of both feet.
 
     Forces act only on a support foot (flag 1) that penetrates (y_D < 0); otherwise 0.
@@ -257,20 +271,23 @@ def contact_forces(x: ArrayLike, params: Params | None = None, flags: ArrayLike 
         Default `Params.paper()`.
     flags : (int, int) or array_like (N, 2)
         Support flags of legs 1 and 2 (1 support, 0 swing; docs/model.md section 5).
-    anchors : (float, float) or array_like (N, 2)
+    anchors : (float, float) or array_like (N, 2), or (4,) or (N, 4)
         Rolling coordinate s_i at the last touch-down of each foot [m]; only the
-        ``consistent`` variant's tangential deformation uses them.
+        ``consistent`` variant's tangential deformation uses them. Four columns: then the
+        approach speeds v_in1, v_in2 [m/s] (`pdw.core._layout.ANCHORS`).
     variant : {"paper", "consistent"}
         docs/model.md section 6.
     features : iterable of str, optional
         Force elements present (`pdw.core._layout.FEATURES`; default all).
+    contact : pdw.Contact, optional
+        Another normal law (with the smooth Coulomb friction); default the paper's.
 
     Returns
     -------
     ContactState
         Each field of shape (2,) for one state, (N, 2) for N (foot 1, foot 2).
     """
-    X, single, *_, work = _evaluate(x, params, flags, anchors, variant, features)
+    X, single, *_, work = _evaluate(x, params, flags, anchors, variant, features, contact)
     k0, nk = _layout.WORK["kin"]
     c0, nc = _layout.WORK["contact"]
     kin = work[:, k0:k0 + nk].reshape(-1, 2, len(_layout.KIN))

@@ -359,6 +359,12 @@ class ContactLaws(_Section):
     d: float | None = _f(None, "float?", "normal damping [N s/m^2.5; kelvin_voigt N s/m]")
     e: float | None = _f(None, "float?", "coefficient of restitution (lankarani_nikravesh, flores)")
     v_in_min: float | None = _f(None, "float?", "smallest approach speed [m/s] (idem)")
+    sigma0: float | None = _f(None, "float?", "LuGre bristle stiffness per unit normal force [1/m]")
+    sigma1: float | None = _f(None, "float?", "LuGre bristle damping per unit normal force [s/m]")
+    sigma2: float | None = _f(None, "float?", "LuGre viscous friction per unit normal force [s/m]")
+    mu_s: float | None = _f(None, "float?", "LuGre static friction coefficient [-]")
+    mu_c: float | None = _f(None, "float?", "LuGre Coulomb friction coefficient [-]")
+    v_s: float | None = _f(None, "float?", "LuGre Stribeck velocity [m/s]")
 
     def _check(self):
         try:

@@ -19,7 +19,7 @@ static void finish(const pdw_batch_job *job, long i, const pdw_sim *s)
     job->stop_reason[i] = s->stop_reason;
     job->flags_final[2*i] = s->disc.flags[0];
     job->flags_final[2*i + 1] = s->disc.flags[1];
-    memcpy(job->x_final + i*PDW_NX, s->x, sizeof s->x);
+    memcpy(job->x_final + i*PDW_NX, s->x, PDW_NX * sizeof(double));
     job->t_final[i] = s->t;
     job->n_taken[i] = s->n;
     job->n_gait[i] = s->gait.n_steps;
@@ -48,6 +48,7 @@ static int start(const pdw_batch_job *job, long i, pdw_sim *s)
     int flags0[2];
     memset(s, 0, sizeof *s);
     s->kernel = job->kernel;
+    s->nx = PDW_NX;             /* the smooth Coulomb law only (_batch.pyx checks) */
     memcpy(s->p, job->p + i*job->p_stride, PDW_NP * sizeof(double));
     s->dt = dt;
     s->n_steps = job->n_steps;
@@ -59,7 +60,7 @@ static int start(const pdw_batch_job *job, long i, pdw_sim *s)
     s->periodic_k = job->periodic_k;
     s->periodic_tol = job->periodic_tol;
     pdw_gait_init(&s->gait);
-    memcpy(s->x, job->x0 + i*PDW_NX, sizeof s->x);
+    memcpy(s->x, job->x0 + i*PDW_NX, PDW_NX * sizeof(double));
     flags0[0] = job->flags0[2*i];
     flags0[1] = job->flags0[2*i + 1];
     pdw_discrete_init(s->kernel, s->p, s->x, flags0, &s->disc, s->work);
