@@ -94,3 +94,14 @@ def test_continuation_counts_its_points():
     continue_gait(params, "gamma", params.gamma * 1.05, model="hybrid", max_points=3,
                   progress=quiet)
     assert quiet.done > 0 and quiet.stream.getvalue() == ""
+
+
+def test_basin_counts_its_grid_points():
+    from pdw.analysis import basin
+    tty, quiet = _bars()
+    b = basin.basin(pdw.Params.paper_steady(), phi=(0.74, 0.76, 2), thetad2=(-2.0, -1.8, 2),
+                    t_end=6.0, chunk_size=3, progress=tty)
+    assert b.walkers == 4 and (tty.done, tty.total) == (4, 4) and "4/4" in tty.stream.getvalue()
+    basin.basin(pdw.Params.paper_steady(), phi=(0.74, 0.76, 2), thetad2=(-2.0, -1.8, 1),
+                t_end=6.0, progress=quiet)
+    assert (quiet.done, quiet.total) == (2, 2) and quiet.stream.getvalue() == ""

@@ -28,7 +28,7 @@ class Token:
         self._event.set()
 
     def is_set(self) -> bool:
-        t = self
+        t: Token | None = self
         while t is not None:
             if t._event.is_set():
                 return True

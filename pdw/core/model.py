@@ -105,14 +105,17 @@ def _evaluate(x, params, flags, anchors, variant, features=None, contact=None):
     return X, single, k, p, f, a, xdot, work
 
 
-def rhs(x: ArrayLike, params: Params | None = None, flags: ArrayLike = (0, 1),
-        anchors: ArrayLike = (0.0, 0.0), variant: str = "paper",
+_FLAGS0, _ANCHORS0 = (0, 1), (0.0, 0.0)     # rhs's defaults (its fast path tests identity)
+
+
+def rhs(x: ArrayLike, params: Params | None = None, flags: ArrayLike = _FLAGS0,
+        anchors: ArrayLike = _ANCHORS0, variant: str = "paper",
         features: Iterable[str] | None = None) -> np.ndarray:
     """Right-hand side f(x) = [qd; M^-1 (Q_f - C qd - G)] of Eq. A.4.
 
     Every argument is checked (`pdw.InvalidInputError` naming it). One finite, C-contiguous
-    float64 state with default ``features`` takes a compiled fast path (about 1 us a call,
-    docs/benchmarks.md); for many calls with fixed arguments use `pdw.ode_function`.
+    float64 state with default ``features`` takes a compiled fast path (its cost per call is
+    in docs/benchmarks.md); for many calls with fixed arguments use `pdw.ode_function`.
 
     Parameters
     ----------
@@ -136,11 +139,15 @@ def rhs(x: ArrayLike, params: Params | None = None, flags: ArrayLike = (0, 1),
         dx/dt [m/s, rad/s, m/s^2, rad/s^2], a fresh array.
     """
     if features is None:
-        # fast path: one finite, C-contiguous float64 state, checked in compiled code
-        try:
-            fn = _rhs_function(params, variant, flags, anchors)  # type: ignore[arg-type]
-        except TypeError:       # unhashable arguments (a list of flags): the general path
-            fn = None
+        # fast path: one finite, C-contiguous float64 state, checked in compiled code; the
+        # default arguments skip even the cache lookup
+        if params is None and flags is _FLAGS0 and anchors is _ANCHORS0 and variant == "paper":
+            fn = _DEFAULT_RHS
+        else:
+            try:
+                fn = _rhs_function(params, variant, flags, anchors)  # type: ignore[arg-type]
+            except TypeError:   # unhashable arguments (a list of flags): the general path
+                fn = None
         if fn is not None:
             out = fn.checked(x)
             if out is not None:
@@ -159,6 +166,9 @@ def _rhs_function(params, variant, flags, anchors):
     f, a = _discrete(flags, anchors, 1)
     return _core.OdeFunction(kernel_index(variant), parameter_vector(params),
                              int(f[0, 0]), int(f[0, 1]), float(a[0, 0]), float(a[0, 1]))
+
+
+_DEFAULT_RHS = _rhs_function(None, "paper", _FLAGS0, _ANCHORS0)
 
 
 def jacobian(x: ArrayLike, params: Params | None = None, flags: ArrayLike = (0, 1),

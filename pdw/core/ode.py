@@ -77,7 +77,7 @@ def ode_function(params: Params | None = None, variant: str = "paper",
     Notes
     -----
     Inputs are validated here, once; a call checks only that x is a C-contiguous float64
-    array of shape (8,) (its raw buffer is then read in place: about 0.5 us over the kernel,
+    array of shape (8,) (its raw buffer is then read in place; the cost per call is in
     docs/benchmarks.md) and converts anything else (a list, another dtype, a strided view);
     a wrong shape is `pdw.InvalidInputError` naming x. A non-finite state gives a non-finite
     derivative. ``solve_ivp(f, (0, T), x0,

@@ -156,7 +156,7 @@ class Result:
     scene: object = None
     sol: object = None
     provenance: dict | None = None
-    contact: object = None      # the pdw.Contact simulated (laws and parameters)
+    contact: _contact.Contact | None = None      # the pdw.Contact simulated (laws, parameters)
 
     @property
     def walked(self) -> bool:

@@ -25,7 +25,7 @@ the local cores (the compiled loop releases the GIL, so threads run in parallel)
 pool (``backend="process"``), or a Dask cluster unchanged (``executor=client.get_executor()``).
 Each finished point is appended to the CSV at once (flushed), so an interrupted sweep resumes
 from its CSV: rerunning skips the points already there and computes only the others
-(``resume=False`` starts afresh). A progress bar is written to stderr on a terminal (`pdw.core.progress`: tqdm if installed).
+(``resume=False`` starts afresh). ``progress=True`` writes a bar to stderr on a terminal (`pdw.core.progress`: tqdm if installed).
 """
 from __future__ import annotations
 
@@ -250,7 +250,7 @@ def _make_executor(backend, workers):
 
 
 def run_study(study, out=None, *, executor=None, workers=None, backend="thread", resume=True,
-              progress=True, figures=None, batch=True) -> StudyResult:
+              progress=False, figures=None, batch=True) -> StudyResult:
     """Run a study (a `Study` or a path to its TOML file).
 
     Parameters
@@ -269,7 +269,8 @@ def run_study(study, out=None, *, executor=None, workers=None, backend="thread",
         Keep the points already in the CSV and compute only the others (default). False
         starts afresh (the CSV is overwritten).
     progress : bool or pdw.Progress
-        Progress bar over points on stderr when it is a terminal (`pdw.core.progress.progress_bar`).
+        Progress bar over points (`pdw.core.progress.progress_bar`): False (default) none,
+        True on stderr when it is a terminal (``pdw sweep`` does that unless --no-progress).
     figures : callable, optional
         ``figures(study, rows, path) -> path`` draws the study's figure into ``path``
         (``<name>.png``); `pdw.present.study_plots.plot_study` is the standard one (``pdw sweep``
