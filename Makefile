@@ -6,7 +6,7 @@ PIP    := $(PY) -m pip
 OUT    ?= out/typical_gait
 BUILT  := $(VENV)/.pdw-built
 STAMP  := $(VENV)/.pdw-installed
-SOURCES := $(wildcard generated/*.c generated/*.h pdw/core/*.pyx pdw/core/*.pxi pdw/core/csrc/*.c pdw/core/csrc/*.h) setup.py pyproject.toml
+SOURCES := $(wildcard generated/*.c generated/*.h pdw/core/*.pyx pdw/core/*.pxi pdw/core/csrc/*.c pdw/core/csrc/*.h pdw/core/csrc/*.inc) setup.py pyproject.toml
 # an extra's requirements, read from pyproject.toml (installed without rebuilding pdw)
 EXTRA_REQS = $(PY) -c "import sys, tomllib; print('\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies'][sys.argv[1]]))"
 
@@ -67,6 +67,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_integrators.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_scenes.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_batch.py $(UPDATE_DOCS)
+	$(PY) benchmarks/bench_sweep_batch.py $(UPDATE_DOCS)
 	$(PY) benchmarks/work_precision.py $(UPDATE_DOCS)
 
 ## study: slow studies (marked slow in tests/), written to out/ (UPDATE_DOCS as for bench)
@@ -74,6 +75,7 @@ study: $(STAMP)
 	PDW_UPDATE_DOCS=$(if $(UPDATE_DOCS),1,0) $(PY) -m pytest -q -m slow
 	$(PY) benchmarks/stability_maps.py $(UPDATE_DOCS)
 	$(PY) benchmarks/step_edge_grid.py $(UPDATE_DOCS)
+	$(PY) benchmarks/basin_study.py 400 200 $(UPDATE_DOCS)
 
 ## sanitize: the compiled core built with AddressSanitizer + UndefinedBehaviorSanitizer (in
 ## build/sanitize, the normal build untouched), and the tests of the compiled boundary, the loops

@@ -3,9 +3,12 @@
 N walkers of the paper run (cdm, dt = 1e-4, t_end = 3.5 s, initial states around the paper's,
 a few of which fall), no recording. Interleaved in one process, round by round: the scalar
 `pdw.simulate` over the walkers one after the other (record_every=0, record_events=False), and
-`pdw.simulate_batch` with W lanes, bitwise (scalar libm sin/cos) and vector (libmvec sin/cos),
-on 1 thread, then on 2 threads. Medians of ROUNDS rounds; the load average is printed before
-and after (the machine is shared: read the ratios, taken in the same rounds, before the times).
+`pdw.simulate_batch` with W lanes: every cdm lane loop this CPU runs (PDW_BATCH_ISA: "scalar" =
+the generated scalar stages per lane, then the structure-of-arrays step compiled for the
+baseline, AVX2, AVX-512F), bitwise (libm sin/cos) and vector (libmvec sin/cos), on 1 thread,
+then on 2 threads; and rodas4 (rtol 1e-6, atol 1e-8) scalar against batch, per accepted step.
+Medians of ROUNDS rounds; the load average is printed before and after (the machine is shared:
+read the ratios, taken in the same rounds, before the times).
 
 Run: `make bench` (or `.venv/bin/python benchmarks/bench_batch.py [N] [ROUNDS] [--update-docs]`).
 Writes batch.txt under out/benchmarks/results/ (--update-docs: benchmarks/results/).
@@ -19,10 +22,12 @@ import numpy as np
 from _results import publish
 
 import pdw
+from pdw.core import _batch
+from pdw.sim.batch import ISA_ENV
 
 N = int(sys.argv[1]) if len(sys.argv) > 1 else 64
 ROUNDS = int(sys.argv[2]) if len(sys.argv) > 2 else 5
-T_END, DT = 3.5, 1e-4
+T_END, DT, RTOL = 3.5, 1e-4, 1e-6
 
 
 def states(n):
@@ -35,6 +40,7 @@ def states(n):
 
 def main():
     x = states(N)
+    best = _batch.best_isa()
     load0 = os.getloadavg()
 
     def scalar():
@@ -44,17 +50,35 @@ def main():
                               on_failure="return", check_step="off").n_steps
         return n
 
-    def batch(lanes, vector, threads):
-        return lambda: int(pdw.simulate_batch(x, t_end=T_END, dt=DT, lanes=lanes, vector=vector,
+    def batch(lanes, vector, threads, isa=best):
+        def run():
+            os.environ[ISA_ENV] = isa
+            try:
+                return int(pdw.simulate_batch(x, t_end=T_END, dt=DT, lanes=lanes, vector=vector,
                                               threads=threads, check_step="off").n_steps.sum())
+            finally:
+                os.environ.pop(ISA_ENV)
+        return run
 
-    cases = [("scalar simulate, 1 thread", scalar, 1),
-             ("batch W=1 bitwise, 1 thread", batch(1, False, 1), 1),
-             ("batch W=8 bitwise, 1 thread", batch(8, False, 1), 1),
-             ("batch W=8 vector, 1 thread", batch(8, True, 1), 1),
-             ("batch W=16 vector, 1 thread", batch(16, True, 1), 1),
-             ("batch W=8 bitwise, 2 threads", batch(8, False, 2), 2),
-             ("batch W=8 vector, 2 threads", batch(8, True, 2), 2)]
+    def scalar_rodas():
+        return sum(pdw.simulate(xi, t_end=T_END, method="rodas4", rtol=RTOL, record_every=0,
+                                record_events=False, on_failure="return",
+                                check_step="off").n_steps for xi in x)
+
+    def batch_rodas(threads):
+        return lambda: int(pdw.simulate_batch(x, t_end=T_END, method="rodas4", rtol=RTOL,
+                                              threads=threads).n_steps.sum())
+
+    isas = [n for n in ("scalar", "base", "avx2", "avx512") if _batch.isa_supported(n)]
+    cases = [("scalar simulate, 1 thread", scalar, 1)]
+    cases += [("batch W=8 bitwise %s, 1 thr" % n, batch(8, False, 1, n), 1) for n in isas]
+    cases += [("batch W=8 vector %s, 1 thr" % best, batch(8, True, 1), 1),
+              ("batch W=16 vector %s, 1 thr" % best, batch(16, True, 1), 1),
+              ("batch W=8 bitwise %s, 2 thr" % best, batch(8, False, 2), 2),
+              ("batch W=8 vector %s, 2 thr" % best, batch(8, True, 2), 2),
+              ("rodas4: scalar simulate, 1 thr", scalar_rodas, 1),
+              ("rodas4: batch W=8, 1 thr", batch_rodas(1), 1),
+              ("rodas4: batch W=8, 2 thr", batch_rodas(2), 2)]
     times = {name: [] for name, _, _ in cases}
     cpu = {name: [] for name, _, _ in cases}
     steps = {}
@@ -65,21 +89,22 @@ def main():
             times[name].append(time.perf_counter() - t0)
             cpu[name].append(time.process_time() - c0)
     load1 = os.getloadavg()
-    ref = statistics.median(times[cases[0][0]]) / steps[cases[0][0]]
-    ref_cpu = statistics.median(cpu[cases[0][0]]) / steps[cases[0][0]]
-    lines = ["Ensemble engine vs scalar loop: %d walkers, paper run (cdm, dt = %g, t_end = %g s), "
-             "%d rounds interleaved, medians" % (N, DT, T_END, ROUNDS),
-             "load average before %.2f %.2f %.2f, after %.2f %.2f %.2f (%d cores)"
-             % (load0 + load1 + (os.cpu_count(),)),
-             "%-30s %11s %10s %12s %12s %10s" % ("case", "wall ns/ws", "vs scalar", "CPU ns/ws",
+    lines = ["Ensemble engine vs scalar loop: %d walkers, paper run (cdm, dt = %g, t_end = %g s; "
+             "rodas4 rtol = %g), %d rounds interleaved, medians" % (N, DT, T_END, RTOL, ROUNDS),
+             "load average before %.2f %.2f %.2f, after %.2f %.2f %.2f (%d cores); widest "
+             "lane loop this CPU runs: %s" % (load0 + load1 + (os.cpu_count(), best)),
+             "%-32s %11s %10s %12s %12s %10s" % ("case", "wall ns/ws", "vs scalar", "CPU ns/ws",
                                                  "ws/CPU-s", "vs scalar"),
              ]
     for name, _, _ in cases:
+        base = cases[0][0] if not name.startswith("rodas4") else "rodas4: scalar simulate, 1 thr"
+        ref = statistics.median(times[base]) / steps[base]
+        ref_cpu = statistics.median(cpu[base]) / steps[base]
         per = statistics.median(times[name]) / steps[name]
         per_cpu = statistics.median(cpu[name]) / steps[name]
-        lines.append("%-30s %11.1f %9.2fx %12.1f %12.3g %9.2fx" % (
+        lines.append("%-32s %11.1f %9.2fx %12.1f %12.3g %9.2fx" % (
             name, per * 1e9, ref / per, per_cpu * 1e9, 1 / per_cpu, ref_cpu / per_cpu))
-    lines.append("ws = walker-step. wall: elapsed time / walker-steps (2 threads: both cores); "
+    lines.append("ws = walker-step (rodas4: accepted step, vs the scalar rodas4 loop). wall: elapsed time / walker-steps (2 threads: both cores); "
                  "CPU: process CPU time / walker-steps, i.e. the cost per core (less sensitive "
                  "to a shared machine's load than wall time)")
     publish("batch.txt", lines)

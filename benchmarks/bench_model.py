@@ -34,11 +34,13 @@ def main():
             jac = statistics.median(_core.bench(k, "jacobian", x0, p, f1, f2, 0.0, 0.01, N // 10)
                                     for _ in range(REPEATS))
             lines.append("%-12s %-22s %10.1f %12.1f" % (variant, label, rhs, jac))
-    lines += ["", "operation counts of the generated stages (SymPy count_ops after CSE):"]
+    lines += ["", "operation counts of the generated stages (SymPy count_ops after CSE; a contact-law",
+              "kernel emits only its contact stages, the others are its variant's: '-'):"]
     stages = list(next(iter(_layout.OPS.values())))
-    lines.append("%-12s " % "kernel" + " ".join("%18s" % s for s in stages))
+    w = max(len(name) for name in _layout.OPS)
+    lines.append("%-*s " % (w, "kernel") + " ".join("%17s" % s for s in stages))
     for name, ops in _layout.OPS.items():
-        lines.append("%-12s " % name + " ".join("%18d" % ops[s] for s in stages))
+        lines.append("%-*s " % (w, name) + " ".join("%17s" % ops.get(s, "-") for s in stages))
     publish("model.txt", lines)
 
 

@@ -1,6 +1,11 @@
 """Which ground model? The calibrated normal laws compared on the `paper_steady` walker
 (issue 12; docs/contact_laws.md).
 
+LuGre friction (on the Hunt-Crossley ground) gets its Stribeck curve matched to Eq. 10 and
+critically damped bristles (`pdw.calibration.calibrate_lugre`); its chatter is measured at the
+cdm step limit when cdm does not walk at the paper's step. Its rodas4 Jacobian is a central
+difference of f (21 right-hand sides, counted as one Jacobian).
+
 Every law gets parameters matched to the paper's Hunt-Crossley ground (`pdw.calibration.calibrate`:
 the same static sink under the weight, the same drop-test restitution of a foot landing at the
 typical touch-down speed). For each law, from the paper's start:
@@ -34,7 +39,7 @@ from _results import publish  # noqa: E402
 
 import pdw  # noqa: E402
 from pdw.analysis import stability_maps as S  # noqa: E402
-from pdw.analysis.calibration import calibrate  # noqa: E402
+from pdw.analysis.calibration import calibrate, calibrate_lugre  # noqa: E402
 
 P = pdw.Params.paper_steady()
 FIG = ROOT / "docs" / "figures" / "contact_laws_stance.png"
@@ -71,11 +76,13 @@ def gait_and_forces(contact):
 
 def chatter_cdm(contact, dt=1e-4):
     r = sim(contact, t_end=6.0, method="cdm", dt=dt, record_every=1, record_forces=False)
+    if r.status != "walked":
+        return math.nan, math.nan
     v = []
     for j in range(2):
         m = (r.flags[:, j] == 1) & (r.flags[:, 1 - j] == 0) & (r.t > 2.0)
         if m.any():
-            cs = pdw.contact_forces(r.x[m], P, flags=(1, 1))
+            cs = pdw.contact_forces(r.x[m][:, :len(pdw.STATE)], P, flags=(1, 1))
             v.append(cs.v_x[:, j])
     if not v:
         return math.nan, math.nan
@@ -155,17 +162,25 @@ def main():
     for law, c in cal.contacts.items():
         lines.append("%-20s %-60s drop e = %.4f%s" % (law, c.as_dict(), cal.e_drop[law],
                                                      "" if cal.reachable[law] else " (target not reachable)"))
+    lg = calibrate_lugre(P)
+    lines.append("%-20s %s; tangential effective mass %.4f kg, bristle frequency %.0f rad/s, "
+                 "presliding %.2g m" % ("lugre", lg.contact.as_dict(), lg.mass, lg.omega,
+                                        lg.presliding))
+    contacts = dict(cal.contacts, lugre=lg.contact)
     lines.append("")
     head = ("| law | status | L [m] | P [s] | v [m/s] | DS [ms] | DS [%] | F_n peak [N] | "
             "F_n settled [N] | cdm slip frac | cdm sign flips | cdm dt limit [s] | "
             "rodas4 evals @1e-6 | rodas4 ms @1e-6 |")
     lines += [head, "|" + "---|" * 14]
     stances = {}
-    for law, c in cal.contacts.items():
+    for law, c in contacts.items():
         g, r, stance = gait_and_forces(c)
         stances[law] = stance
-        slip, flips = chatter_cdm(c)
         lim = cdm_limit(c)
+        slip, flips = chatter_cdm(c)
+        if math.isnan(slip) and lim[0]:
+            slip, flips = chatter_cdm(c, lim[0])
+            law += " (chatter at dt = %.3g)" % lim[0]
         cost, wall = rodas_cost(c)
         f = lambda k, s=1.0, fmt="%.4f", g=g: fmt % (g[k] * s) if k in g else "—"  # noqa: E731
         lines.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %.3f | %.3f | %s | %.0f | %.1f |" % (

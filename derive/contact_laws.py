@@ -21,6 +21,18 @@ keeps the damping finite). Units: k_n in N/m^1.5 (N/m for kelvin_voigt), d_n in 
 (N s/m for kelvin_voigt), e_n dimensionless in (0, 1]. Lankarani & Nikravesh (1990) derived
 their hysteresis factor for e close to 1; Flores et al. (2011) for the whole range.
 
+Friction laws (`FRICTION_LAWS`): ``coulomb``, the paper's smooth law mu(v) F_n (Eq. 10, in
+derive/model.py), and ``lugre`` (Canudas de Wit, Olsson, Astrom & Lischinsky 1995), per unit
+normal force, with a bristle deflection z [m] per foot added to the continuous state:
+
+    g(v)  = mu_c + (mu_s - mu_c) exp(-(v/v_s)^2)             Stribeck curve [-]
+    dz/dt = v - sigma0 |v| z / g(v)                           bristle dynamics [m/s]
+    F_f   = -(sigma0 z + sigma1 dz/dt + sigma2 v) F_n         friction force, +X [N]
+
+(v the slip velocity v_x of Eq. 9; the minus sign: friction opposes slip, as Eq. 10's mu(v)).
+sigma0 [1/m], sigma1 [s/m], sigma2 [s/m] are per unit normal force. At constant sliding v the
+bristle settles at z_ss = g(v) sign(v) / sigma0, where F_f = -(g(v) sign(v) + sigma2 v) F_n.
+
 The Hunt-Crossley expression is built exactly as it always was (`hunt_crossley`), so that the
 default kernel's generated code, and its results, do not move.
 """
@@ -29,7 +41,7 @@ from __future__ import annotations
 import sympy as sp
 
 NORMAL_LAWS = ("hunt_crossley", "hertz", "kelvin_voigt", "lankarani_nikravesh", "flores")
-FRICTION_LAWS = ("coulomb",)
+FRICTION_LAWS = ("coulomb", "lugre")
 
 #: the exponent of the nonlinear laws (the paper's m = p = 1.5)
 EXPONENT = sp.Rational(3, 2)
@@ -99,3 +111,30 @@ def normal_force(law, delta, deltad, v_in, P):
 def uses_approach_speed(law):
     """Does the law's damping depend on the approach speed at touch-down?"""
     return law in ("lankarani_nikravesh", "flores")
+
+
+def stribeck(v, P):
+    """LuGre's Stribeck curve g(v) = mu_c + (mu_s - mu_c) exp(-(v/v_s)^2) [-]."""
+    mu_s, mu_c, v_s = P["lg_mu_s"], P["lg_mu_c"], P["lg_v_s"]
+    return mu_c + (mu_s - mu_c) * sp.exp(-(v / v_s) ** 2)
+
+
+def lugre(v, z, P):
+    """LuGre friction per unit normal force and bristle dynamics of one sliding foot.
+
+    Parameters
+    ----------
+    v, z : sympy.Symbol
+        Slip velocity [m/s] and bristle deflection [m].
+    P : dict
+        Parameter symbols by name (sigma0, sigma1, sigma2, lg_mu_s, lg_mu_c, lg_v_s).
+
+    Returns
+    -------
+    (mu, zdot, rate) : friction force per unit normal force (+X, opposes slip) [-], dz/dt [m/s]
+    and the relaxation rate sigma0 |v| / g(v) [1/s], so that dz/dt = v - rate z.
+    """
+    rate = P["sigma0"] * sp.Abs(v) / stribeck(v, P)
+    zdot = v - rate * z
+    mu = -(P["sigma0"] * z + P["sigma1"] * zdot + P["sigma2"] * v)
+    return mu, zdot, rate

@@ -8,6 +8,14 @@ the Python module ``pdw/core/_layout.py``. No other file may hard-code an index.
 # State x = [q, qdot] (paper Eq. 1), slope frame: X downhill along the slope, Y normal, up.
 STATE = ("x_o", "y_o", "theta1", "theta2", "xd_o", "yd_o", "thetad1", "thetad2")
 NQ = 4
+# The LuGre friction law (derive/contact_laws.py) adds one bristle deflection per foot [m] to the
+# continuous state, after the mechanical state. The state layout of each friction law:
+BRISTLE = ("z1", "z2")
+STATE_LAYOUTS = {
+    "coulomb": STATE,               # the paper's smooth Coulomb law (Eq. 10): x = [q, qd]
+    "lugre": STATE + BRISTLE,       # LuGre: x = [q, qd, z]
+}
+NX_MAX = max(len(s) for s in STATE_LAYOUTS.values())
 
 # Physical parameters (paper Tables 1-3, docs/model.md section 1), in this order.
 PARAMS = (
@@ -23,6 +31,12 @@ DERIVED = ("sin_gamma", "cos_gamma")
 CONTACT_PARAMS = (
     "e_n",        # coefficient of restitution of the Lankarani-Nikravesh and Flores laws [-]
     "v_in_min",   # smallest approach speed those laws divide by [m/s]
+    "sigma0",     # LuGre bristle stiffness per unit normal force [1/m]
+    "sigma1",     # LuGre bristle damping per unit normal force [s/m]
+    "sigma2",     # LuGre viscous friction per unit normal force [s/m]
+    "lg_mu_s",    # LuGre static friction coefficient (Stribeck curve at v = 0) [-]
+    "lg_mu_c",    # LuGre Coulomb friction coefficient (Stribeck curve for |v| >> v_s) [-]
+    "lg_v_s",     # LuGre Stribeck velocity [m/s]
 )
 
 # Discrete per-foot values captured at touch-down, passed to the kinematics stage ("anchors"):
@@ -39,13 +53,18 @@ KIN = (
     "s",      # rolling coordinate x_o + (l-r) sin(theta) + r theta [m]; ds/dt = v_x
     "xi",     # tangential deformation of the variant [m] (Eqs. 8, 11)
     "v_in",   # approach speed -v_y captured at the foot's touch-down [m/s] (anchors)
+    "z",      # LuGre bristle deflection of the foot [m] (state BRISTLE; 0 under coulomb)
 )
 
 # Per-foot contact forces and their partial derivatives (docs/model.md section 4, Eqs. 3, 6, 7, 10, 11).
 CONTACT = (
     "F_n",          # normal force, +Y [N]
     "F_t",          # tangential force, +X [N] (spring-damper + friction)
-    "mu",           # friction coefficient mu(v_t) of Eq. 10 (0 when not in contact)
+    "mu",           # friction coefficient mu(v_t) of Eq. 10 (0 when not in contact); under
+                    # LuGre the friction force per unit normal force -(s0 z + s1 zdot + s2 v)
+    "zdot",         # LuGre bristle rate dz/dt [m/s] (0 under coulomb and off contact)
+    "z_rate",       # LuGre relaxation rate s0 |v| / g(v) of zdot = v - z_rate z [1/s] (0 under
+                    # coulomb): the central difference method's exponential bristle update
     "dFn_ddelta",   # partial F_n / partial delta
     "dFn_ddeltad",  # partial F_n / partial delta_dot
     "dFt_dxi",      # partial F_t / partial xi

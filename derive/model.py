@@ -54,8 +54,10 @@ F_T = (_real("F_t1"), _real("F_t2"))
 QDD = tuple(_real("qdd%d" % i) for i in range(layout.NQ))
 ANCHOR = (_real("s0_1"), _real("s0_2"))
 V_IN = (_real("v_in1"), _real("v_in2"))     # approach speed at touch-down (layout.ANCHORS)
+Z = tuple(_real(n) for n in layout.BRISTLE)   # LuGre bristle deflections (state after X)
 # per-foot scalar contact variables of the force laws
-DELTA, DELTAD, VT, XI, FN, VIN = (_real(n) for n in ("delta", "deltad", "v_t", "xi", "F_n", "v_in"))
+DELTA, DELTAD, VT, XI, FN, VIN, ZB = (_real(n) for n in ("delta", "deltad", "v_t", "xi", "F_n",
+                                                          "v_in", "z"))
 
 
 @dataclass(frozen=True)
@@ -119,11 +121,12 @@ def mechanics() -> Mechanics:
     return Mechanics(T=T, V_gravity=sp.expand(Vg), V_hip=Vh, M=M, Cqd=Cqd, C=C, G=G)
 
 
-def contact_kinematics(foot: int, variant: str) -> dict:
+def contact_kinematics(foot: int, variant: str, friction: str = "coulomb") -> dict:
     """Contact quantities of foot ``foot`` (0 or 1) for ``variant`` (docs/model.md sections 2, 6).
 
     Returns a dict keyed by `layout.KIN` field names (all functions of x and,
-    for the ``consistent`` xi, of the anchor symbol s0_i).
+    for the ``consistent`` xi, of the anchor symbol s0_i). Under ``friction="lugre"`` the
+    field ``z`` is the foot's bristle state; 0 otherwise.
     """
     if variant not in VARIANTS:
         raise ValueError("variant must be one of %s, got %r" % (VARIANTS, variant))
@@ -144,6 +147,7 @@ def contact_kinematics(foot: int, variant: str) -> dict:
         out["v_y"] = v_y
         out["xi"] = out["s"] - ANCHOR[foot]                             # slip since touch-down
     out["v_in"] = V_IN[foot]                                            # captured at touch-down
+    out["z"] = Z[foot] if friction == "lugre" else sp.S.Zero
     return {k: out[k] for k in layout.KIN}
 
 
@@ -171,7 +175,8 @@ def friction_coefficient(v):
     )
 
 
-def contact_laws(variant: str, features=FEATURES, normal: str = "hunt_crossley") -> dict:
+def contact_laws(variant: str, features=FEATURES, normal: str = "hunt_crossley",
+                 friction: str = "coulomb") -> dict:
     """Force laws of one penetrating support foot, in the scalar variables delta, deltad, v_t, xi
     (and v_in, the approach speed at touch-down, for the laws that use it).
 
@@ -184,6 +189,9 @@ def contact_laws(variant: str, features=FEATURES, normal: str = "hunt_crossley")
     normal : str
         Normal law, one of `derive.contact_laws.NORMAL_LAWS` (default: the paper's
         Hunt-Crossley, Eqs. 3, 6).
+    friction : {"coulomb", "lugre"}
+        Friction law: Eq. 10's mu(v_t), or LuGre (`derive.contact_laws.lugre`) in v_t and the
+        foot's bristle state z.
 
     Returns
     -------
@@ -195,7 +203,13 @@ def contact_laws(variant: str, features=FEATURES, normal: str = "hunt_crossley")
     if normal in ("lankarani_nikravesh", "flores") and "normal_damping" not in features:
         Pn["e_n"] = sp.S.One                # no damping: perfectly elastic
     Fn = laws.normal_force(normal, DELTA, DELTAD, VIN, Pn)   # the ground cannot pull
-    mu = friction_coefficient(VT) if "friction" in features else sp.S.Zero
+    zdot = rate = sp.S.Zero
+    if "friction" not in features:
+        mu = sp.S.Zero
+    elif friction == "lugre":
+        mu, zdot, rate = laws.lugre(VT, ZB, P)
+    else:
+        mu = friction_coefficient(VT)
     # Eq. 7 with m = p = 1.5: -sign(xi) k_t |xi|^1.5 - d_t |xi|^1.5 v_t. Its xi-derivative is
     # written out so that it stays finite at xi = 0 (where the anchored variant starts).
     ax = sp.Abs(XI)
@@ -209,6 +223,8 @@ def contact_laws(variant: str, features=FEATURES, normal: str = "hunt_crossley")
         "F_n": Fn,
         "F_t": Ft.subs(FN, Fn),
         "mu": mu,
+        "zdot": zdot,
+        "z_rate": rate,
         "dFn_ddelta": sp.diff(Fn, DELTA),
         "dFn_ddeltad": sp.diff(Fn, DELTAD),
         "dFt_dxi": d_sd_dxi,

@@ -32,17 +32,25 @@ class KernelSpec:
     variant: str
     features: tuple = mdl.FEATURES
     normal: str = "hunt_crossley"
+    friction: str = "coulomb"
 
     @property
     def name(self):
         missing = [f for f in mdl.FEATURES if f not in self.features]
         law = "" if self.normal == "hunt_crossley" else "_" + self.normal
-        return self.variant + "".join("_no_" + f for f in missing) + law
+        fr = "" if self.friction == "coulomb" else "_" + self.friction
+        return self.variant + "".join("_no_" + f for f in missing) + law + fr
+
+    @property
+    def nx(self):
+        """Size of the continuous state of this kernel's friction law (layout.STATE_LAYOUTS)."""
+        return len(layout.STATE_LAYOUTS[self.friction])
 
     @property
     def mechanics(self):
         """The kernel whose mechanical stages this one shares (same variant and features,
-        Hunt-Crossley): only the contact stages depend on the normal law."""
+        Hunt-Crossley, smooth Coulomb): only the contact stages (and, under LuGre, the
+        kinematics, which carry the bristle state) depend on the contact laws."""
         return KernelSpec(self.variant, self.features)
 
     @property
@@ -67,12 +75,13 @@ def _trig(expr):
 
 def kinematics(spec: KernelSpec):
     """Expressions of `layout.KIN` for both feet (foot-major order)."""
-    return [_trig(e) for i in range(2) for e in mdl.contact_kinematics(i, spec.variant).values()]
+    return [_trig(e) for i in range(2)
+            for e in mdl.contact_kinematics(i, spec.variant, spec.friction).values()]
 
 
 def contact(spec: KernelSpec):
     """Expressions of `layout.CONTACT` for one penetrating support foot."""
-    return list(mdl.contact_laws(spec.variant, spec.features, spec.normal).values())
+    return list(mdl.contact_laws(spec.variant, spec.features, spec.normal, spec.friction).values())
 
 
 def forcing(spec: KernelSpec) -> sp.Matrix:

@@ -6,6 +6,7 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 project = "pdw"
+copyright = "2026 the pdw authors, MIT licence"
 author = "pdw developers"
 extensions = ["sphinx.ext.autodoc", "sphinx.ext.napoleon", "sphinx.ext.mathjax", "myst_parser",
               "sphinx_gallery.gen_gallery"]

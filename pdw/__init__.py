@@ -15,6 +15,7 @@ contact_forces          contact kinematics and forces of both feet (Eqs. 3-11)
 energies                kinetic and potential energies
 simulate, Result        one compiled simulation (support flags, events, status)
 simulate_batch          N walkers in one call, W lanes in lockstep (docs/ensemble.md): BatchResult
+simulate_many           N walkers: the batch engine when it runs the method, else pdw.simulate
 Contact                 the normal and friction contact laws of a run (docs/contact_laws.md)
 Scene, run              everything a simulation needs, as one object or TOML file (docs/scenes.md)
 steps                   per-step gait descriptors (docs/model.md section 8)
@@ -27,6 +28,8 @@ continue_gait, Branch   continuation of gaits in one parameter: branches, Floque
                         ``pdw continue``)
 sweep                   parameter studies from TOML files: run_study, load_study (``pdw sweep``)
 examples                the scenes and studies shipped with pdw (``pdw run --list-examples``)
+Progress                the progress bar of long jobs (``progress=`` of sweeps, cell maps, basins,
+                        continuation, figures; tqdm when installed, quiet off a terminal)
 PdwError, SimulationError, DivergedError, InvalidInputError   the error hierarchy
 STATE, VARIANTS         the state layout and the contact variants (docs/model.md section 6)
 """
@@ -64,9 +67,11 @@ from .core.model import (
 )
 from .core.ode import OdeFunction, ode_function
 from .core.params import X0_DISTURBED, X0_PAPER, Params
+from .core.progress import Progress
 from .sim import scene
 from .sim.batch import BatchResult, simulate_batch
 from .sim.buffers import RecordBuffer
+from .sim.ensemble import simulate_many
 from .sim.files import load
 from .sim.gait import Steps, steps
 from .sim.scene import Scene, run
@@ -82,11 +87,12 @@ del _name, _module
 
 __all__ = [
     "Params", "rhs", "jacobian", "mass_matrix", "contact_forces", "ContactState", "energies",
-    "STATE", "VARIANTS", "INPUT_HASH", "simulate", "Result", "simulate_batch", "BatchResult", "Event", "METHODS", "X0_PAPER",
+    "STATE", "VARIANTS", "INPUT_HASH", "simulate", "Result", "simulate_batch", "simulate_many", "BatchResult",
+    "Event", "METHODS", "X0_PAPER",
     "X0_DISTURBED", "steps", "Steps", "PdwError", "SimulationError", "DivergedError",
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait", "Scene", "run",
     "limit_cycle", "cell_mapping", "find_gait", "sweep",
     "StepSizeWarning", "StepSizeError", "examples", "continue_gait", "Branch", "Bifurcation",
     "ode_function", "OdeFunction", "load", "RecordBuffer",
-    "Contact",
+    "Contact", "Progress",
 ]

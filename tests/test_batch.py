@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 
 import pdw
-from pdw.core import _layout
-from pdw.sim.batch import simulate_batch
+from pdw.core import _batch, _layout
+from pdw.sim.batch import ISA_ENV, simulate_batch
 
 T_END = 1.2      # long enough for touch-downs, lift-offs, gait steps and falls
 
@@ -110,8 +110,15 @@ def test_bad_row_is_named():
         simulate_batch(_states(2), t_end=T_END, params=[pdw.Params.paper(), "paper"])
     with pytest.raises(pdw.InvalidInputError, match=r"\(N, 8\)"):
         simulate_batch(np.zeros((3, 7)), t_end=T_END)
-    with pytest.raises(pdw.InvalidInputError, match="cdm"):
-        simulate_batch(_states(2), t_end=T_END, method="rodas4")
+    with pytest.raises(pdw.InvalidInputError, match="method"):
+        simulate_batch(_states(2), t_end=T_END, method="euler")
+    with pytest.raises(pdw.InvalidInputError, match="vector"):
+        simulate_batch(_states(2), t_end=T_END, method="rodas4", vector=True)
+    with pytest.raises(pdw.InvalidInputError, match="rtol"):
+        simulate_batch(_states(2), t_end=T_END, method="rodas4", rtol=0.0)
+    with pytest.raises(pdw.InvalidInputError, match="row 1"):
+        simulate_batch(_states(2), t_end=T_END, method="rodas4",
+                       params=[pdw.Params.paper(), None])
 
 
 def test_dataframe():
@@ -162,3 +169,145 @@ def test_threads_and_lanes_are_checked():
         simulate_batch(_states(2), t_end=T_END, threads=0)
     with pytest.raises(pdw.InvalidInputError, match="lanes"):
         simulate_batch(_states(2), t_end=T_END, lanes=65)
+
+
+# ---- the other methods: per-lane rounds through the scalar integrators' C ----------------
+
+def _assert_bitwise(b, i, r):
+    """_assert_same, and the final state bit for bit."""
+    _assert_same(b, i, r, rtol=0.0)
+    assert np.array_equal(b.x_final[i], r.x_final), (i, b.x_final[i] - r.x_final)
+
+
+@pytest.mark.parametrize("n, lanes, threads", [(1, 8, 1), (11, 4, 1), (13, 8, 2)])
+def test_rodas4_lanes_are_the_scalar_runs_bitwise(n, lanes, threads):
+    """Each lane has its own step size, rejections and located events; resumed one accepted
+    step at a time it is bit for bit `simulate(method="rodas4")`: batch of 1, non-full last
+    blocks, threads, a mix of falls and walks."""
+    x = _states(n, seed=4)
+    b = simulate_batch(x, t_end=T_END, dt=1e-4, method="rodas4", rtol=1e-6, atol=1e-8,
+                       lanes=lanes, threads=threads)
+    statuses = set()
+    for i in range(n):
+        r = _scalar(x[i], pdw.Params.paper(), method="rodas4", rtol=1e-6, atol=1e-8)
+        _assert_bitwise(b, i, r)
+        statuses.add(r.status)
+    if n > 1:
+        assert statuses >= {"walked", "fell"}, statuses
+        # the lanes did take different step sequences (adaptive, not lockstep in time)
+        assert len(set(b.n_steps[b.status == "walked"])) > 1
+
+
+def test_rodas4_per_walker_params_tolerances_and_stop_conditions():
+    x = _states(5, seed=5)
+    x[:, 6] = pdw.X0_PAPER[6]
+    params = [pdw.Params.paper(d_hip=d) for d in np.linspace(0.005, 0.03, 5)]
+    kw = dict(rtol=1e-5, atol=1e-7, h_max=2e-3, event_tol=1e-8, stop_steps=1)
+    b = simulate_batch(x, t_end=T_END, params=params, method="rodas4", lanes=2, threads=1, **kw)
+    for i in range(5):
+        _assert_bitwise(b, i, _scalar(x[i], params[i], method="rodas4", **kw))
+    assert set(b.stop_reason) == {"steps"}
+    assert len(set(np.round(b.x_final[:, 6], 9))) > 1
+
+
+def test_rodas4_step_budget_is_per_walker():
+    x = _states(3, seed=6)
+    b = simulate_batch(x, t_end=T_END, method="rodas4", max_steps=50, lanes=2, threads=1)
+    for i in range(3):
+        r = _scalar(x[i], pdw.Params.paper(), method="rodas4", max_steps=50)
+        _assert_bitwise(b, i, r)
+    assert "diverged" in set(b.status)
+
+
+@pytest.mark.parametrize("method, dt", [("verlet", 4e-6), ("rk4", 4e-6), ("dopri5", 1e-4)])
+def test_other_methods_are_the_scalar_runs_bitwise(method, dt):
+    """The same per-lane rounds serve every method (explicit ones at a step they are stable
+    at, past a lift-off and a touch-down)."""
+    x = _states(3, seed=7)
+    b = simulate_batch(x, t_end=0.4, dt=dt, method=method, lanes=2, threads=1,
+                       check_step="off")
+    assert np.all(b.n_touch_down >= 1) and np.all(b.n_lift_off >= 1)
+    for i in range(3):
+        r = pdw.simulate(x[i], t_end=0.4, dt=dt, method=method, record_every=1,
+                         record_forces=False, on_failure="return", check_step="off")
+        _assert_bitwise(b, i, r)
+
+
+# ---- the cdm lane loops: structure of arrays per instruction set, dispatched at run time ----
+
+ISAS = [n for n in _batch.ISAS if _batch.isa_supported(n)]
+
+
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("variant, n, lanes", [("paper", 13, 8), ("consistent", 7, 3),
+                                               ("paper", 70, 64)])
+def test_every_lane_loop_is_bitwise_the_scalar_run(isa, variant, n, lanes, monkeypatch):
+    """PDW_BATCH_ISA forces each loop this CPU runs (so the narrower ones are tested on a wide
+    machine): the structure-of-arrays step (masks, the generated batched stages) is the scalar
+    step bit for bit, events, falls and failures going through the scalar code."""
+    monkeypatch.setenv(ISA_ENV, isa)
+    x = _states(n, seed=8)
+    b = simulate_batch(x, t_end=T_END, lanes=lanes, threads=1, variant=variant,
+                       check_step="off")
+    statuses = set()
+    for i in range(n):
+        r = _scalar(x[i], pdw.Params.paper(), variant=variant)
+        _assert_bitwise(b, i, r)
+        statuses.add(r.status)
+    assert statuses >= {"walked", "fell"}, statuses
+
+
+@pytest.mark.parametrize("isa", ISAS)
+def test_vector_trig_is_lane_independent_per_isa(isa, monkeypatch):
+    monkeypatch.setenv(ISA_ENV, isa)
+    x = _states(11, seed=9)
+    ref = simulate_batch(x, t_end=0.6, lanes=1, threads=1, vector=True, check_step="off")
+    for lanes in (3, 8, 16):
+        b = simulate_batch(x, t_end=0.6, lanes=lanes, threads=1, vector=True, check_step="off")
+        np.testing.assert_array_equal(b.x_final, ref.x_final)
+
+
+def test_isa_choice_is_checked(monkeypatch):
+    monkeypatch.setenv(ISA_ENV, "sse9")
+    with pytest.raises(pdw.InvalidInputError, match=ISA_ENV):
+        simulate_batch(_states(2), t_end=0.1)
+    missing = [n for n in _batch.ISAS if not _batch.isa_supported(n)]
+    if missing:
+        monkeypatch.setenv(ISA_ENV, missing[0])
+        with pytest.raises(pdw.InvalidInputError, match="does not run"):
+            simulate_batch(_states(2), t_end=0.1)
+
+
+@pytest.mark.parametrize("method, isa", [("rodas4", None), ("cdm", ISAS[-1])])
+def test_lane_loops_stop_on_a_cancel_token(method, isa, monkeypatch):
+    """The per-method rounds and the SoA loop poll like the first loop: a cancelled token stops
+    them within a second; finished walkers keep their rows, the others are "interrupted" at a
+    finite state."""
+    import threading
+    import time
+
+    from pdw.core import interrupt
+    if isa:
+        monkeypatch.setenv(ISA_ENV, isa)
+    token, out = interrupt.Token(), {}
+
+    def worker():
+        interrupt._local.token = token
+        t0 = time.monotonic()
+        try:
+            simulate_batch(np.tile(pdw.X0_PAPER, (3000, 1)), t_end=3.5, method=method,
+                           threads=1, check_step="off")
+            out["r"] = ("finished", time.monotonic() - t0, None)
+        except KeyboardInterrupt as e:
+            out["r"] = ("interrupted", time.monotonic() - t0, e.result)
+
+    t = threading.Thread(target=worker)
+    t.start()
+    time.sleep(1.0)
+    token.set()
+    t.join(30)
+    what, seconds, res = out["r"]
+    assert what == "interrupted" and seconds < 3.0, out["r"]
+    stopped = res.status == "interrupted"
+    assert stopped.any() and np.isfinite(res.x_final).all()
+    assert set(res.status[~stopped]) <= {"walked", "periodic", "fell", "diverged", "no_steps"}

@@ -1,4 +1,5 @@
 """The command line: `pdw walk`, `pdw run`, `pdw sweep` options, exit codes and messages."""
+import io
 import json
 import os
 import subprocess
@@ -177,3 +178,19 @@ def test_unreadable_files_are_one_line_errors(tmp_path, capsys):
         assert cli.main(argv) == 2
         err = capsys.readouterr().err
         assert err.startswith("pdw: ") and "missing.toml" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("flag", [[], ["--no-progress"]])
+def test_walk_draws_a_bar_over_its_figures_on_a_terminal_only(tmp_path, monkeypatch, flag):
+    pytest.importorskip("matplotlib")
+
+    class Tty(io.StringIO):
+        def isatty(self):
+            return True
+
+    err = Tty()
+    monkeypatch.setattr(sys, "stderr", err)
+    rc = cli.main(["walk", "--t-end", "0.5", "--out", str(tmp_path)] + flag)
+    assert rc == 0 and (tmp_path / "walker.gif").exists()
+    drawn = "figures" in err.getvalue()
+    assert drawn == (flag == []), err.getvalue()

@@ -207,3 +207,34 @@ def test_approach_speed_is_captured_at_touch_down():
         assert np.allclose(r.Fn[idx[pen], j], want[pen], rtol=1e-10, atol=1e-9)
         other = np.maximum(P.k_n * delta ** 1.5 * (1 + chi * deltad / (1.2 * v_in)), 0.0)
         assert not np.allclose(r.Fn[idx[pen], j], other[pen], rtol=1e-3)
+
+
+def test_flores_fixed_point_reproduces_itself_under_simulate():
+    """find_gait with Flores carries the approach speeds through the section: its fixed point is
+    the continuous run's periodic orbit. From the fixed point's state (the trailing foot's
+    approach speed = the landing one, as on the orbit), a continuous run returns to the same
+    section point at every touch-down; with both feet re-initialised (the section's old
+    behaviour) it does not."""
+    from pdw.analysis import limit_cycle as LC
+    from pdw.core.model import contact_forces
+    c = Contact("flores", e=0.18)
+    P = pdw.Params.paper_steady()
+    g = LC.find_gait(P, contact=c, workers=2)
+    z, tol = g.details["z"], 1e-9
+    assert g.details["residual"] < tol
+    x0 = LC.embed(z, P)
+    v2 = -float(contact_forces(x0, P, flags=(1, 1)).v_y[1])
+    assert v2 > 0.5                                  # a landing, not a resting foot
+
+    def returns(a0):
+        r = pdw.simulate(x0, t_end=3.0, params=P, method="rodas4", flags0=(1, 1), contact=c,
+                         record_every=1, approach_speeds0=a0, **LC.TIGHT)
+        out = []
+        for e in (e for e in r.events if e.kind == "touch_down"):
+            i = int(np.searchsorted(r.t, e.t))
+            out.append(np.max(np.abs(LC.section_coordinates(r.x[i], e.leg) - z)))
+        return np.array(out)
+
+    d = returns((v2, v2))
+    assert len(d) >= 4 and d[0] < 10 * tol and d.max() < 1e-7, d
+    assert returns(None)[0] > 1e-2                   # the re-initialised section is far off

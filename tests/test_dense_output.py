@@ -107,3 +107,35 @@ def test_record_buffer_gives_the_same_run(method):
         assert np.array_equal(a.x, b.x)          # a view: overwritten by the next run
     with pytest.raises(pdw.InvalidInputError, match="out"):
         pdw.simulate(t_end=0.1, out=np.zeros(3))
+
+
+@pytest.mark.parametrize("method", pdw.METHODS)
+@pytest.mark.parametrize("contact", [pdw.Contact("flores", e=0.18),
+                                     pdw.Contact("lankarani_nikravesh", e=0.9),
+                                     pdw.Contact("kelvin_voigt", k=7318.0, d=112.0)])
+def test_t_eval_with_another_normal_law_is_the_recorded_run(method, contact):
+    """t_eval at the recorded steps gives the recorded states and forces with every normal law:
+    the approach speeds captured at the touch-downs are part of what the interpolant sees."""
+    kw = dict(t_end=0.8, method=method, dt=2e-6 if method in ("rk4", "dopri5") else 1e-4,
+              check_step="off", contact=contact)
+    r = pdw.simulate(pdw.X0_PAPER, dense_output=True, **kw)
+    assert sum(e.kind == "touch_down" and e.leg == 1 for e in r.events) >= 1
+    pick = r.t[:: max(1, len(r.t) // 60)]
+    s = pdw.simulate(pdw.X0_PAPER, t_eval=pick, **kw)
+    idx = np.searchsorted(r.t, pick, side="right") - 1
+    np.testing.assert_array_equal(s.x, r.x[idx])
+    np.testing.assert_allclose(s.Fn, r.Fn[idx], rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(s.Ft, r.Ft[idx], rtol=1e-12, atol=1e-9)
+    if contact.normal != "kelvin_voigt":
+        # without the captured approach speeds (v_in -> v_in_min) the stance forces differ:
+        # the test above sees them
+        an = r.sol.anchors.copy()
+        an[:, 2:] = 0.0
+        stance = (r.flags[:, 0] == 1) & (r.Fn[:, 0] > 1.0)
+        i = np.flatnonzero(stance)[len(np.flatnonzero(stance)) // 2]
+        c_ok = pdw.contact_forces(r.x[i], r.params, flags=tuple(r.flags[i]),
+                                  anchors=tuple(r.sol.anchors[i]), contact=contact)
+        c_no = pdw.contact_forces(r.x[i], r.params, flags=tuple(r.flags[i]),
+                                  anchors=tuple(an[i]), contact=contact)
+        assert c_ok.F_n[0] == pytest.approx(r.Fn[i, 0], rel=1e-12)
+        assert abs(c_no.F_n[0] - r.Fn[i, 0]) > 1e-3 * r.Fn[i, 0]

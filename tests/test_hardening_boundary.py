@@ -25,6 +25,7 @@ import pdw
 from pdw.core import _core, _hybrid
 from pdw.core.model import parameter_vector
 NX, NP, NW = _core.NX, _core.NP, _core.NWORK
+NC = 2 * len(pdw.core._layout.CONTACT)
 P = parameter_vector(pdw.Params.paper())
 x = np.tile(np.array(pdw.X0_PAPER), (4, 1))
 f = np.tile(np.array([0, 1], dtype=np.intc), (4, 1))
@@ -42,7 +43,7 @@ CASES = [
     ("_core.rhs_batch(0, x[:, :3].copy(), P, f, a, np.empty((4, NX)), np.empty((4, NW)))", "x"),
     ("_core.jacobian_batch(0, x, P, f, a, np.empty((4, 8)), np.empty((4, NW)))", "J"),
     ("_core.energies_batch(0, x, P, np.empty((1, 3)))", "e"),
-    ("_core.cdm_terms(0, x[0], P, np.zeros(14), np.empty(4), np.empty(16), np.empty(4))", "M"),
+    ("_core.cdm_terms(0, x[0], P, np.zeros(NC), np.empty(4), np.empty(16), np.empty(4))", "M"),
     ("_core.cdm_terms(0, x[0], P, np.zeros(2), np.empty(16), np.empty(16), np.empty(4))",
      "contact"),
     ("_core.precompute(np.ones(3), np.empty(NP))", "params"),

@@ -39,6 +39,55 @@ def test_returns_a_fresh_array_each_call():
     assert not np.shares_memory(a, b) and not np.array_equal(a, b)
 
 
+def test_kept_results_are_not_overwritten_by_later_calls():
+    """f and jac compute into an internal buffer and return a copy: what a caller keeps stays."""
+    f = pdw.ode_function()
+    a, ja = f(0, X0), f.jac(0, X0)
+    a0, ja0 = a.copy(), ja.copy()
+    b, jb = f(0, X0 + 0.01), f.jac(0, X0 + 0.01)
+    np.testing.assert_array_equal(a, a0)
+    np.testing.assert_array_equal(ja, ja0)
+    assert not np.array_equal(a, b) and not np.array_equal(ja, jb)
+    assert not np.shares_memory(ja, jb)
+
+
+def test_every_input_layout_gives_the_fast_paths_values():
+    """The raw-buffer path (C-contiguous float64 (8,)) and the converting path agree."""
+    import array
+    f = pdw.ode_function(flags=(1, 1), anchors=(0.01, -0.02))
+    want, want_j = f(0, X0), f.jac(0, X0)
+    strided = np.zeros((8, 3))
+    strided[:, 1] = X0
+    for x in (X0.tolist(), strided[:, 1], array.array("d", X0), memoryview(X0), X0.reshape(1, 8)[0], X0.astype(">f8")):
+        np.testing.assert_array_equal(f(0, x), want)
+        np.testing.assert_array_equal(f.general(0, x), want)
+        np.testing.assert_array_equal(f.jac(0, x), want_j)
+    np.testing.assert_array_equal(f(0, np.stack([X0, X0])), np.stack([want, want]))
+    x32 = X0.astype(np.float32)
+    np.testing.assert_array_equal(f(0, x32), f(0, x32.astype(np.float64)))
+
+
+@pytest.mark.parametrize("x", [np.zeros(7), np.zeros(9), [0.0] * 7, np.zeros((2, 4)).ravel()[:5]])
+def test_a_state_of_the_wrong_shape_is_refused_naming_x(x):
+    f = pdw.ode_function()
+    for call in (f, f.jac, f.general):
+        with pytest.raises(pdw.InvalidInputError, match=r"x must .*shape \(8,\)"):
+            call(0.0, x)
+
+
+def test_rhs_fast_path_agrees_with_its_general_path_for_every_layout():
+    strided = np.zeros((8, 2))
+    strided[:, 0] = X0
+    want = pdw.rhs(X0.tolist())
+    for x in (X0, strided[:, 0], np.asfortranarray(X0)):
+        np.testing.assert_array_equal(pdw.rhs(x), want)
+    x32 = X0.astype(np.float32)
+    np.testing.assert_array_equal(pdw.rhs(x32), pdw.rhs(x32.tolist()))
+    a = pdw.rhs(X0)
+    pdw.rhs(X0 + 0.1)
+    np.testing.assert_array_equal(a, want)
+
+
 @pytest.mark.parametrize("kw, field", [({"flags": (0, 2)}, "flags"), ({"anchors": (0, np.nan)}, "anchors"),
                                        ({"variant": "soft"}, "variant"), ({"params": 3}, "params"),
                                        ({"features": ("wings",)}, "feature")])

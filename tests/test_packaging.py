@@ -58,6 +58,7 @@ def test_wheel_carries_the_package_and_no_sources(dists):
     assert "pdw/examples/studies/fig11_k_n.toml" in names
     assert any(n.endswith("LICENSE") for n in names)
     assert any(n.startswith("pdw/") and n.endswith(".so") for n in names)
+    assert "pdw/py.typed" in names and "pdw/core/_core.pyi" in names      # PEP 561
     bad = [n for n in names if n.endswith((".c", ".h", ".pyx")) or "/tests/" in n]
     assert bad == []
     meta = zipfile.ZipFile(dists[1]).read(

@@ -1,4 +1,5 @@
 """Tests of pdw.present.plots: files written, image sizes, GIF frames, the double-support zoom."""
+import io
 import subprocess
 import sys
 
@@ -8,6 +9,7 @@ import pytest
 pytest.importorskip("matplotlib")
 PIL_Image = pytest.importorskip("PIL.Image")
 
+from pdw.core.progress import Progress  # noqa: E402
 from pdw.present import plots  # noqa: E402
 from pdw.sim.simulation import simulate  # noqa: E402
 
@@ -21,10 +23,26 @@ def run():
     return r
 
 
+class _Tty(io.StringIO):
+    def isatty(self):
+        return True
+
+
 @pytest.fixture(scope="module")
-def written(run, tmp_path_factory):
+def bar():
+    return Progress(stream=_Tty())
+
+
+@pytest.fixture(scope="module")
+def written(run, tmp_path_factory, bar):
     out = tmp_path_factory.mktemp("plots")
-    return out, plots.save_all(run, out)
+    return out, plots.save_all(run, out, progress=bar)
+
+
+def test_save_all_advances_its_bar_one_unit_per_file(written, bar):
+    _, paths = written
+    assert (bar.done, bar.total) == (len(paths), len(paths))
+    assert "figures" in bar.stream.getvalue() and "%d/%d" % (len(paths), len(paths)) in bar.stream.getvalue()
 
 
 def _events_double_supports(result):

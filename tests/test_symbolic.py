@@ -173,6 +173,7 @@ def _kin_transcribed(i, variant):
         out["v_y"] = yd_o + (l - r) * sp.sin(th) * thd               # d/dt of Eq. 4
         out["xi"] = out["s"] - s0[i]                                 # slip since touch-down
     out["v_in"] = sp.Symbol("v_in%d" % (i + 1), real=True)        # approach speed at touch-down
+    out["z"] = sp.S.Zero                                          # no bristle state (Coulomb)
     return out
 
 
@@ -182,6 +183,10 @@ def test_contact_kinematics_match_model_md(foot, variant):
     derived = dm.contact_kinematics(foot, variant)
     mine = _kin_transcribed(foot, variant)
     assert set(derived) == set(mine)
+    # under LuGre friction the foot's bristle state z_i, the rest unchanged
+    lugre = dm.contact_kinematics(foot, variant, "lugre")
+    assert lugre["z"] == sp.Symbol("z%d" % (foot + 1), real=True)
+    assert all(lugre[k] == derived[k] for k in derived if k != "z")
     for name, expr in mine.items():
         assert is_zero(derived[name] - expr), (foot, variant, name, derived[name])
     # only the foot's own angle enters

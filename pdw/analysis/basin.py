@@ -17,13 +17,20 @@ and is classed by its outcome:
 """
 from __future__ import annotations
 
+import hashlib
+import json
+import os
+import pathlib
+import tempfile
 import time
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..core import _layout
 from ..core.errors import InvalidInputError
 from ..core.params import Params
+from ..core.progress import progress_bar
 from ..sim.batch import simulate_batch
 from . import cell_mapping as cmap
 from . import limit_cycle as lc
@@ -50,6 +57,9 @@ class Basin:
         Step length [m] and period [s] of the reference gait (the reference point's own walk).
     wall_time : float
         Seconds for the whole grid; ``walkers`` its size.
+    cpu_time : float
+        Process CPU seconds of the grid's chunks (this process's, all threads; NaN for chunks
+        computed on an executor's workers or read from a checkpoint that did not keep it).
     """
 
     phi: np.ndarray
@@ -61,6 +71,7 @@ class Basin:
     gait_P: float
     wall_time: float
     walkers: int
+    cpu_time: float = float("nan")
 
     def fraction(self, outcome=GAIT) -> float:
         """Fraction of the grid with this outcome."""
@@ -68,7 +79,6 @@ class Basin:
 
 
 def _last(b, field):
-    from ..core import _layout
     j = _layout.STEP.index(field)
     idx = np.minimum(b.n_gait_steps, _layout.STEP_RING) - 1
     out = np.full(len(b), np.nan)
@@ -77,9 +87,43 @@ def _last(b, field):
     return out
 
 
+def _classify(res, L0, P0, match_tol):
+    """Outcome codes of a batch's walkers against the reference gait (L0, P0)."""
+    L, P = _last(res, "L"), _last(res, "P")
+    same = (np.abs(L - L0) <= match_tol * abs(L0)) & (np.abs(P - P0) <= match_tol * P0)
+    out = np.where(res.walked, UNDECIDED, FELL)
+    per = res.status == "periodic"
+    out[per & same] = GAIT
+    out[per & ~same] = OTHER
+    return out
+
+
+def _key(p, A, B, opts):
+    """What decides a basin's numbers (a checkpoint of other settings is not reused)."""
+    text = json.dumps({"params": p.as_dict(), "phi": A.tolist(), "thetad2": B.tolist(),
+                       "opts": opts, "model": _layout.INPUT_HASH}, sort_keys=True, default=repr)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def _save(path, **arrays):
+    """Write the checkpoint atomically (a temporary file in the same folder, then rename)."""
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix="." + path.name, suffix=".tmp.npz")
+    os.close(fd)
+    try:
+        np.savez(tmp, **arrays)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
 def basin(params=None, phi=(0.69, 0.81, 100), thetad2=(-3.2, -0.4, 100), *, t_end=8.0,
           dt=1e-4, periodic_steps=4, periodic_tol=1e-3, match_tol=0.02, reference=None,
-          threads=None, lanes=8, vector=False) -> Basin:
+          threads=None, lanes=8, vector=False, chunk_size=4096, checkpoint=None,
+          executor=None, progress=False) -> Basin:
     """Basin of the gait reached from ``reference`` on a ``phi`` x ``thetad2`` grid.
 
     Parameters
@@ -99,7 +143,25 @@ def basin(params=None, phi=(0.69, 0.81, 100), thetad2=(-3.2, -0.4, 100), *, t_en
         Default `cell_mapping.reference_point(params)` (first touch-down of the paper's initial
         condition, found with rodas4).
     threads, lanes, vector
-        Passed to `pdw.simulate_batch`.
+        Passed to `pdw.simulate_batch` (per chunk).
+    chunk_size : int
+        Grid points per `simulate_batch` call (row-major: thetad2 slowest). Each chunk's
+        outcomes are final (no walker depends on another), so chunks can be saved and resumed.
+    checkpoint : path, optional
+        An ``.npz`` file written (atomically) after every chunk; a later call with the same
+        settings (parameters, grid, options, model hash) takes the chunks already there and
+        computes only the rest. A checkpoint of other settings is ignored and overwritten.
+    executor : concurrent.futures.Executor-like, optional
+        Run the chunks as ``executor.submit(simulate_batch, ...)`` tasks (a process pool, a
+        Dask client's executor); each chunk then uses ``threads`` threads (default 1 here).
+    progress : bool or pdw.Progress
+        A progress bar over grid points on stderr (`pdw.core.progress.progress_bar`).
+
+    Returns
+    -------
+    Basin
+        ``wall_time`` is the compute time of all chunks, those of a resumed checkpoint
+        included.
     """
     p = Params.paper_steady() if params is None else params
     if not isinstance(p, Params):
@@ -107,33 +169,71 @@ def basin(params=None, phi=(0.69, 0.81, 100), thetad2=(-3.2, -0.4, 100), *, t_en
     (a0, a1, na), (b0, b1, nb) = phi, thetad2
     if int(na) < 1 or int(nb) < 1:
         raise InvalidInputError("grid sizes must be >= 1, got %r, %r" % (na, nb))
+    chunk_size = int(chunk_size)
+    if chunk_size < 1:
+        raise InvalidInputError("chunk_size must be >= 1, got %r" % (chunk_size,))
     z_ref = cmap.reference_point(p) if reference is None else lc._z(reference, "reference")
     if z_ref is None:
         raise InvalidInputError("the paper's initial condition does not reach a touch-down "
                                 "with these params: give a reference section point")
     rest = cmap.rest_of(z_ref, p)
     A, B = np.linspace(a0, a1, int(na)), np.linspace(b0, b1, int(nb))
-    x0 = [lc.embed(z_ref, p)]
-    for b in B:
-        for a in A:
-            x0.append(lc.embed(cmap.cell_state(a, b, rest, p), p))
-    start = time.perf_counter()
-    res = simulate_batch(np.array(x0), t_end=t_end, dt=dt, params=p, flags0=(1, 1),
-                         periodic_steps=periodic_steps, periodic_tol=periodic_tol,
-                         threads=threads, lanes=lanes, vector=vector)
-    wall = time.perf_counter() - start
-    L, P = _last(res, "L"), _last(res, "P")
-    if res.status[0] != "periodic":
+    opts = dict(t_end=t_end, dt=dt, params=p, flags0=(1, 1), periodic_steps=periodic_steps,
+                periodic_tol=periodic_tol, lanes=lanes, vector=vector)
+    ref = simulate_batch(lc.embed(z_ref, p)[None, :], threads=1, **opts)
+    if ref.status[0] != "periodic":
         raise InvalidInputError("the reference point does not settle into a periodic gait "
-                                "within t_end = %g s (status %s)" % (t_end, res.status[0]))
-    same = (np.abs(L - L[0]) <= match_tol * abs(L[0])) & (np.abs(P - P[0]) <= match_tol * P[0])
-    out = np.where(res.walked, UNDECIDED, FELL)
-    per = res.status == "periodic"
-    out[per & same] = GAIT
-    out[per & ~same] = OTHER
-    return Basin(phi=A, thetad2=B, outcome=out[1:].reshape(len(B), len(A)),
-                 n_steps=res.n_gait_steps[1:].reshape(len(B), len(A)), reference=z_ref,
-                 gait_L=float(L[0]), gait_P=float(P[0]), wall_time=wall, walkers=len(x0) - 1)
+                                "within t_end = %g s (status %s)" % (t_end, ref.status[0]))
+    L0, P0 = float(_last(ref, "L")[0]), float(_last(ref, "P")[0])
+    x0 = np.array([lc.embed(cmap.cell_state(a, b, rest, p), p) for b in B for a in A])
+    n = len(x0)
+    key = _key(p, A, B, {**{k: v for k, v in opts.items() if k != "params"},
+                         "match_tol": match_tol, "reference": z_ref.tolist()})
+    outcome = np.full(n, -1, dtype=np.int8)
+    steps = np.zeros(n, dtype=np.int64)
+    wall = cpu = 0.0
+    if checkpoint is not None and os.path.exists(checkpoint):
+        with np.load(checkpoint) as ck:
+            if str(ck["key"]) == key and ck["outcome"].shape == (n,):
+                outcome, steps, wall = ck["outcome"].copy(), ck["n_steps"].copy(), float(ck["wall"])
+                cpu = float(ck["cpu"]) if "cpu" in ck.files else float("nan")
+    bounds = [(lo, min(n, lo + chunk_size)) for lo in range(0, n, chunk_size)]
+    todo = [(lo, hi) for lo, hi in bounds if (outcome[lo:hi] < 0).any()]
+    bar = progress_bar(progress, n, "basin", done=n - sum(hi - lo for lo, hi in todo))
+    nthreads = threads if threads is not None else (1 if executor is not None else None)
+
+    def finish(lo, hi, res, seconds, cpu_seconds):
+        nonlocal wall, cpu
+        outcome[lo:hi] = _classify(res, L0, P0, match_tol)
+        steps[lo:hi] = res.n_gait_steps
+        wall += seconds
+        cpu += cpu_seconds
+        if checkpoint is not None:
+            _save(checkpoint, key=np.array(key), outcome=outcome, n_steps=steps,
+                  wall=np.array(wall), cpu=np.array(cpu))
+        bar.update(hi - lo)
+
+    try:
+        if executor is None:
+            for lo, hi in todo:
+                t0, c0 = time.perf_counter(), time.process_time()
+                res = simulate_batch(x0[lo:hi], threads=nthreads, **opts)
+                finish(lo, hi, res, time.perf_counter() - t0, time.process_time() - c0)
+        else:
+            t0 = time.perf_counter()
+            futs = [executor.submit(simulate_batch, x0[lo:hi], threads=nthreads, **opts)
+                    for lo, hi in todo]
+            for (lo, hi), f in zip(todo, futs):
+                res = f.result()
+                t1 = time.perf_counter()
+                finish(lo, hi, res, t1 - t0, float("nan"))
+                t0 = t1
+    finally:
+        bar.close()
+    shape = (len(B), len(A))
+    return Basin(phi=A, thetad2=B, outcome=outcome.astype(int).reshape(shape),
+                 n_steps=steps.reshape(shape), reference=z_ref, gait_L=L0, gait_P=P0,
+                 wall_time=wall, walkers=n, cpu_time=cpu)
 
 
 def plot(b: Basin, ax=None, title=None):

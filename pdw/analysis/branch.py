@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -68,7 +69,9 @@ class Bifurcation:
                                                         self.reason)
 
     def as_dict(self) -> dict:
-        m = [] if self.multipliers is None else np.asarray(self.multipliers)
+        """JSON-able fields: kind, value, tolerance, index, reason, z (or None), and the
+        multipliers as ``multipliers_re`` and ``multipliers_im`` lists."""
+        m = np.zeros(0) if self.multipliers is None else np.asarray(self.multipliers)
         return {"kind": self.kind, "value": self.value, "tolerance": self.tolerance,
                 "index": self.index, "reason": self.reason,
                 "z": None if self.z is None else np.asarray(self.z).tolist(),
@@ -122,13 +125,29 @@ class Branch:
                 % (self.parameter, self.model, self.period_n, len(self), self.parameter,
                    np.min(self.values), np.max(self.values), self.bifurcations, self.stop_reason))
 
-    def of_kind(self, kind) -> list:
-        """The bifurcations of one kind."""
+    def of_kind(self, kind: str) -> list[Bifurcation]:
+        """The bifurcations of one kind (`KINDS`: "fold", "period_doubling", ...)."""
         return [b for b in self.bifurcations if b.kind == kind]
 
-    def switch(self, bifurcation, amplitude=0.005, **kw) -> Gait:
-        """The first gait of the period-2n branch born at a period doubling (see
-        `pdw.analysis.continuation.switch_branch`)."""
+    def switch(self, bifurcation: Bifurcation, amplitude: float = 0.005, **kw: Any) -> Gait:
+        """The first gait of the period-2n branch born at a period doubling.
+
+        Parameters
+        ----------
+        bifurcation : Bifurcation
+            A ``period_doubling`` of this branch.
+        amplitude : float
+            Offset from the bifurcation's fixed point in the section coordinates (halved up to
+            ``max_tries`` times when Newton fails or lands back on the period-n branch).
+        **kw
+            Passed to `pdw.analysis.continuation.switch_branch` (``max_tries``).
+
+        Returns
+        -------
+        Gait
+            A period-2n gait; ``details["value"]`` and ``details["direction"]`` let
+            ``pdw.continue_gait(..., period=2n, start=gait)`` follow its branch.
+        """
         return self.switcher(self, bifurcation, amplitude=amplitude, **kw)
 
     # --- output -------------------------------------------------------------------------------
@@ -151,7 +170,7 @@ class Branch:
             out.append(r)
         return out
 
-    def to_csv(self, path):
+    def to_csv(self, path: str | os.PathLike) -> str | os.PathLike:
         """Write the per-point table (`rows`) to ``path``; returns the path."""
         rows = self.rows()
         with open(path, "w", newline="") as fh:
@@ -170,7 +189,7 @@ class Branch:
                 "wall_time_s": self.wall_time, "settings": self.settings,
                 "bifurcations": [b.as_dict() for b in self.bifurcations]}
 
-    def to_json(self, path, **extra):
+    def to_json(self, path: str | os.PathLike, **extra: Any) -> str | os.PathLike:
         """Write `summary` (plus ``extra``) as JSON to ``path``; returns the path."""
         with open(path, "w") as fh:
             json.dump({**self.summary(), **extra}, fh, indent=2, default=_jsonable)

@@ -238,3 +238,51 @@ def calibrate(params: Params | None = None, variant: str = "paper",
     e_drop = {law: e_of(c) for law, c in contacts.items()}
     sinks = {law: sink for law in contacts}
     return Calibration(landing, W, sinks, e_target, e_drop, contacts, reachable)
+
+
+@dataclass(frozen=True)
+class LugreCalibration:
+    """LuGre matched to the paper's friction law (`calibrate_lugre`): the `Contact`, the
+    tangential effective mass of a foot at mid-stance [kg], the weight [N], the bristle
+    mode's natural frequency sqrt(sigma0 W / m_t) [rad/s] and the presliding displacement
+    mu_s / sigma0 [m]."""
+
+    contact: Contact
+    mass: float
+    weight: float
+    omega: float
+    presliding: float
+
+
+def calibrate_lugre(params: Params | None = None, sigma0: float = 1e5,
+                    normal: str = "hunt_crossley", **normal_parameters) -> LugreCalibration:
+    """LuGre friction matched to the paper's smooth Coulomb law (Eq. 10) on physical grounds.
+
+    * Stribeck curve: mu_s = `Params.mu_s`, mu_c = `Params.mu_d`, and v_s such that g(v) is
+      half-way from mu_s to mu_c where Eq. 10's cubic step is, at (v_s + v_d)/2
+      (`pdw.core.contact.lugre_stribeck`).
+    * sigma0 [1/m]: the bristle stiffness per unit normal force; default 1e5 (Canudas de Wit et
+      al. 1995), a presliding displacement mu_s / sigma0 of 5 um: stiff against the foot's
+      travel, as the paper's law, which lets the stuck foot creep at most v_s.
+    * sigma1 [s/m]: critically damped bristles for the foot that carries the weight W:
+      sigma1 = 2 sqrt(sigma0 m_t / W), m_t = 1/(J M^-1 J^T) with J = dv_x/dq' of a foot at
+      mid-stance (both legs vertical).
+    * sigma2 = 0: Eq. 10 has no viscous term (mu = mu_d for every |v| > v_d).
+
+    ``normal`` and ``normal_parameters`` (k, d, e, ...) give the normal law, as `Contact`.
+    """
+    from ..core.contact import lugre_stribeck
+    from ..core.model import mass_matrix
+    params = Params.paper_steady() if params is None else params
+    W = params.weight
+    q = np.zeros(_layout.NQ)
+    q[_layout.STATE.index("y_o")] = params.l
+    J = np.zeros(_layout.NQ)                 # v_x = xd_o + ((l - r) cos(theta) + r) thetad
+    J[_layout.STATE.index("x_o")] = 1.0
+    J[_layout.STATE.index("theta1")] = params.l
+    m_t = 1.0 / float(J @ np.linalg.solve(mass_matrix(q, params), J))
+    sigma1 = 2.0 * math.sqrt(sigma0 * m_t / W)
+    st = lugre_stribeck(params)
+    c = Contact(normal, friction="lugre", sigma0=sigma0, sigma1=sigma1, sigma2=0.0, **st,
+                **normal_parameters)
+    return LugreCalibration(c, m_t, W, math.sqrt(sigma0 * W / m_t), st["mu_s"] / sigma0)

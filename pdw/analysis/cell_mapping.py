@@ -39,6 +39,7 @@ import numpy as np
 from ..core import interrupt
 from ..core.errors import InvalidInputError
 from ..core.params import X0_PAPER, Params
+from ..core.progress import progress_bar
 from . import limit_cycle as lc
 
 SINK = -1
@@ -208,7 +209,7 @@ def _cell_index(a_edges, b_edges, a, b):
 
 
 def cell_map(params=None, variant="paper", phi=(0.69, 0.81, 80), thetad2=(-3.2, -0.4, 80), *,
-             reference=None, method="rodas4", workers=None, **options) -> CellMap:
+             reference=None, method="rodas4", workers=None, progress=False, **options) -> CellMap:
     """Simple cell mapping of the touch-down map on a (phi, thetad2) grid.
 
     Parameters
@@ -221,6 +222,8 @@ def cell_map(params=None, variant="paper", phi=(0.69, 0.81, 80), thetad2=(-3.2, 
         Section point whose four non-grid coordinates the cells use (default `reference_point`).
     workers : int
         Threads for the map evaluations (default: all cores).
+    progress : bool or pdw.Progress
+        A bar over the cells on stderr when it is a terminal (`pdw.core.progress`).
     options
         Step-map options (default `pdw.limit_cycle.LOOSE`: rtol 1e-7).
 
@@ -245,7 +248,7 @@ def cell_map(params=None, variant="paper", phi=(0.69, 0.81, 80), thetad2=(-3.2, 
     A = np.repeat(0.5 * (a_edges[1:] + a_edges[:-1]), int(nb))
     B = np.tile(0.5 * (b_edges[1:] + b_edges[:-1]), int(na))
     Z = np.array([cell_state(A[c], B[c], rest[c], p) for c in range(N)])
-    outs = lc.map_batch(Z, p, variant, method, workers=workers, t_hint=0.6, **opts)
+    outs = lc.map_batch(Z, p, variant, method, workers=workers, t_hint=0.6, progress=progress, **opts)
     image_point = np.array([s["z"] for s in outs])
     status = np.array([s["status"] for s in outs], dtype=object)
     g = grid_of(image_point)
@@ -295,13 +298,13 @@ def plot_basin(cm: CellMap, ax=None, fixed_point=None, title=None, max_steps=8):
 
 
 def point_mapping_basin(cm: CellMap, z_star, *, n_steps=12, tol=1e-4, workers=None,
-                        **options):
+                        progress=False, **options):
     """Check of a cell map against the full dynamics: from every cell's centre state, iterate
     the touch-down map (6-D, no cells) up to ``n_steps`` steps; a cell is in the basin when the
     orbit comes within ``tol`` (max norm) of the fixed point ``z_star``.
 
     Returns (converged, steps): boolean mask (N,) and the number of steps taken (N,) (-1 when
-    a step failed).
+    a step failed). ``progress``: False, True or a `pdw.Progress` (one unit per cell).
     """
     p = cm.params
     opts = {**cm.info.get("options", lc.LOOSE), **options}
@@ -310,7 +313,8 @@ def point_mapping_basin(cm: CellMap, z_star, *, n_steps=12, tol=1e-4, workers=No
     z_star = np.asarray(z_star, dtype=float)
     fn = lambda z: _converge(z, z_star, n_steps, tol, p, cm.variant, cm.info.get("method", "rodas4"), opts)  # noqa: E731
     nw = min(lc._workers(workers), len(Z))
-    outs = interrupt.thread_map(fn, Z, nw)             # Ctrl-C stops every thread
+    bar = progress_bar(progress, len(Z), "point mapping")
+    outs = interrupt.thread_map(fn, Z, nw, bar)        # Ctrl-C stops every thread
     return np.array([o[0] for o in outs]), np.array([o[1] for o in outs])
 
 

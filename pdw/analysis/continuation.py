@@ -33,10 +33,15 @@ branch, tangent to (v, 0), does.
 from __future__ import annotations
 
 import time
+from concurrent.futures import Executor
+from typing import Callable, Literal, Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..core.errors import InvalidInputError
+from ..core.params import Params
+from ..core.progress import Progress, progress_bar
 from . import hybrid as H
 from . import limit_cycle as LC
 from .branch import Bifurcation, Branch
@@ -76,12 +81,20 @@ def _start_z(prob, params, start, variant, period):
     return np.asarray(g.details["z"], dtype=float)
 
 
-def continue_gait(params, parameter, stop, *, model="continuous", variant="paper", period=1,
-                  step=None, start=None, value=None, method="pseudo_arclength", max_points=200,
-                  step_min=None, step_max=None, tol=None, locate_tol=None, params_of=None,
-                  log=False, detect=("fold", "period_doubling", "neimark_sacker", "end"),
-                  max_newton=8, executor=None, workers=None, fd_step=1e-5,
-                  options=None, at=()) -> Branch:
+def continue_gait(params: Params, parameter: str, stop: float, *,
+                  model: Literal["continuous", "hybrid"] = "continuous", variant: str = "paper",
+                  period: int = 1, step: float | None = None, start: Gait | ArrayLike | None = None,
+                  value: float | None = None,
+                  method: Literal["pseudo_arclength", "natural"] = "pseudo_arclength",
+                  max_points: int = 200, step_min: float | None = None,
+                  step_max: float | None = None, tol: float | None = None,
+                  locate_tol: float | None = None,
+                  params_of: Callable[[float], Params] | None = None, log: bool = False,
+                  detect: Sequence[str] = ("fold", "period_doubling", "neimark_sacker", "end"),
+                  max_newton: int = 8, executor: Executor | None = None,
+                  workers: int | None = None, fd_step: float = 1e-5,
+                  options: dict | None = None, at: Sequence[float] = (),
+                  progress: bool | Progress = False) -> Branch:
     """Follow the period-``period`` gait of ``params`` as ``parameter`` moves towards ``stop``.
 
     Parameters
@@ -108,7 +121,9 @@ def continue_gait(params, parameter, stop, *, model="continuous", variant="paper
         The parameter's value at the start (default: ``getattr(params, parameter)``, or the
         start gait's).
     method : {"pseudo_arclength", "natural"}
+        Pseudo-arclength (follows folds) or natural continuation (steps in the parameter).
     max_points : int
+        Most points on the branch.
     step_min, step_max : float
         Bounds of the arclength step in the scaled coordinates (the range is 1 unit; default
         1e-6 and 0.1).
@@ -123,6 +138,8 @@ def continue_gait(params, parameter, stop, *, model="continuous", variant="paper
         Continue in log(parameter) (for parameters spanning decades, e.g. k_n).
     detect : tuple of str
         Which test functions to watch (`pdw.branch.KINDS`).
+    max_newton : int
+        Newton iterations of the corrector per point.
     executor, workers : concurrent.futures.Executor, int
         Where the continuous model's finite-difference evaluations run (default: threads).
     fd_step : float
@@ -133,6 +150,9 @@ def continue_gait(params, parameter, stop, *, model="continuous", variant="paper
     at : sequence of float
         Parameter values at which the branch gets a point of its own (a natural correction
         there, when the branch passes the value), e.g. to compare with a table.
+    progress : bool or pdw.Progress
+        A bar over the branch's points (up to ``max_points``) on stderr when it is a terminal
+        (`pdw.core.progress`).
 
     Returns
     -------
@@ -166,13 +186,14 @@ def continue_gait(params, parameter, stop, *, model="continuous", variant="paper
                             locate_tol=locate_tol, detect=detect, max_newton=max_newton,
                             direction=details.get("direction"), origin=details.get("origin"),
                             settings=dict(log=log, variant=variant, fd_step=fd_step), t0=t0,
-                            at=at)
+                            at=at, progress=progress)
 
 
 def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_points=200,
                      step=None, step_min=None, step_max=None, tol=1e-10, locate_tol=None,
                      detect=("fold", "period_doubling", "neimark_sacker", "end"), max_newton=8,
-                     direction=None, origin=None, settings=None, t0=None, at=()) -> Branch:
+                     direction=None, origin=None, settings=None, t0=None, at=(),
+                     progress=False) -> Branch:
     """The continuation proper, on any problem object (`pdw.analysis.gait_maps`: ``dim``, ``evaluate``,
     ``coord``/``value``, ``gait``, ``ADMISSIBLE``, ...), from the fixed point z0 at ``value``
     towards ``stop``; the arguments as in `continue_gait` (``direction``: (dz, dmu) to orient
@@ -210,7 +231,10 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
     pts[0].tests = tests(eng, pts[0])
     bifs = []
     stop_reason = "max_points (%d) reached" % max_points
+    bar, seen = progress_bar(progress, int(max_points), "continuation %s" % prob.parameter), 0
     while len(pts) < max_points:
+        bar.update(len(pts) - seen)
+        seen = len(pts)
         a = pts[-1]
         b, why, its = eng.step_from(a, ds)
         if b is None and str(why).startswith("invalid parameter") and a.tangent[-1] > 0:
@@ -270,6 +294,8 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
             ds = min(ds * 1.5, step_max)
         elif its >= 5:
             ds = max(ds * 0.7, step_min)
+    bar.update(len(pts) - seen)
+    bar.close()
     return _branch(eng, pts, bifs, stop_reason, prob, time.perf_counter() - t0,
                    dict(method=method, tol=tol, locate_tol=locate_tol, step_min=step_min,
                         step_max=step_max, start_value=float(value), stop=float(stop),

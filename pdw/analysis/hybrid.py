@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core import _hybrid, checks
+from ..core import _hybrid, _layout, checks
 from ..core.errors import (
     FellError,
     InvalidInputError,
@@ -121,7 +121,7 @@ def full_state(y, params=None, s0=0.0, stance_leg=1) -> np.ndarray:
     state(s) y, shape (4,) or (N, 4); ``s0`` the stance foot's rolling coordinate, and
     ``stance_leg`` (1 or 2, scalar or per row) which leg is in stance."""
     Y = np.ascontiguousarray(np.atleast_2d(checks.real_array("y", y, [(4,), (-1, 4)])))
-    X = np.empty((len(Y), 8))
+    X = np.empty((len(Y), len(_layout.STATE)))
     _hybrid.full_state_batch(_p(params), Y, X)
     X[:, 0] += np.broadcast_to(np.asarray(s0, dtype=float), (len(Y),))
     swap = np.broadcast_to(np.asarray(stance_leg), (len(Y),)) == 2

@@ -76,13 +76,17 @@ from __future__ import annotations
 
 import math
 import os
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-from ..core import interrupt
+from ..core import _layout, interrupt
+from ..core.contact import Contact
 from ..core.errors import FellError, InvalidInputError, SimulationError
 from ..core.integrators import INTEGRATORS, METHODS
 from ..core.params import X0_DISTURBED, X0_PAPER, Params
+from ..core.progress import progress_bar
 from ..sim.simulation import simulate
 from .gait_types import Gait, GaitNotFoundError
 
@@ -159,8 +163,9 @@ def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max
     ``result`` (the `Result`, legs not relabelled, time from the section).
     """
     p = _params(params)
+    law = Contact.coerce(contact).for_section(SECTION)
     nan6 = np.full(6, np.nan)
-    out = dict(status="ok", z=nan6, x_touch=np.full(8, np.nan), period=np.nan,
+    out = dict(status="ok", z=nan6, x_touch=np.full(len(_layout.STATE), np.nan), period=np.nan,
                double_support=np.nan, swing_period=np.nan, step_length=np.nan, travel=np.nan,
                n_events=0, stats={})
     try:
@@ -171,13 +176,15 @@ def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max
     if method not in METHODS:
         raise InvalidInputError("method must be one of %s, got %r" % (", ".join(METHODS), method))
     adaptive = INTEGRATORS[method].adaptive
+    v_in0 = law.section_approach_speeds(x0, p, variant)
     t_first = 1.3 * (0.75 if t_hint is None or not np.isfinite(t_hint) else float(t_hint)) + 0.05
     ends = [min(t_first, t_max), t_max] if t_first < t_max else [t_max]
     for t_end in ends:
         t_end = max(t_end, 10 * dt)
         res = simulate(x0, t_end=t_end, dt=dt, params=p, variant=variant, method=method,
                        flags0=(1, 1), record_every=1, record_forces=record, on_failure="return",
-                       rtol=rtol, atol=atol, event_tol=event_tol, contact=contact)
+                       rtol=rtol, atol=atol, event_tol=event_tol, contact=contact,
+                       approach_speeds0=v_in0)
         out["stats"] = dict(res.stats)
         lo = next((e for e in res.events if e.leg == 1 and e.kind == "lift_off"), None)
         td = next((e for e in res.events if e.leg == 1 and e.kind == "touch_down"), None)
@@ -242,11 +249,14 @@ def _workers(workers):
     return max(1, int(workers if workers is not None else (os.cpu_count() or 1)))
 
 
-def map_batch(Z, params=None, variant="paper", method="rodas4", *, workers=None, **options):
-    """Steps from every row of Z (N, 6), in ``workers`` threads: list of step dicts."""
+def map_batch(Z, params=None, variant="paper", method="rodas4", *, workers=None,
+              progress=False, **options):
+    """Steps from every row of Z (N, 6), in ``workers`` threads: list of step dicts
+    (``progress``: False, True or a `pdw.Progress`, one unit per row)."""
     Z = np.atleast_2d(np.asarray(Z, dtype=float))
+    bar = progress_bar(progress, len(Z), "step map")
     fn = lambda z: step(z, params, variant, method, **options)   # noqa: E731
-    return interrupt.thread_map(fn, Z, min(_workers(workers), len(Z)))
+    return interrupt.thread_map(fn, Z, min(_workers(workers), len(Z)), bar)
 
 
 def _compose(z, n, params, variant, method, options):
@@ -345,7 +355,7 @@ def _guess_z(guess, params):
         x = hybrid.full_state(guess.details["y_minus"], params)
         return section_coordinates(x, 2)
     g = np.asarray(guess, dtype=float).reshape(-1)
-    if g.shape == (8,):
+    if g.shape == (len(_layout.STATE),):
         return section_coordinates(g, 2 if g[3] >= g[2] else 1)
     return _z(g, "guess")
 
@@ -386,8 +396,10 @@ def _newton(z, period, params, variant, method, opts, tol, max_iter, fd_step, wo
                       iterations=max_iter)
 
 
-def find_gait(params=None, variant="paper", guess=None, method="rodas4", *, period=1, tol=1e-9,
-              max_iter=20, fd_step=1e-5, settle_time=8.0, workers=None, **options) -> Gait:
+def find_gait(params: Params | None = None, variant: str = "paper",
+              guess: ArrayLike | Gait | None = None, method: str = "rodas4", *, period: int = 1,
+              tol: float = 1e-9, max_iter: int = 20, fd_step: float = 1e-5,
+              settle_time: float = 8.0, workers: int | None = None, **options: Any) -> Gait:
     """The period-``period`` gait of the continuous (compliant-ground) walker by Newton shooting
     on the touch-down Poincaré map (module docstring).
 
@@ -406,6 +418,8 @@ def find_gait(params=None, variant="paper", guess=None, method="rodas4", *, peri
         Solve P^period(z) = z (2 for a period-two gait, ...).
     tol : float
         Newton converges when max|P^n(z) - z| < tol.
+    max_iter : int
+        Newton iterations per guess.
     fd_step : float
         Absolute step of the central-difference Jacobian.
     settle_time : float
@@ -414,9 +428,10 @@ def find_gait(params=None, variant="paper", guess=None, method="rodas4", *, peri
         Threads for the Jacobian's 13 map evaluations (default: all cores).
     options
         Step-map options: rtol, atol, event_tol (default `TIGHT`), t_max, dt, and
-        ``contact`` (`pdw.Contact`: the contact laws; the section re-initialises both feet's
-        approach speeds, so with lankarani_nikravesh or flores the trailing foot's damping
-        during the double support differs from a continuous run's).
+        ``contact`` (`pdw.Contact`: the normal law; with lankarani_nikravesh or flores both feet
+        get the section's landing speed as their approach speed
+        (`Contact.section_approach_speeds`: exact at a period-1 fixed point). LuGre friction is
+        refused).
 
     Returns
     -------

@@ -12,11 +12,16 @@ from libc.stdlib cimport malloc, free
 from pdw.core import interrupt as _interrupt
 
 
+cdef extern from "<stdlib.h>" nogil:
+    int posix_memalign(void **memptr, size_t alignment, size_t size)
+
+
 cdef extern from "pdw_model.h":
     enum:
         PDW_NX, PDW_NP, PDW_NKERNELS, PDW_NSTEP, PDW_STEP_RING
     ctypedef struct pdw_kernel:
         int variant
+        int nx
     const pdw_kernel pdw_kernels[]
 
 
@@ -43,6 +48,10 @@ cdef extern from "pdw_batch.h":
         long stop_steps
         int periodic_k
         double periodic_tol
+        int method
+        double t_end
+        double rtol, atol, h_max, event_tol
+        long max_steps
         int *status
         int *stop_reason
         int *flags_final
@@ -61,9 +70,36 @@ cdef extern from "pdw_batch.h":
         void *poll_ctx
     long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
                        int vector) noexcept nogil
+    long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W,
+                          pdw_sim *lanes) noexcept nogil
+    ctypedef struct pdw_soa_state:
+        int W
+    int pdw_batch_isa_supported(int isa) noexcept nogil
+    long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
+                           int vector, int isa, pdw_soa_state *S) noexcept nogil
+
+
+cdef extern from "pdw_sim.h":
+    ctypedef struct pdw_method:
+        int adaptive
+    const pdw_method pdw_methods[]
+    const int pdw_nmethods
 
 
 MAX_LANES = PDW_BATCH_MAXW
+ISAS = {"scalar": -1, "base": 0, "avx2": 1, "avx512": 2}
+"""The cdm lane loops: "scalar" (every lane through the generated scalar stages), and the
+structure-of-arrays step compiled for the x86-64 baseline (SSE2), AVX2 and AVX-512F."""
+
+
+def isa_supported(name):
+    """Can this CPU run the cdm lane loop compiled for instruction set `name` (ISAS)?"""
+    return bool(pdw_batch_isa_supported(ISAS[name]))
+
+
+def best_isa():
+    """The widest instruction set of ISAS this CPU runs."""
+    return [n for n in ("avx512", "avx2", "base") if isa_supported(n)][0]
 
 
 cdef int _poll(void *ctx) noexcept nogil:
@@ -91,8 +127,17 @@ _OUT_KEYS = ("status", "stop_reason", "flags_final", "x_final", "t_final", "n_st
 def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[:, ::1] flags0,
               const double[::1] hip, const double[::1] depth, double dt, long n_steps,
               double max_speed, long stop_steps, int periodic_k, double periodic_tol,
-              dict out, long i0, long i1, int lanes, bint vector):
+              dict out, long i0, long i1, int lanes, bint vector, int method=0,
+              double t_end=0.0, double rtol=1e-6, double atol=1e-8, double h_max=0.0,
+              double event_tol=1e-9, long max_steps=0, int isa=0):
     """Advance walkers [i0, i1) with `lanes` lanes (GIL released), writing rows of `out`.
+
+    method: index into the compiled method table (pdw.core.integrators.METHODS); 0 (cdm) takes
+    the lockstep cdm loop (pdw_batch_cdm, `vector` applies), any other the per-lane rounds of
+    pdw_batch_method with t_end (0: n_steps dt), rtol, atol, h_max (0: t_end), event_tol and
+    max_steps (0: no budget) as `pdw.core._core.run` takes them; dt is then the first step.
+    isa: the cdm loop, a value of ISAS (-1: per-lane scalar stages; an unsupported one falls
+    back to it).
 
     x0 (N, 8); p (N, NP) or (1, NP) (one vector for all); flags0 (N, 2) intc; hip, depth (N,).
     out: the dict of output arrays made by pdw.sim.batch (status, stop_reason, flags_final,
@@ -104,6 +149,9 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     """
     if k < 0 or k >= PDW_NKERNELS:
         raise ValueError("kernel id %d out of range [0, %d)" % (k, PDW_NKERNELS))
+    if pdw_kernels[k].nx != PDW_NX:
+        raise ValueError("kernel %d has a %d-entry state: the ensemble engine runs the smooth "
+                         "Coulomb law's kernels only" % (k, pdw_kernels[k].nx))
     if lanes < 1 or lanes > PDW_BATCH_MAXW:
         raise ValueError("lanes must be in [1, %d], got %d" % (PDW_BATCH_MAXW, lanes))
     cdef long n = x0.shape[0]
@@ -162,6 +210,10 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
             ("out['fail_x']", (fail_x.shape[0], fail_x.shape[1]), (n, PDW_NX))):
         if got != want:
             raise ValueError("%s must have shape %s, got %s" % (name, want, got))
+    if method < 0 or method >= pdw_nmethods:
+        raise ValueError("method id %d out of range [0, %d)" % (method, pdw_nmethods))
+    if max_steps < 0 or not (event_tol > 0) or not (rtol > 0) or not (atol > 0):
+        raise ValueError("max_steps must be >= 0 and rtol, atol, event_tol > 0")
     if n == 0 or i0 == i1:
         return 0
     cdef pdw_batch_job job
@@ -179,6 +231,13 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     job.stop_steps = stop_steps
     job.periodic_k = periodic_k
     job.periodic_tol = periodic_tol
+    job.method = method
+    job.t_end = t_end if t_end > 0 else n_steps * dt
+    job.rtol = rtol
+    job.atol = atol
+    job.h_max = h_max
+    job.event_tol = event_tol
+    job.max_steps = max_steps
     job.status = &status[0]
     job.stop_reason = &stop_reason[0]
     job.flags_final = &flags_final[0, 0]
@@ -199,12 +258,23 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     cdef pdw_sim *sims = <pdw_sim *> malloc(lanes * sizeof(pdw_sim))
     if sims == NULL:
         raise MemoryError()
+    cdef pdw_soa_state *soa = NULL
+    # 64-byte aligned: the first 8 lanes of a row are one cache line
+    if posix_memalign(<void **> &soa, 64, sizeof(pdw_soa_state)) != 0:
+        free(sims)
+        raise MemoryError()
     cdef long done
     try:
         with nogil:
-            done = pdw_batch_cdm(&job, i0, i1, lanes, sims, vector)
+            if method == 0 and isa >= 0:
+                done = pdw_batch_cdm_soa(&job, i0, i1, lanes, sims, vector, isa, soa)
+            elif method == 0:
+                done = pdw_batch_cdm(&job, i0, i1, lanes, sims, vector)
+            else:
+                done = pdw_batch_method(&job, i0, i1, lanes, sims)
     finally:
         free(sims)
+        free(soa)
     if pending:             # Ctrl-C (or a cancelled pool): the rows written so far stay
         raise pending[0]
     return done

@@ -12,6 +12,8 @@ from pdw.core.errors import InvalidInputError
 
 from cpython.exc cimport PyErr_CheckSignals
 from libc.string cimport memset, memcpy
+from cpython.buffer cimport (PyObject_GetBuffer, PyBuffer_Release, PyBUF_C_CONTIGUOUS,
+                            PyBUF_FORMAT)
 
 
 cdef extern from "pdw_model.h":
@@ -21,6 +23,7 @@ cdef extern from "pdw_model.h":
         PDW_WORK_TRIG, PDW_WORK_KIN, PDW_WORK_CONTACT, PDW_WORK_M, PDW_WORK_F, PDW_WORK_QDD
         PDW_STATUS_RUNNING, PDW_STATUS_EVENTS_FULL
         PDW_NSTEP, PDW_STEP_RING, PDW_NANCHOR, PDW_ANCHOR_V_IN1, PDW_ANCHOR_V_IN2
+        PDW_NX_MAX
     ctypedef struct pdw_kernel:
         const char *name
         int variant
@@ -43,6 +46,9 @@ cdef extern from "pdw_model.h":
                     double *xdot, double *work) noexcept nogil
         void (*jacobian)(const double *x, const double *p, const int *flags,
                          const double *anchors, double *J, double *work) noexcept nogil
+        int normal
+        int friction
+        int nx
     const pdw_kernel pdw_kernels[]
     void pdw_precompute(const double *params, double *p) noexcept nogil
     void pdw_trig(const double *x, double *trig) noexcept nogil
@@ -55,7 +61,7 @@ cdef extern from "pdw_sim.h":
         double anchors[4]
     ctypedef struct pdw_failure:
         double t
-        double x[8]
+        double x[1]         # PDW_NX_MAX entries; the first pdw_sim.nx are the state
         int leg
         int reason
     ctypedef struct pdw_gait:
@@ -66,6 +72,7 @@ cdef extern from "pdw_sim.h":
         long poll_every
         long max_steps
         const pdw_kernel *kernel
+        int nx
         double p[32]
         double dt
         long n_steps
@@ -91,7 +98,7 @@ cdef extern from "pdw_sim.h":
         long n
         double t
         double h
-        double x[8]
+        double x[1]         # PDW_NX_MAX entries; the first nx are the state
         double u_prev[4]
         int started
         pdw_discrete disc
@@ -147,7 +154,8 @@ cdef extern from "pdw_bench.h":
                               double *sink) noexcept nogil
 
 
-NX = PDW_NX
+NX = PDW_NX            # the mechanical state [q, qd]; a kernel's own size: kernel_nx(k)
+NX_MAX = PDW_NX_MAX
 NQ = PDW_NQ
 NP = PDW_NP
 NWORK = PDW_NWORK
@@ -157,6 +165,11 @@ def kernel_table():
     """[(name, variant index, feature mask)] in the order of the C table."""
     return [(pdw_kernels[i].name.decode(), pdw_kernels[i].variant, pdw_kernels[i].features)
             for i in range(PDW_NKERNELS)]
+
+
+def kernel_nx(int k):
+    """Size of kernel k's continuous state (layout STATE_LAYOUTS of its friction law)."""
+    return _kernel(k).nx
 
 
 cdef const pdw_kernel *_kernel(int k) except NULL:
@@ -181,9 +194,9 @@ cdef int _flags_ok(const int[:, ::1] flags) except -1:
 
 cdef int _batch(const double[:, ::1] x, const double[::1] p, const int[:, ::1] flags,
                 const double[:, ::1] anchors, str out_name, Py_ssize_t out_r, Py_ssize_t out_c,
-                Py_ssize_t want_out_c, const double[:, ::1] work) except -1:
+                Py_ssize_t want_out_c, const double[:, ::1] work, int nx) except -1:
     cdef Py_ssize_t n = x.shape[0]
-    _rows("x", n, x.shape[1], n, PDW_NX)
+    _rows("x", n, x.shape[1], n, nx)
     _len("p", p.shape[0], PDW_NP)
     _rows("flags", flags.shape[0], flags.shape[1], n, 2)
     if anchors.shape[0] != n or anchors.shape[1] < 2 or anchors.shape[1] > PDW_NANCHOR:
@@ -224,7 +237,7 @@ def rhs_batch(int k, const double[:, ::1] x, const double[::1] p, const int[:, :
     Shapes (checked): x, xdot (N, NX); p (NP,); flags (N, 2) of 0/1; anchors (N, 2..NANCHOR)
     (s0 only, or s0 and the approach speeds; missing columns are zero)."""
     cdef const pdw_kernel *kern = _kernel(k)
-    _batch(x, p, flags, anchors, "xdot", xdot.shape[0], xdot.shape[1], PDW_NX, work)
+    _batch(x, p, flags, anchors, "xdot", xdot.shape[0], xdot.shape[1], kern.nx, work, kern.nx)
     cdef Py_ssize_t i, n = x.shape[0]
     cdef double a[PDW_NANCHOR]
     cdef int na = _anchor_width(anchors)
@@ -236,9 +249,10 @@ def rhs_batch(int k, const double[:, ::1] x, const double[::1] p, const int[:, :
 
 def jacobian_batch(int k, const double[:, ::1] x, const double[::1] p, const int[:, ::1] flags,
                    const double[:, ::1] anchors, double[:, ::1] J, double[:, ::1] work):
-    """df/dx (8x8 row-major per row of J, shape (N, 64)); work as in rhs_batch, with partials."""
+    """df/dx (nx x nx row-major per row of J, shape (N, nx^2), nx = kernel_nx(k)); work as in
+    rhs_batch, with partials."""
     cdef const pdw_kernel *kern = _kernel(k)
-    _batch(x, p, flags, anchors, "J", J.shape[0], J.shape[1], PDW_NX * PDW_NX, work)
+    _batch(x, p, flags, anchors, "J", J.shape[0], J.shape[1], kern.nx * kern.nx, work, kern.nx)
     cdef Py_ssize_t i, n = x.shape[0]
     cdef double a[PDW_NANCHOR]
     cdef int na = _anchor_width(anchors)
@@ -268,10 +282,10 @@ def contact_batch(int k, const double[:, ::1] kin, const int[:, ::1] flags, cons
 
 
 def energies_batch(int k, const double[:, ::1] x, const double[::1] p, double[:, ::1] e):
-    """T, V_gravity, V_hip for each row of x (N, NX) into e (N, NENERGY)."""
+    """T, V_gravity, V_hip for each row of x (N, kernel_nx(k)) into e (N, NENERGY)."""
     cdef const pdw_kernel *kern = _kernel(k)
     cdef Py_ssize_t i, n = x.shape[0]
-    _rows("x", n, x.shape[1], n, PDW_NX)
+    _rows("x", n, x.shape[1], n, kern.nx)
     _len("p", p.shape[0], PDW_NP)
     _rows("e", e.shape[0], e.shape[1], n, PDW_NENERGY)
     cdef double trig[4]
@@ -306,6 +320,8 @@ def bench(int k, str what, const double[::1] x, const double[::1] p, int f1, int
     cdef double anchors[PDW_NANCHOR]
     cdef double work[PDW_NWORK]
     cdef double sink = 0.0, ns
+    if kern.nx != PDW_NX:
+        raise ValueError("bench times the kernels of the smooth Coulomb law only")
     _len("x", x.shape[0], PDW_NX)
     _len("p", p.shape[0], PDW_NP)
     if n < 0:
@@ -394,7 +410,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         double rtol=1e-6, double atol=1e-8, double h_max=0.0, long max_records=0,
         long event_capacity=256, double event_tol=1e-9, bint record_events=True,
         long stop_steps=0, int periodic_k=0, double periodic_tol=0.0, double t_end=0.0,
-        long max_steps=0, long poll_every=POLL_EVERY, buffers=None):
+        long max_steps=0, long poll_every=POLL_EVERY, buffers=None, approach_speeds0=None):
     """Run one simulation in compiled code (GIL released). Returns a dict of arrays and status.
 
     The online gait analysis runs for every method: the result's "gait" holds the last
@@ -413,11 +429,15 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     loop returns PDW_STATUS_POLL: signals are checked here (GIL held); on Ctrl-C the run stops
     and the result (so far) is returned with "interrupted" set to the KeyboardInterrupt.
 
-    Shapes (checked): x0 (NX,), p (NP,).
+    approach_speeds0: (v1, v2) [m/s] replaces the approach speeds of the feet that start in
+    support (default: pdw_discrete_init's max(-v_y, 0)).
+
+    Shapes (checked): x0 (kernel_nx(k),), p (NP,).
     """
     cdef pdw_sim s
     cdef int flags0[2]
-    _len("x0", x0.shape[0], PDW_NX)
+    cdef int nx = _kernel(k).nx
+    _len("x0", x0.shape[0], nx)
     _len("p", p.shape[0], PDW_NP)
     if (f1 != 0 and f1 != 1) or (f2 != 0 and f2 != 1):
         raise ValueError("flags must be 0 or 1, got (%d, %d)" % (f1, f2))
@@ -439,6 +459,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     cdef pdw_advance_fn advance = pdw_methods[method].advance
     memset(&s, 0, sizeof(pdw_sim))
     s.kernel = _kernel(k)
+    s.nx = nx
     s.t_end = t_end if t_end > 0 else n_steps * dt   # adaptive methods end exactly at t_end
     s.rtol = rtol
     s.atol = atol
@@ -463,7 +484,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
             rec_contact = np.zeros((0, PDW_NREC))
         # every buffer as long as rec_t, checked before a pointer is taken (issue 16)
         _rows("buffers[1] (x)", rec_x.shape[0], rec_x.shape[1] if rec_x.ndim == 2 else -1,
-              n_rec_cap, PDW_NX)
+              n_rec_cap, nx)
         _rows("buffers[2] (flags)", rec_flags.shape[0],
               rec_flags.shape[1] if rec_flags.ndim == 2 else -1, n_rec_cap, 2)
         if record_contact:
@@ -471,7 +492,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
                   rec_contact.shape[1] if rec_contact.ndim == 2 else -1, n_rec_cap, PDW_NREC)
     else:
         rec_t = np.zeros(n_rec_cap)
-        rec_x = np.zeros((n_rec_cap, PDW_NX))
+        rec_x = np.zeros((n_rec_cap, nx))
         rec_flags = np.zeros((n_rec_cap, 2), dtype=np.intc)
         rec_contact = np.zeros((n_rec_cap if record_contact else 0, PDW_NREC))
     events = np.zeros((max(event_capacity, 4) if record_events else 1, PDW_NEVENT))
@@ -494,9 +515,14 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     s.periodic_k = periodic_k
     s.periodic_tol = periodic_tol
     pdw_gait_init(&s.gait)
-    memcpy(s.x, &x0[0], PDW_NX * sizeof(double))
+    memcpy(s.x, &x0[0], nx * sizeof(double))
     flags0[0] = f1; flags0[1] = f2
     pdw_discrete_init(s.kernel, s.p, s.x, flags0, &s.disc, s.work)
+    if approach_speeds0 is not None:        # feet that start in support: given approach speeds
+        if f1:
+            s.disc.anchors[PDW_ANCHOR_V_IN1] = approach_speeds0[0]
+        if f2:
+            s.disc.anchors[PDW_ANCHOR_V_IN2] = approach_speeds0[1]
     cdef int status
     interrupted = None
     while True:
@@ -559,12 +585,12 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         "n_steps": s.n,
         "t_final": s.t,
         "stats": {"steps": s.n, "rhs": s.n_rhs, "jacobians": s.n_jac, "rejected": s.n_rejected},
-        "x_final": np.array(<double[:PDW_NX]> s.x),
+        "x_final": np.array(<double[:nx]> s.x),
         "flags_final": (s.disc.flags[0], s.disc.flags[1]),
         "anchors_final": (s.disc.anchors[0], s.disc.anchors[1]),
         "approach_speeds_final": (s.disc.anchors[PDW_ANCHOR_V_IN1],
                                   s.disc.anchors[PDW_ANCHOR_V_IN2]),
-        "failure": {"t": s.failure.t, "x": np.array(<double[:PDW_NX]> s.failure.x),
+        "failure": {"t": s.failure.t, "x": np.array(<double[:nx]> s.failure.x),
                     "leg": s.failure.leg, "reason": s.failure.reason},
     }
 
@@ -587,103 +613,6 @@ def _real_states(x, bint allow_rows):
     return np.ascontiguousarray(arr, dtype=np.float64)
 
 
-cdef class OdeFunction:
-    """f(t, x) of Eq. A.4 with the discrete state fixed: the model object for external solvers.
+# --- the model object for external solvers (pdw.ode_function) ----------------------------
 
-    Built (and validated) by `pdw.ode_function`; every call goes straight to the compiled
-    kernel. ``x`` must be a C-contiguous float64 array of shape (8,) (what ``solve_ivp`` passes);
-    anything else takes a slower converting path. No check of finiteness is made per call.
-    """
-    cdef const pdw_kernel *kern
-    cdef double p[PDW_NP]
-    cdef int _flags[2]
-    cdef double _anchors[PDW_NANCHOR]      # s0_1, s0_2 given; the approach speeds stay 0
-    cdef double work[PDW_NWORK]
-
-    def __cinit__(self, int k, const double[::1] p, int f1, int f2, double a1, double a2):
-        self.kern = _kernel(k)
-        _len("p", p.shape[0], PDW_NP)
-        memcpy(self.p, &p[0], PDW_NP * sizeof(double))
-        memset(self._anchors, 0, PDW_NANCHOR * sizeof(double))
-        self.set_discrete(f1, f2, a1, a2)
-
-    def set_discrete(self, int f1, int f2, double a1, double a2):
-        """Replace the support flags (0 or 1) and the anchors (finite) [m]."""
-        if (f1 != 0 and f1 != 1) or (f2 != 0 and f2 != 1):
-            raise ValueError("flags must be 0 or 1, got (%d, %d)" % (f1, f2))
-        if not (a1 - a1 == 0.0 and a2 - a2 == 0.0):
-            raise ValueError("anchors must be finite, got (%r, %r)" % (a1, a2))
-        self._flags[0] = f1
-        self._flags[1] = f2
-        self._anchors[0] = a1
-        self._anchors[1] = a2
-
-    @property
-    def flags(self):
-        return (self._flags[0], self._flags[1])
-
-    @property
-    def anchors(self):
-        return (self._anchors[0], self._anchors[1])
-
-    def __call__(self, t, x):
-        cdef const double[::1] v
-        cdef double[::1] o
-        try:
-            v = x
-        except (ValueError, TypeError, BufferError):
-            arr = _real_states(x, True)
-            if arr.ndim == 2:
-                return self.batch(arr)
-            v = arr
-        if v.shape[0] != PDW_NX:
-            raise ValueError("x must have shape (8,), got (%d,)" % v.shape[0])
-        out = np.empty(PDW_NX)
-        o = out
-        self.kern.rhs(&v[0], self.p, self._flags, self._anchors, &o[0], self.work)
-        return out
-
-    def checked(self, const double[::1] v):
-        """f at v (8,) if every component is finite, else None (`pdw.rhs`'s fast path)."""
-        cdef Py_ssize_t i
-        cdef double[::1] o
-        if v.shape[0] != PDW_NX:
-            return None
-        for i in range(PDW_NX):
-            if not (v[i] - v[i] == 0.0):
-                return None
-        out = np.empty(PDW_NX)
-        o = out
-        self.kern.rhs(&v[0], self.p, self._flags, self._anchors, &o[0], self.work)
-        return out
-
-    def jac(self, t, x):
-        """df/dx at x, shape (8, 8) (the symbolic Jacobian of the kernel)."""
-        cdef const double[::1] v
-        cdef double[:, ::1] o
-        try:
-            v = x
-        except (ValueError, TypeError, BufferError):
-            v = _real_states(x, False)
-        if v.shape[0] != PDW_NX:
-            raise ValueError("x must have shape (8,), got (%d,)" % v.shape[0])
-        out = np.empty((PDW_NX, PDW_NX))
-        o = out
-        self.kern.jacobian(&v[0], self.p, self._flags, self._anchors, &o[0, 0], self.work)
-        return out
-
-    def batch(self, const double[:, ::1] X, double[:, ::1] out=None):
-        """f for each row of X (N, 8) -> (N, 8), one compiled loop (GIL released)."""
-        cdef Py_ssize_t i, n = X.shape[0]
-        if X.shape[1] != PDW_NX:
-            raise ValueError("X must have shape (N, 8), got (%d, %d)" % (n, X.shape[1]))
-        if out is None:
-            out = np.empty((n, PDW_NX))
-        elif out.shape[0] != n or out.shape[1] != PDW_NX:
-            raise ValueError("out must have shape (%d, %d), got (%d, %d)"
-                             % (n, PDW_NX, out.shape[0], out.shape[1]))
-        cdef double w[PDW_NWORK]
-        with nogil:
-            for i in range(n):
-                self.kern.rhs(&X[i, 0], self.p, self._flags, self._anchors, &out[i, 0], w)
-        return np.asarray(out)
+include "_ode.pxi"

@@ -94,10 +94,10 @@ def flags(name, value, n=None):
     return np.ascontiguousarray(arr, dtype=np.intc)
 
 
-def real_array(name, value, shapes, labels=None):
+def real_array(name, value, shapes, labels=None, lo=None):
     """A finite float array whose shape is one of ``shapes`` (tuples; -1 matches any length).
     Refuses strings, complex, object and boolean arrays. ``labels``: names of the last axis's
-    components (for the message)."""
+    components (for the message); ``lo``: the smallest allowed value."""
     if isinstance(value, (str, bytes)):
         raise InvalidInputError("%s must be an array of numbers, got the string %r" % (name, value))
     try:
@@ -118,7 +118,29 @@ def real_array(name, value, shapes, labels=None):
         label = " (%s)" % labels[where[-1]] if labels and len(labels) == arr.shape[-1] else ""
         raise InvalidInputError("%s%s%s must be finite, got %r"
                                 % (name, list(where), label, float(arr[where])))
+    if lo is not None and (arr < lo).any():
+        where = tuple(int(i) for i in np.argwhere(arr < lo)[0])
+        raise InvalidInputError("%s%s must be >= %g, got %r" % (name, list(where), lo,
+                                                               float(arr[where])))
     return arr
+
+
+def features(value, allowed):
+    """A collection of force-element names (None: all of ``allowed``), in ``allowed``'s order."""
+    if value is None:
+        return tuple(allowed)
+    if isinstance(value, str):
+        raise InvalidInputError("features must be a collection of names, got the string %r"
+                                % value)
+    try:
+        unknown = set(value) - set(allowed)
+    except TypeError:
+        raise InvalidInputError("features must be a collection of names from %s, got %r"
+                                % (", ".join(allowed), value)) from None
+    if unknown:
+        raise InvalidInputError("unknown feature(s) %s; allowed: %s"
+                                % (", ".join(sorted(map(str, unknown))), ", ".join(allowed)))
+    return tuple(f for f in allowed if f in set(value))
 
 
 def _shape_text(s):

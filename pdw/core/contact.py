@@ -20,6 +20,18 @@ flores                 k delta^1.5 (1 + 8(1-e)/(5e) delta_dot/v0)     k [N/m^1.5
 Every damped law is clamped at 0 (the ground cannot pull). v0 = max(v_in, v_in_min), v_in the
 foot's approach speed captured at its touch-down. k and d default to `Params.k_n`, `Params.d_n`
 (whose units are then the law's).
+
+=====================  ====================================================================
+friction law           friction force F_f (+X) of a penetrating support foot, slip velocity v
+=====================  ====================================================================
+coulomb (default)      mu(v) F_n, the smooth law of Eq. 10 (parameters in `Params`)
+lugre                  -(sigma0 z + sigma1 dz/dt + sigma2 v) F_n, with a bristle state z [m]
+                       per foot: dz/dt = v - sigma0 |v| z / g(v),
+                       g(v) = mu_c + (mu_s - mu_c) exp(-(v/v_s)^2)  (Canudas de Wit et al. 1995)
+=====================  ====================================================================
+
+Both keep the tangential spring-damper of Eqs. 7, 11. LuGre's state is [q, qd, z1, z2]
+(`pdw.core._layout.STATE_LAYOUTS`); z is reset to 0 at the foot's touch-down.
 """
 from __future__ import annotations
 
@@ -49,6 +61,30 @@ UNITS = {
     "lankarani_nikravesh": {"k": "N/m^1.5", "e": "-", "v_in_min": "m/s"},
     "flores": {"k": "N/m^1.5", "e": "-", "v_in_min": "m/s"},
 }
+#: LuGre's parameters: (lower bound, lower bound open, unit, meaning)
+LUGRE_PARAMETERS = {
+    "sigma0": (0.0, True, "1/m", "bristle stiffness per unit normal force"),
+    "sigma1": (0.0, False, "s/m", "bristle damping per unit normal force"),
+    "sigma2": (0.0, False, "s/m", "viscous friction per unit normal force"),
+    "mu_s": (0.0, True, "-", "static friction coefficient (Stribeck curve at v = 0)"),
+    "mu_c": (0.0, True, "-", "Coulomb friction coefficient (Stribeck curve at |v| >> v_s)"),
+    "v_s": (0.0, True, "m/s", "Stribeck velocity"),
+}
+#: LuGre's defaults for sigma0, sigma1, sigma2 (Canudas de Wit et al. 1995's values for a unit
+#: normal force); mu_s, mu_c, v_s default to the paper's law (`lugre_stribeck`).
+LUGRE_DEFAULTS = {"sigma0": 1e5, "sigma1": math.sqrt(1e5), "sigma2": 0.0}
+_LG_P = {"sigma0": "sigma0", "sigma1": "sigma1", "sigma2": "sigma2", "mu_s": "lg_mu_s",
+         "mu_c": "lg_mu_c", "v_s": "lg_v_s"}
+
+
+def lugre_stribeck(params: Params) -> dict:
+    """LuGre's Stribeck curve matched to the paper's Eq. 10: mu_s = `Params.mu_s`, mu_c =
+    `Params.mu_d`, and v_s such that g falls half-way from mu_s to mu_c where Eq. 10's cubic step
+    does, at (v_s + v_d)/2 of `Params`: v_s(LuGre) = (v_s + v_d) / (2 sqrt(ln 2))."""
+    return {"mu_s": params.mu_s, "mu_c": params.mu_d,
+            "v_s": 0.5 * (params.v_s + params.v_d) / math.sqrt(math.log(2.0))}
+
+
 _P = {n: i for i, n in enumerate(_layout.PARAMS + _layout.DERIVED + _layout.CONTACT_PARAMS)}
 
 
@@ -73,6 +109,12 @@ class Contact:
     v_in_min : float, optional
         Smallest approach speed those laws divide by [m/s] (a foot that starts in contact, or
         lands slower than this, uses it); default 0.01 m/s.
+    sigma0, sigma1, sigma2 : float, optional
+        LuGre only: bristle stiffness (> 0) [1/m], bristle damping (>= 0) [s/m] and viscous
+        friction (>= 0) [s/m], per unit normal force; default `LUGRE_DEFAULTS`.
+    mu_s, mu_c, v_s : float, optional
+        LuGre only: its Stribeck curve's static and Coulomb coefficients (> 0) [-] and Stribeck
+        velocity (> 0) [m/s]; default the paper's law matched (`lugre_stribeck`).
 
     Raises
     ------
@@ -86,6 +128,12 @@ class Contact:
     d: float | None = None
     e: float | None = None
     v_in_min: float | None = None
+    sigma0: float | None = None
+    sigma1: float | None = None
+    sigma2: float | None = None
+    mu_s: float | None = None
+    mu_c: float | None = None
+    v_s: float | None = None
 
     def __post_init__(self):
         if self.normal not in NORMAL_LAWS:
@@ -110,6 +158,21 @@ class Contact:
                                         % (name, v, ">" if lo_open else ">=", lo,
                                            " and <= 1" if hi == 1.0 else "",
                                            UNITS[self.normal][name]))
+            object.__setattr__(self, name, v)
+        for name, (lo, lo_open, unit, _) in LUGRE_PARAMETERS.items():
+            v = getattr(self, name)
+            if v is None:
+                continue
+            if self.friction != "lugre":
+                raise InvalidInputError("contact.%s is a parameter of the lugre friction law, not "
+                                        "of %s" % (name, self.friction))
+            try:
+                v = float(v)
+            except (TypeError, ValueError):
+                raise InvalidInputError("contact.%s must be a number, got %r" % (name, v)) from None
+            if not math.isfinite(v) or (v <= lo if lo_open else v < lo):
+                raise InvalidInputError("contact.%s = %r is out of range; allowed: %s %g [%s]"
+                                        % (name, v, ">" if lo_open else ">=", lo, unit))
             object.__setattr__(self, name, v)
         if "e" in allowed and self.e is None:
             raise InvalidInputError("contact.e (coefficient of restitution, 0 < e <= 1) is "
@@ -151,10 +214,90 @@ class Contact:
             changes["d_n"] = 0.0
         return params.replace(**changes) if changes else params
 
-    def vector(self, p: np.ndarray, features=None) -> np.ndarray:
+    @property
+    def nx(self) -> int:
+        """Size of the continuous state under this friction law (`pdw.core._layout.STATE_LAYOUTS`)."""
+        return len(_layout.STATE_LAYOUTS[self.friction])
+
+    @property
+    def state_names(self) -> tuple:
+        """Names of the state components under this friction law."""
+        return _layout.STATE_LAYOUTS[self.friction]
+
+    def run_state(self, x, all_features=True, interpolate=False, buffer=False) -> np.ndarray:
+        """The initial state of a run under this friction law from a checked x0: a mechanical
+        x0 (`pdw.STATE`) gets bristle states 0 (relaxed). Refuses, saying why, what a run
+        with bristle states cannot do yet: a kernel without every force element
+        (``all_features=False``), interpolation (t_eval, dense_output), a `RecordBuffer`."""
+        x = np.asarray(x, dtype=float)
+        if self.friction == "coulomb":
+            if len(x) != len(_layout.STATE):
+                raise InvalidInputError("x0 has %d entries: the state of the %s friction law has "
+                                        "%d (%s)" % (len(x), self.friction, self.nx,
+                                                     ", ".join(self.state_names)))
+            return x
+        if not all_features:
+            raise InvalidInputError("features: the %s friction law has a kernel with every force "
+                                    "element only; leave features unset (or set the parameters "
+                                    "of the elements to 0)" % self.friction)
+        if interpolate:
+            raise InvalidInputError("t_eval and dense_output interpolate the mechanical state "
+                                    "[q, qd] only; with contact.friction = %r (state %s) record "
+                                    "every step (record_every=1) instead"
+                                    % (self.friction, ", ".join(self.state_names)))
+        if buffer:
+            raise InvalidInputError("out: a pdw.RecordBuffer holds %d-wide states; the %s "
+                                    "friction law's state has %d entries: leave out unset"
+                                    % (len(_layout.STATE), self.friction, self.nx))
+        return np.concatenate([x, np.zeros(self.nx - len(x))]) if len(x) < self.nx else x
+
+    def for_section(self, section) -> "Contact":
+        """This contact, for a Poincare map on ``section`` (names of the mechanical coordinates
+        it carries): refuses a friction law with more state (LuGre), saying why."""
+        if self.friction != "coulomb":
+            raise InvalidInputError(
+                "contact.friction = %r: the Poincare section (%s) carries the mechanical state "
+                "only; the trailing foot's bristle state would be re-initialised at every "
+                "section, so the map would not be the continuous run's. Use simulate(..., "
+                "contact=...) with periodic_steps to settle a LuGre gait instead"
+                % (self.friction, ", ".join(section)))
+        return self
+
+    def section_approach_speeds(self, x0, params: Params, variant: str):
+        """Approach speeds of both feet at a touch-down section (for the laws that use them;
+        else None). The foot that has just landed (leg 2) gets max(-v_y, 0), as the loop
+        captures it; the trailing leg 1 landed one step earlier, on a period-1 gait with the
+        same speed, which the section point does not otherwise hold. So a period-1 fixed point
+        of the map is the continuous run's periodic orbit (tests/test_contact_laws.py); off it,
+        the trailing foot's damping during the double support uses this step's landing speed
+        instead of the previous step's."""
+        if "e" not in LAW_PARAMETERS[self.normal]:
+            return None
+        from .model import contact_forces
+        v2 = max(-float(contact_forces(x0, params, flags=(1, 1), variant=variant).v_y[1]), 0.0)
+        return (v2, v2)
+
+    def lugre_parameters(self, params: Params) -> dict:
+        """LuGre's six parameters with the defaults filled in (sigma0, sigma1, sigma2, mu_s,
+        mu_c, v_s)."""
+        out = dict(LUGRE_DEFAULTS, **lugre_stribeck(params))
+        out.update({n: getattr(self, n) for n in LUGRE_PARAMETERS if getattr(self, n) is not None})
+        for name in ("mu_s", "mu_c"):           # defaults from Params may be 0 (no friction)
+            if not out[name] > 0:
+                raise InvalidInputError(
+                    "contact.%s = %r (from Params.%s) is out of range; allowed: > 0 [-] (LuGre "
+                    "divides by its Stribeck curve): set contact.%s" % (
+                        name, out[name], "mu_s" if name == "mu_s" else "mu_d", name))
+        return out
+
+    def vector(self, p: np.ndarray, features=None, params: Params | None = None) -> np.ndarray:
         """Fill the contact-law entries (`pdw._layout.CONTACT_PARAMS`) of a kernel parameter
         vector ``p`` (from `pdw.model.parameter_vector`) in place; returns ``p``. Without the
-        ``normal_damping`` feature, e = 1 (no damping)."""
+        ``normal_damping`` feature, e = 1 (no damping). LuGre's unset Stribeck parameters come
+        from ``params`` (default `Params.paper`)."""
+        if self.friction == "lugre":
+            for name, v in self.lugre_parameters(params or Params.paper()).items():
+                p[_P[_LG_P[name]]] = v
         if "e" in LAW_PARAMETERS[self.normal]:
             damped = features is None or "normal_damping" in features
             p[_P["e_n"]] = self.e if damped else 1.0

@@ -28,7 +28,7 @@ class Token:
         self._event.set()
 
     def is_set(self) -> bool:
-        t = self
+        t: Token | None = self
         while t is not None:
             if t._event.is_set():
                 return True
@@ -53,22 +53,32 @@ def check():
         raise KeyboardInterrupt("cancelled: the pool of this task was interrupted")
 
 
-def thread_map(fn, items, workers: int) -> list:
+def thread_map(fn, items, workers: int, bar=None) -> list:
     """``[fn(x) for x in items]`` on ``workers`` threads, in order, stoppable by Ctrl-C.
 
     On KeyboardInterrupt in the calling thread (or an exception of a task) the pending tasks
     are cancelled, the running ones stop at their next poll, and the exception is re-raised
-    once they have. With ``workers <= 1`` the tasks run in the calling thread.
+    once they have. With ``workers <= 1`` the tasks run in the calling thread. ``bar`` (a
+    `pdw.Progress`, optional) advances by one as each task finishes.
     """
     items = list(items)
+    lock = threading.Lock()
+
+    def counted(x):
+        out = fn(x)
+        if bar is not None:
+            with lock:
+                bar.update()
+        return out
+
     if workers <= 1 or len(items) <= 1:
-        return [fn(x) for x in items]
+        return [counted(x) for x in items]
     token = Token(current())
 
     def task(x):
         _local.token = token
         try:
-            return fn(x)
+            return counted(x)
         finally:
             _local.token = None
 

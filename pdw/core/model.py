@@ -8,8 +8,10 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
+from typing import Iterable
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from . import _core, _layout, checks
 from .errors import InvalidInputError
@@ -21,14 +23,20 @@ _KERNELS = {name: i for i, (name, _, _) in enumerate(_core.kernel_table())}
 _IX = {n: i for i, n in enumerate(STATE)}
 
 
-def kernel_index(variant: str = "paper", features=None, normal: str = "hunt_crossley") -> int:
-    """Index of the generated kernel for ``variant`` with the given force elements and normal
-    contact law (`pdw.core._layout.NORMAL_LAWS`).
+def kernel_index(variant: str = "paper", features=None, normal: str = "hunt_crossley",
+                 friction: str = "coulomb") -> int:
+    """Index of the generated kernel for ``variant`` with the given force elements, normal
+    contact law (`pdw.core._layout.NORMAL_LAWS`) and friction law (`FRICTION_LAWS`).
 
     ``features=None`` means every element (`pdw.core._layout.FEATURES`). A combination without
     a specialized kernel falls back to the general one (of its normal law).
     """
     check_variant(variant)
+    if friction != "coulomb":
+        if friction not in _layout.FRICTION_LAWS or normal not in _layout.NORMAL_LAWS:
+            raise ValueError("no kernel for normal law %r with friction law %r" % (normal, friction))
+        law = "" if normal == "hunt_crossley" else "_" + normal
+        return _KERNELS[variant + law + "_" + friction]
     if normal != "hunt_crossley":
         if normal not in _layout.NORMAL_LAWS:
             raise ValueError("normal law must be one of %s, got %r"
@@ -65,10 +73,13 @@ def _states(x, name="x", width=_core.NX):
 
 
 def _discrete(flags, anchors, n):
+    """Flags (n, 2) and anchors (n, 2) (s0 only) or (n, NANCHOR) (`pdw.core._layout.ANCHORS`:
+    s0 and the approach speeds)."""
     f = checks.flags("flags", flags, n)
     f = np.ascontiguousarray(np.broadcast_to(np.asarray(f, dtype=np.intc), (n, 2)))
-    a = checks.real_array("anchors", anchors, [(2,), (n, 2)])
-    return f, np.ascontiguousarray(np.broadcast_to(a, (n, 2)))
+    na = len(_layout.ANCHORS)
+    a = checks.real_array("anchors", anchors, [(2,), (n, 2), (na,), (n, na)])
+    return f, np.ascontiguousarray(np.broadcast_to(a, (n, a.shape[-1])))
 
 
 def _folded(params, features):
@@ -78,45 +89,66 @@ def _folded(params, features):
     return params if features is None else params.without(features)
 
 
-def _evaluate(x, params, flags, anchors, variant, features=None):
+def _evaluate(x, params, flags, anchors, variant, features=None, contact=None):
     X, single = _states(x)
-    k = kernel_index(variant, features)
     f, a = _discrete(flags, anchors, len(X))
-    p = parameter_vector(_folded(params, features))
+    if contact is None or contact.is_default:
+        k = kernel_index(variant, features)
+        p = parameter_vector(_folded(params, features))
+    else:                                       # a normal law beyond the paper's (Coulomb friction)
+        params = contact.parameters(_folded(params, features))
+        k = kernel_index(variant, features, contact.normal)
+        p = contact.vector(parameter_vector(params), features, params)
     xdot = np.empty_like(X)
     work = np.empty((len(X), _core.NWORK))
     _core.rhs_batch(k, X, p, f, a, xdot, work)
     return X, single, k, p, f, a, xdot, work
 
 
-def rhs(x, params=None, flags=(0, 1), anchors=(0.0, 0.0), variant="paper", features=None):
+_FLAGS0, _ANCHORS0 = (0, 1), (0.0, 0.0)     # rhs's defaults (its fast path tests identity)
+
+
+def rhs(x: ArrayLike, params: Params | None = None, flags: ArrayLike = _FLAGS0,
+        anchors: ArrayLike = _ANCHORS0, variant: str = "paper",
+        features: Iterable[str] | None = None) -> np.ndarray:
     """Right-hand side f(x) = [qd; M^-1 (Q_f - C qd - G)] of Eq. A.4.
+
+    Every argument is checked (`pdw.InvalidInputError` naming it). One finite, C-contiguous
+    float64 state with default ``features`` takes a compiled fast path (its cost per call is
+    in docs/benchmarks.md); for many calls with fixed arguments use `pdw.ode_function`.
 
     Parameters
     ----------
     x : array_like, shape (8,) or (N, 8)
-        State [q, qd].
+        State [q, qd] [m, rad, m/s, rad/s].
     params : Params, optional
         Default `Params.paper()`.
-    flags : (int, int)
+    flags : (int, int) or array_like (N, 2)
         Support flags of legs 1 and 2 (1 support, 0 swing; docs/model.md section 5).
-    anchors : (float, float)
+    anchors : (float, float) or array_like (N, 2)
         Rolling coordinate s_i at the last touch-down of each foot [m]; only the
         ``consistent`` variant's tangential deformation uses them.
     variant : {"paper", "consistent"}
         docs/model.md section 6.
+    features : iterable of str, optional
+        Force elements present (`pdw.core._layout.FEATURES`; default all).
 
     Returns
     -------
     ndarray, shape (8,) or (N, 8)
+        dx/dt [m/s, rad/s, m/s^2, rad/s^2], a fresh array.
     """
-    if (features is None and type(x) is np.ndarray and x.shape == (_core.NX,)
-            and x.dtype == np.float64):
-        try:
-            fn = _rhs_function(params, variant, flags, anchors)
-        except TypeError:       # unhashable arguments (a list of flags): the general path
-            fn = None
-        if fn is not None and x.flags.c_contiguous:
+    if features is None:
+        # fast path: one finite, C-contiguous float64 state, checked in compiled code; the
+        # default arguments skip even the cache lookup
+        if params is None and flags is _FLAGS0 and anchors is _ANCHORS0 and variant == "paper":
+            fn = _DEFAULT_RHS
+        else:
+            try:
+                fn = _rhs_function(params, variant, flags, anchors)  # type: ignore[arg-type]
+            except TypeError:   # unhashable arguments (a list of flags): the general path
+                fn = None
+        if fn is not None:
             out = fn.checked(x)
             if out is not None:
                 return out
@@ -136,11 +168,37 @@ def _rhs_function(params, variant, flags, anchors):
                              int(f[0, 0]), int(f[0, 1]), float(a[0, 0]), float(a[0, 1]))
 
 
-def jacobian(x, params=None, flags=(0, 1), anchors=(0.0, 0.0), variant="paper", features=None):
-    """Jacobian df/dx of `rhs`, from the symbolic derivation; shape (8, 8) or (N, 8, 8).
+_DEFAULT_RHS = _rhs_function(None, "paper", _FLAGS0, _ANCHORS0)
+
+
+def jacobian(x: ArrayLike, params: Params | None = None, flags: ArrayLike = (0, 1),
+             anchors: ArrayLike = (0.0, 0.0), variant: str = "paper",
+             features: Iterable[str] | None = None) -> np.ndarray:
+    """Jacobian df/dx of `rhs` (Eq. A.4), from the symbolic derivation.
 
     At the switching surfaces of the force laws (clamp, friction branches, Eq. 11's gate)
     it is the derivative of the branch that is active at x.
+
+    Parameters
+    ----------
+    x : array_like, shape (8,) or (N, 8)
+        State [q, qd] [m, rad, m/s, rad/s].
+    params : Params, optional
+        Default `Params.paper()`.
+    flags : (int, int) or array_like (N, 2)
+        Support flags of legs 1 and 2 (1 support, 0 swing; docs/model.md section 5).
+    anchors : (float, float) or array_like (N, 2)
+        Rolling coordinate s_i at the last touch-down of each foot [m]; only the
+        ``consistent`` variant's tangential deformation uses them.
+    variant : {"paper", "consistent"}
+        docs/model.md section 6.
+    features : iterable of str, optional
+        Force elements present (`pdw.core._layout.FEATURES`; default all).
+
+    Returns
+    -------
+    ndarray, shape (8, 8) or (N, 8, 8)
+        ``J[i, j] = d f_i / d x_j`` (units of f_i over units of x_j).
     """
     X, single = _states(x)
     k = kernel_index(variant, features)
@@ -152,10 +210,21 @@ def jacobian(x, params=None, flags=(0, 1), anchors=(0.0, 0.0), variant="paper", 
     return J[0] if single else J
 
 
-def mass_matrix(q, params=None):
-    """Mass matrix M(q) of Eq. 2 (docs/model.md section 3), shape (4, 4) or (N, 4, 4).
+def mass_matrix(q: ArrayLike, params: Params | None = None) -> np.ndarray:
+    """Mass matrix M(q) of Eq. 2 (docs/model.md section 3).
 
-    ``q`` may be a configuration (4,) / (N, 4) or a full state (8,) / (N, 8).
+    Parameters
+    ----------
+    q : array_like, shape (4,), (N, 4), (8,) or (N, 8)
+        A configuration [x_o, y_o, theta1, theta2] [m, rad] or a full state (its velocities
+        are ignored).
+    params : Params, optional
+        Default `Params.paper()`.
+
+    Returns
+    -------
+    ndarray, shape (4, 4) or (N, 4, 4)
+        Symmetric positive definite [kg, kg m, kg m^2 by block].
     """
     Q = checks.real_array("q", q, [(_core.NQ,), (-1, _core.NQ), (_core.NX,), (-1, _core.NX)])
     if Q.shape[-1] == _core.NQ:
@@ -187,13 +256,38 @@ class ContactState:
     mu: np.ndarray
 
 
-def contact_forces(x, params=None, flags=(0, 1), anchors=(0.0, 0.0), variant="paper",
-                   features=None) -> ContactState:
+def contact_forces(x: ArrayLike, params: Params | None = None, flags: ArrayLike = (0, 1),
+                   anchors: ArrayLike = (0.0, 0.0), variant: str = "paper",
+                   features: Iterable[str] | None = None, contact=None) -> ContactState:
     """Contact kinematics (Eqs. 4-9) and forces (Eqs. 3, 6, 7, 10, 11) of both feet.
 
     Forces act only on a support foot (flag 1) that penetrates (y_D < 0); otherwise 0.
+
+    Parameters
+    ----------
+    x : array_like, shape (8,) or (N, 8)
+        State [q, qd] [m, rad, m/s, rad/s].
+    params : Params, optional
+        Default `Params.paper()`.
+    flags : (int, int) or array_like (N, 2)
+        Support flags of legs 1 and 2 (1 support, 0 swing; docs/model.md section 5).
+    anchors : (float, float) or array_like (N, 2), or (4,) or (N, 4)
+        Rolling coordinate s_i at the last touch-down of each foot [m]; only the
+        ``consistent`` variant's tangential deformation uses them. Four columns: then the
+        approach speeds v_in1, v_in2 [m/s] (`pdw.core._layout.ANCHORS`).
+    variant : {"paper", "consistent"}
+        docs/model.md section 6.
+    features : iterable of str, optional
+        Force elements present (`pdw.core._layout.FEATURES`; default all).
+    contact : pdw.Contact, optional
+        Another normal law (with the smooth Coulomb friction); default the paper's.
+
+    Returns
+    -------
+    ContactState
+        Each field of shape (2,) for one state, (N, 2) for N (foot 1, foot 2).
     """
-    X, single, *_, work = _evaluate(x, params, flags, anchors, variant, features)
+    X, single, *_, work = _evaluate(x, params, flags, anchors, variant, features, contact)
     k0, nk = _layout.WORK["kin"]
     c0, nc = _layout.WORK["contact"]
     kin = work[:, k0:k0 + nk].reshape(-1, 2, len(_layout.KIN))
@@ -208,9 +302,22 @@ def contact_forces(x, params=None, flags=(0, 1), anchors=(0.0, 0.0), variant="pa
     return ContactState(**{k: out[k] for k in ContactState.__dataclass_fields__})
 
 
-def energies(x, params=None) -> dict:
+def energies(x: ArrayLike, params: Params | None = None) -> dict[str, np.ndarray | float]:
     """Kinetic energy T, gravitational potential V_gravity, hip-spring energy V_hip and their
-    sum E [J] (docs/model.md section 3; V_gravity is zero at the slope-frame origin)."""
+    sum E [J] (docs/model.md section 3; V_gravity is zero at the slope-frame origin).
+
+    Parameters
+    ----------
+    x : array_like, shape (8,) or (N, 8)
+        State [q, qd] [m, rad, m/s, rad/s].
+    params : Params, optional
+        Default `Params.paper()`.
+
+    Returns
+    -------
+    dict
+        ``{"T", "V_gravity", "V_hip", "E"}`` -> float for one state, ndarray (N,) for N [J].
+    """
     X, single = _states(x)
     e = np.empty((len(X), len(_layout.ENERGY)))
     _core.energies_batch(kernel_index("paper"), X, parameter_vector(params), e)

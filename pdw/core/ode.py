@@ -10,6 +10,8 @@ rows of an (N, 8) array in one compiled loop. The discrete state of MODEL.md sec
 """
 from __future__ import annotations
 
+from typing import Iterable
+
 from . import _core, _layout, checks
 from .errors import InvalidInputError
 from .model import check_variant, kernel_index, parameter_vector
@@ -44,7 +46,8 @@ def _check_features(features):
 
 
 def ode_function(params: Params | None = None, variant: str = "paper",
-                 flags=(0, 1), anchors=(0.0, 0.0), features=None) -> OdeFunction:
+                 flags: tuple[int, int] = (0, 1), anchors: tuple[float, float] = (0.0, 0.0),
+                 features: Iterable[str] | None = None) -> OdeFunction:
     """The right-hand side f(t, x) of Eq. A.4 as a fast callable for external solvers.
 
     Parameters
@@ -65,14 +68,19 @@ def ode_function(params: Params | None = None, variant: str = "paper",
     -------
     OdeFunction
         ``f(t, x)`` -> ndarray (8,) for a float64 state x of shape (8,) [m, rad, m/s, rad/s]
-        (t is ignored: the model is autonomous); ``f.jac(t, x)`` -> (8, 8);
+        (t is ignored: the model is autonomous); ``f.jac(t, x)`` -> (8, 8). Both return a
+        fresh array every call (a copy of an internal buffer): keeping it is safe, as
+        ``solve_ivp`` does;
         ``f.batch(X, out=None)`` -> (N, 8) for X of shape (N, 8); ``f.set_discrete(f1, f2,
         a1, a2)`` changes the flags and anchors (unchecked: use `ode_function` to validate).
 
     Notes
     -----
-    Inputs are validated here, once; a call does no checking beyond the shape of x (a
-    non-finite state gives a non-finite derivative). ``solve_ivp(f, (0, T), x0,
+    Inputs are validated here, once; a call checks only that x is a C-contiguous float64
+    array of shape (8,) (its raw buffer is then read in place; the cost per call is in
+    docs/benchmarks.md) and converts anything else (a list, another dtype, a strided view);
+    a wrong shape is `pdw.InvalidInputError` naming x. A non-finite state gives a non-finite
+    derivative. ``solve_ivp(f, (0, T), x0,
     method="Radau", jac=f.jac)`` integrates one stretch of constant support flags; see
     docs/benchmarks.md for the cost per call (benchmarks/bench_io.py).
 

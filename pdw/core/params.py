@@ -83,18 +83,38 @@ class Params:
 
     # --- presets ---------------------------------------------------------------------------
     @classmethod
-    def paper(cls, **overrides) -> "Params":
-        """The paper's Tables 1-3 as read in docs/model.md section 1 (d_hip = 0.018)."""
+    def paper(cls, **overrides: float) -> Params:
+        """The paper's Tables 1-3 as read in docs/model.md section 1 (d_hip = 0.018).
+
+        ``overrides``: fields to change (name=value, SI units), validated as in the constructor.
+        """
         return cls(**overrides)
 
     @classmethod
-    def paper_steady(cls, **overrides) -> "Params":
+    def paper_steady(cls, **overrides: float) -> Params:
         """`paper` with d_hip = 0.010: the preset with a stable period-one gait (docs/model.md section 8)."""
         return cls(**{"d_hip": 0.010, **overrides})
 
     @classmethod
-    def preset(cls, name: str, **overrides) -> "Params":
-        """A preset by name: ``"paper"`` or ``"paper_steady"``."""
+    def preset(cls, name: str, **overrides: float) -> Params:
+        """A preset by name.
+
+        Parameters
+        ----------
+        name : {"paper", "paper_steady"}
+            `Params.paper` or `Params.paper_steady`.
+        **overrides : float
+            Fields to change (SI units), validated.
+
+        Returns
+        -------
+        Params
+
+        Raises
+        ------
+        InvalidInputError
+            An unknown preset, an unknown field or a value out of its range.
+        """
         presets = {"paper": cls.paper, "paper_steady": cls.paper_steady}
         if name not in presets:
             raise InvalidInputError("unknown preset %r; allowed: %s" % (name, ", ".join(presets)))
@@ -114,8 +134,12 @@ class Params:
         return self.replace(**{n: 0.0 for f, names in zero.items() if f not in features
                                for n in names})
 
-    def replace(self, **changes) -> "Params":
-        """A copy with some fields changed (validated)."""
+    def replace(self, **changes: float) -> Params:
+        """A copy with some fields changed: ``p.replace(k_n=2e5, d_hip=0.01)`` (SI units).
+
+        Raises `pdw.InvalidInputError` for an unknown field (listing the allowed ones) or a
+        value out of its range (naming the field and the range).
+        """
         unknown = set(changes) - {f.name for f in dataclasses.fields(self)}
         if unknown:
             raise InvalidInputError("unknown Params field(s): %s; allowed: %s"
@@ -126,7 +150,8 @@ class Params:
         """Physical parameters in the C layout (`pdw.core._layout.PARAMS`), shape (NPARAM,)."""
         return np.array([getattr(self, n) for n in _layout.PARAMS], dtype=float)
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, float]:
+        """Every physical parameter by name (the order of `pdw.core._layout.PARAMS`), SI units."""
         return {n: getattr(self, n) for n in _layout.PARAMS}
 
     @property

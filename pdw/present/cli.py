@@ -132,7 +132,7 @@ def _walk(args):
         else:
             try:
                 from .plots import save_all
-                written += save_all(res, out)
+                written += save_all(res, out, progress=not args.no_progress)
             except ImportError as e:
                 hint = missing_extra(e)
                 if hint is None:
@@ -207,6 +207,8 @@ def _parser():
     w.add_argument("--out", default="out/typical_gait",
                    help="output folder (default out/typical_gait)")
     w.add_argument("--no-figures", action="store_true", help="skip the figures and the GIF")
+    w.add_argument("--no-progress", action="store_true",
+                   help="no progress bar over the figures (drawn only on a terminal)")
     r = sub.add_parser("run", help="run a scene file (docs/scenes.md): summary, gait descriptors")
     r.add_argument("scene", nargs="?", help="TOML scene file (pdw.Scene)")
     r.add_argument("--example", help="run an example scene shipped with pdw (see --list-examples)")

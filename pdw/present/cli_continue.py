@@ -98,8 +98,9 @@ def load_spec(path) -> dict:
     return spec
 
 
-def run_spec(spec, out=None):
-    """Run a loaded spec: (branches, paths written)."""
+def run_spec(spec, out=None, progress=False):
+    """Run a loaded spec: (branches, paths written); ``progress`` (False, True or a
+    `pdw.Progress`) as in `pdw.continue_gait`."""
     params = preset(spec.get("preset", "paper_steady"), **spec.get("params", {}))
     par = spec["parameter"]
     couple = dict(spec.get("couple", {}))
@@ -116,7 +117,7 @@ def run_spec(spec, out=None):
                                              for f, e in couple.items()})
     params = params.replace(**{par: start}) if start is not None else params
     common = dict(model=spec.get("model", "continuous"), variant=spec.get("variant", "paper"),
-                  params_of=params_of, value=start, **kw)
+                  params_of=params_of, value=start, progress=progress, **kw)
     t0 = time.perf_counter()
     if depth > 0:
         branches = follow_cascade(params, par, spec["stop"], depth=depth, **common)
@@ -175,6 +176,7 @@ def add_cli(subparsers):
     s.add_argument("--example", help="run an example continuation shipped with pdw (%s)"
                                      % ", ".join(examples.continuations()))
     s.add_argument("--out", help="output folder (default out/continuation/<name>)")
+    s.add_argument("--no-progress", action="store_true", help="no progress bar")
     s.set_defaults(func=cli_main)
     return s
 
@@ -183,7 +185,7 @@ def cli_main(args):
     if (args.spec is None) == (args.example is None):
         raise InvalidInputError("give a continuation file or --example NAME (one of them)")
     spec = load_spec(examples.continuation_path(args.example) if args.example else args.spec)
-    branches, paths = run_spec(spec, args.out)
+    branches, paths = run_spec(spec, args.out, progress=not args.no_progress)
     for b in branches:
         print("period %d: %d points, %s in [%.8g, %.8g], %d map evaluations, %.1f s; %s"
               % (b.period_n, len(b), b.parameter, b.values.min(), b.values.max(), b.n_maps,

@@ -30,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..core.progress import progress_bar
 from .animation import animate
 from .figure_kit import (  # noqa: F401 (re-exported by pdw.present.plots)
     _SHADE,
@@ -444,7 +445,7 @@ def fig_double_support(result, which=-1, margin=None):
 
 # --------------------------------------------------------------------------------------------
 
-def save_all(result, outdir) -> list[Path]:
+def save_all(result, outdir, progress=False) -> list[Path]:
     """Write every figure as PNG (``DPI``) and the animation as GIF into ``outdir``.
 
     Files: ``fig4_gait.png``, ``fig5_stick.png``, ``fig6_contact.png``,
@@ -457,6 +458,8 @@ def save_all(result, outdir) -> list[Path]:
         A simulated walk.
     outdir : str or Path
         Output folder, created if missing.
+    progress : bool or pdw.Progress
+        A bar over the files on stderr when it is a terminal (`pdw.core.progress`).
 
     Returns
     -------
@@ -472,10 +475,12 @@ def save_all(result, outdir) -> list[Path]:
         if double_support_intervals(result):
             jobs.append(("fig7_double_support.png", fig_double_support))
     written = []
-    for name, fn in jobs:
+    bar = progress_bar(progress, len(jobs) + 1, "figures")
+    for name, fn in bar.track(jobs):
         fig = fn(result)
         path = outdir / name
         fig.savefig(path, dpi=DPI)
         written.append(path)
     written.append(animate(result, outdir / "walker.gif"))
+    bar.update()
     return written

@@ -4,21 +4,27 @@ The compiled engine (pdw/core/csrc/pdw_batch.c) advances a block of W walkers wi
 central difference method (docs/model.md section 7), one walker per lane: the sin/cos of all lanes in
 one vector loop (glibc's libmvec), the generated stages and the discrete logic (flags, arming,
 anchors, events, online gait descriptors) per lane, exactly as `pdw.simulate`; a lane whose
-walker finishes takes the next one. Threads (GIL released) take disjoint ranges of walkers.
+walker finishes takes the next one. Every other method of `pdw.METHODS` (rodas4, dopri5, rk4,
+verlet) runs in rounds of one step per lane through the scalar integrator's own C, each lane
+with its own time, step size, accept/reject and located events. Threads (GIL released) take
+disjoint ranges of walkers.
 """
 from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..core import _batch, _layout, checks, interrupt
 from ..core.errors import InvalidInputError
+from ..core.integrators import METHODS
+from ..core.integrators import get as _method_info
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
 from ..core.params import Params
 from . import stepsize as _stepsize
+from .chunks import honest, record_subset, run_chunked
 from .gait import Steps, steps_from_rows
 from .simulation import _REASONS, _check_count, _check_positive
 
@@ -26,6 +32,26 @@ _STATUS = {0: "interrupted", 1: "walked", 2: "fell", 3: "diverged", 5: "diverged
 _STOP = {0: "t_end", 1: "steps", 2: "periodic"}
 LANES = 8
 """Default lanes per block (walkers advanced in lockstep by one thread)."""
+ISA_ENV = "PDW_BATCH_ISA"
+"""Environment variable that picks the cdm lane loop: ``scalar`` (every lane through the
+generated scalar stages), ``base`` (the structure-of-arrays step at the x86-64 baseline, SSE2),
+``avx2`` or ``avx512``; default: the widest this CPU runs (`pdw.core._batch.best_isa`). Every
+choice gives the same bits with ``vector=False``; the tests force each one."""
+
+
+def batch_isa() -> str:
+    """The cdm lane loop `simulate_batch` uses: $PDW_BATCH_ISA, else the widest supported."""
+    name = os.environ.get(ISA_ENV, "").strip().lower()
+    if not name:
+        return _batch.best_isa()
+    if name not in _batch.ISAS:
+        raise InvalidInputError("%s must be one of %s, got %r"
+                                % (ISA_ENV, tuple(_batch.ISAS), name))
+    if not _batch.isa_supported(name):
+        raise InvalidInputError("%s = %r: this CPU does not run it (it runs %s)"
+                                % (ISA_ENV, name, [n for n in _batch.ISAS
+                                                   if _batch.isa_supported(n)]))
+    return name
 
 
 @dataclass
@@ -56,6 +82,10 @@ class BatchResult:
         `pdw.core._layout.STEP`, legs 0/1), NaN beyond; `steps(i)` gives them as `Steps`.
     dt, t_end : float
         Step and end time [s]; ``method``, ``variant``: as given.
+    recorded : dict
+        ``{i: Result}`` for the walkers listed in ``record`` (`simulate_batch`), else empty.
+    engine : str
+        ``"batch"`` (the compiled lanes) or ``"scalar"`` (`pdw.sim.ensemble.scalar_batch`).
     """
 
     status: np.ndarray
@@ -76,6 +106,8 @@ class BatchResult:
     t_end: float
     method: str
     variant: str
+    recorded: dict = field(default_factory=dict)
+    engine: str = "batch"
 
     def __len__(self) -> int:
         return len(self.status)
@@ -147,7 +179,9 @@ def _flags(flags0, n):
 def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
                    flags0=(0, 1), threads=None, lanes=LANES, vector=False, stop_steps=0,
                    periodic_steps=0, periodic_tol=1e-3, fall_hip_height=None, fall_depth=None,
-                   max_speed=1e3, check_step="warn") -> BatchResult:
+                   max_speed=1e3, check_step="warn", rtol=1e-6, atol=1e-8, h_max=None,
+                   event_tol=1e-9, max_steps=None, *, executor=None, chunk_size=None,
+                   record=None, record_every=1) -> BatchResult:
     """Simulate N walkers at once: the result of `pdw.simulate` for each, without recording.
 
     Parameters
@@ -159,9 +193,12 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
     params : Params or sequence of N Params, optional
         One parameter set for all walkers (default: the paper's) or one per walker.
     variant : {"paper", "consistent"}
-    method : {"cdm"}
-        Only the paper's central difference method (docs/model.md section 7) has a batched loop;
-        adaptive rodas4 with per-lane step control is not implemented (docs/ensemble.md).
+    method : {"cdm", "verlet", "rk4", "dopri5", "rodas4"}
+        "cdm" (the paper's central difference method, docs/model.md section 7) runs the lockstep
+        lane loop; every other method of `pdw.METHODS` runs per lane through the scalar
+        integrator's C, one (accepted) step per lane per round: each lane keeps its own time,
+        step size, accept/reject and event location, and every walker is bitwise its
+        `simulate` run (docs/ensemble.md). For the adaptive methods dt is the first step.
     flags0 : (2,) or (N, 2) ints in {0, 1}
         Initial support flags of legs 1, 2.
     threads : int, optional
@@ -175,8 +212,28 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
         step-sized shifts of events, so final states then agree with `simulate` in outcome,
         not to 1e-12 (docs/ensemble.md).
     stop_steps, periodic_steps, periodic_tol, fall_hip_height, fall_depth, max_speed, check_step
+    rtol, atol, h_max, event_tol, max_steps
+        As `simulate` (adaptive methods; max_steps is the budget of each walker).
         As `simulate`; fall_hip_height and fall_depth default to 0.5 l and 0.25 l of each
-        walker's parameters. A divergence is a status here (``"diverged"``), never an error.
+        walker's parameters. A divergence is a status here (``"diverged"``), never an error;
+        the end-of-run checks of `simulate` (runaway, ``"no_steps"``) are applied to the final
+        states (`pdw.sim.chunks.honest`).
+    executor : concurrent.futures.Executor-like, optional
+        Cut the batch into chunks of ``chunk_size`` consecutive walkers, each one task
+        ``executor.submit`` (a thread or process pool, Dask's ``client.get_executor()``), the
+        results put back in order: bitwise the unchunked batch. Each chunk runs ``threads``
+        threads (give ``threads=1`` with a pool of one worker per core).
+    chunk_size : int, optional
+        Walkers per chunk (default: N / 8 with an executor); without an executor the chunks
+        run one after the other in this thread.
+    record : sequence of int, optional
+        Walkers whose trajectories are wanted: they are run again through the **scalar**
+        `pdw.simulate` in this call (the compiled lane loop records nothing), with
+        ``record_every`` and the same inputs (forces and events recorded,
+        ``on_failure="return"``), and returned in ``BatchResult.recorded`` as `Result`s. On the
+        bitwise path (``vector=False``) those runs are the lanes' arithmetic: same ``x_final``.
+    record_every : int
+        Sampling of the recorded walkers (every k-th step, >= 1).
 
     Returns
     -------
@@ -192,6 +249,17 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
     """
     x = _rows(x0)
     n = len(x)
+    if executor is not None or chunk_size is not None:
+        kw = dict(x0=x, t_end=t_end, dt=dt, params=params, variant=variant, method=method,
+                  flags0=flags0, threads=threads, lanes=lanes, vector=vector,
+                  stop_steps=stop_steps, periodic_steps=periodic_steps,
+                  periodic_tol=periodic_tol, fall_hip_height=fall_hip_height,
+                  fall_depth=fall_depth, max_speed=max_speed, check_step=check_step,
+                  rtol=rtol, atol=atol, h_max=h_max, event_tol=event_tol, max_steps=max_steps,
+                  record=record, record_every=record_every)
+        if chunk_size is None:
+            chunk_size = max(1, math.ceil(n / 8))
+        return run_chunked(simulate_batch, kw, executor, chunk_size)
     t_end = _check_positive("t_end", t_end)
     dt = _check_positive("dt", dt)
     if dt > t_end:
@@ -200,9 +268,22 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
         check_variant(variant)
     except ValueError as e:
         raise InvalidInputError(str(e)) from None
-    if method != "cdm":
-        raise InvalidInputError("simulate_batch supports method 'cdm' only, got %r (use "
-                                "pdw.simulate on a thread pool for the others)" % (method,))
+    if method not in METHODS:
+        raise InvalidInputError("method must be one of %s, got %r" % (METHODS, method))
+    if vector and method != "cdm":
+        raise InvalidInputError("vector=True (vector sin/cos) applies to method 'cdm' only, "
+                                "got method %r" % (method,))
+    adaptive = _method_info(method).adaptive
+    rtol = _check_positive("rtol", rtol)
+    atol = _check_positive("atol", atol)
+    h_max = 0.0 if h_max is None else _check_positive("h_max", h_max)
+    event_tol = _check_positive("event_tol", event_tol)
+    if max_steps is None:
+        budget = 10 ** 6 + int(2e6 * t_end) if adaptive else 0     # as simulate's
+    else:
+        budget = _check_count("max_steps", max_steps)
+        if budget < 1:
+            raise InvalidInputError("max_steps must be >= 1, got %d" % budget)
     if params is None or isinstance(params, Params):
         plist = [Params.paper() if params is None else params]
     else:
@@ -258,13 +339,19 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
     hip = np.ascontiguousarray(hip, dtype=float)
     depth = np.ascontiguousarray(depth, dtype=float)
     out = _outputs(n)
+    if not adaptive and max_steps is not None and n_steps > budget:
+        raise InvalidInputError("t_end/dt = %d steps exceeds max_steps = %d: raise max_steps "
+                                "or take a larger dt" % (n_steps, budget))
+    t_stop = t_end if adaptive else n_steps * dt
+    opts = dict(method=METHODS.index(method), t_end=t_stop, rtol=rtol, atol=atol, h_max=h_max,
+                event_tol=event_tol, max_steps=budget, isa=_batch.ISAS[batch_isa()])
     if n:
         chunks = _chunks(n, threads, lanes)
         args = (k, x, pvec, f0, hip, depth, dt, n_steps, max_speed, stop_steps, periodic_steps,
                 periodic_tol, out)
         try:
             interrupt.thread_map(lambda c: _batch.run_range(*args, c[0], c[1], lanes,
-                                                            bool(vector)),
+                                                            bool(vector), **opts),
                                  chunks, threads)
         except KeyboardInterrupt as e:
             # Ctrl-C: the walkers finished so far, the running ones as they are, the others at
@@ -272,9 +359,20 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
             unstarted = np.isnan(out["t_final"])
             out["x_final"][unstarted] = x[unstarted]
             out["t_final"][unstarted] = 0.0
-            e.result = _result(out, dt, n_steps * dt, method, variant)
+            e.result = _result(out, dt, t_stop, method, variant)
             raise
-    return _result(out, dt, n_steps * dt, method, variant)
+    res = _result(out, dt, t_stop, method, variant)
+    honest(res, x, plist if len(plist) == n else plist[0])
+    if record is not None:
+        res.recorded = record_subset(
+            res, record, record_every, x, plist if len(plist) == n else plist[0], f0,
+            dict(t_end=t_end, dt=dt, variant=variant, method=method, stop_steps=stop_steps,
+                 periodic_steps=periodic_steps, periodic_tol=periodic_tol,
+                 fall_hip_height=fall_hip_height, fall_depth=fall_depth, max_speed=max_speed,
+                 check_step=check_step, rtol=rtol, atol=atol,
+                 h_max=None if h_max == 0.0 else h_max, event_tol=event_tol,
+                 max_steps=max_steps))
+    return res
 
 
 def _chunks(n, threads, lanes):

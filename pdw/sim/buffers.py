@@ -42,6 +42,7 @@ class RecordBuffer:
 
     @property
     def capacity(self) -> int:
+        """Rows allocated now."""
         return len(self.t)
 
     def arrays(self, rows: int):

@@ -12,41 +12,47 @@ recorded end points and their derivatives under the interval's discrete state:
 
 The interpolant passes through the recorded states exactly, is C^1 inside each smooth stretch,
 and its error between steps converges with the method's order (tests/test_dense_output.py).
-The tangential anchors (docs/model.md section 6) are not recorded; they are rebuilt from the
-touch-downs (the rolling coordinate s_i at the step where flag i became 1), as the loops set
-them.
+The anchors (docs/model.md section 6, `pdw.core._layout.ANCHORS`) are not recorded; they are
+rebuilt from the touch-downs as the loops set them: the rolling coordinate s_i and the approach
+speed max(-v_y, 0) of foot i at the step where flag i became 1 (or at the start, for a foot
+that starts in support). The approach speeds are the discrete values of the Lankarani-Nikravesh
+and Flores laws (docs/contact_laws.md): the interpolant's f(x) uses the values of the run.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from ..core import _core, checks
+from ..core import _core, _layout, checks
+from ..core.contact import Contact
 from ..core.errors import InvalidInputError
 from ..core.model import contact_forces, kernel_index, parameter_vector
 
 
 def _anchors(x, flags, params, variant):
-    """Anchors in force at each recorded step, shape (N, 2) [m]."""
-    s = contact_forces(x, params, flags=(0, 0), variant=variant).s   # s does not use anchors
-    s = np.atleast_2d(s)
-    a = np.zeros((len(x), 2))
+    """Anchors in force at each recorded step, shape (N, 4): s0_1, s0_2 [m], v_in1, v_in2 [m/s]
+    (`pdw.core._layout.ANCHORS`)."""
+    cs = contact_forces(x, params, flags=(0, 0), variant=variant)   # s, v_y use no anchors
+    s, vin = np.atleast_2d(cs.s), np.maximum(-np.atleast_2d(cs.v_y), 0.0)
+    a = np.zeros((len(x), len(_layout.ANCHORS)))
     for i in range(2):
         f = flags[:, i]
         down = f.astype(bool) & np.r_[True, f[:-1] == 0]          # touch-downs (and start)
         last = np.maximum.accumulate(np.where(down, np.arange(len(x)), -1))
         ok = last >= 0
-        a[ok, i] = s[last[ok], i]
+        a[ok, _layout.ANCHORS.index("s0_%d" % (i + 1))] = s[last[ok], i]
+        a[ok, _layout.ANCHORS.index("v_in%d" % (i + 1))] = vin[last[ok], i]
     return a
 
 
 class DenseOutput:
     """Piecewise Hermite interpolant of a recorded run; ``sol(t)`` -> (8,) or (len(t), 8).
 
-    Attributes ``t`` (N,), ``x`` (N, 8), ``flags`` (N, 2), ``anchors`` (N, 2) are the recorded
-    steps; ``order`` is 3 (cubic) or 5 (quintic).
+    Attributes ``t`` (N,), ``x`` (N, 8), ``flags`` (N, 2), ``anchors`` (N, 4) (layout
+    `pdw.core._layout.ANCHORS`) are the recorded steps; ``order`` is 3 (cubic) or 5 (quintic);
+    ``contact`` the run's `pdw.Contact` (its normal law's f is interpolated).
     """
 
-    def __init__(self, t, x, flags, params, variant, features, order):
+    def __init__(self, t, x, flags, params, variant, features, order, contact=None):
         self.t = np.ascontiguousarray(t, dtype=float)
         self.x = np.ascontiguousarray(x, dtype=float)
         self.flags = np.ascontiguousarray(flags, dtype=np.intc)
@@ -54,21 +60,22 @@ class DenseOutput:
             raise InvalidInputError("dense output needs at least two recorded steps")
         self.order = order
         self.anchors = _anchors(self.x, self.flags, params, variant)
-        k = kernel_index(variant, features)
-        p = parameter_vector(params)
+        self.contact = Contact.coerce(contact)
+        k = kernel_index(variant, features, self.contact.normal)
+        p = self.contact.vector(parameter_vector(params), features, params)
         fl = np.ascontiguousarray(self.flags[:-1])
         an = np.ascontiguousarray(self.anchors[:-1])
         n = len(self.t) - 1
         self._fl, self._an, self._k, self._p = fl, an, k, p
         ends = []
         for xs in (np.ascontiguousarray(self.x[:-1]), np.ascontiguousarray(self.x[1:])):
-            f = np.empty((n, 8))
+            f = np.empty((n, _core.NX))
             _core.rhs_batch(k, xs, p, fl, an, f, np.empty((n, _core.NWORK)))
             a = None
             if order == 5:
-                J = np.empty((n, 64))
+                J = np.empty((n, _core.NX * _core.NX))
                 _core.jacobian_batch(k, xs, p, fl, an, J, np.empty((n, _core.NWORK)))
-                a = np.einsum("nij,nj->ni", J.reshape(n, 8, 8), f)
+                a = np.einsum("nij,nj->ni", J.reshape(n, _core.NX, _core.NX), f)
             ends.append((f, a))
         (self.f0, self.a0), (self.f1, self.a1) = ends
 
@@ -143,28 +150,30 @@ def resample(res, sol, t_eval, params, variant):
     """Replace the Result's records (t, x, flags, Fn, Ft) by their values at t_eval (those up to
     the run's last recorded time); the steps stay in ``res.sol``."""
     te = t_eval[t_eval <= sol.t[-1]]
-    x = sol(te) if len(te) else np.zeros((0, 8))
+    x = sol(te) if len(te) else np.zeros((0, _core.NX))
     fl = sol.flags_at(te) if len(te) else np.zeros((0, 2), dtype=np.intc)
     res.t, res.x, res.flags = te, x, fl
     if len(res.Fn):
         Fn = np.zeros((len(te), 2))
         Ft = np.zeros((len(te), 2))
-        an = sol.anchors_at(te) if len(te) else np.zeros((0, 2))
+        an = sol.anchors_at(te) if len(te) else np.zeros((0, len(_layout.ANCHORS)))
         for f in np.unique(fl, axis=0):
             m = np.all(fl == f, axis=1)
             for a in np.unique(an[m], axis=0):
                 mm = m & np.all(an == a, axis=1)
                 c = contact_forces(x[mm], params, flags=tuple(int(v) for v in f),
-                                   anchors=tuple(a), variant=variant, features=None)
+                                   anchors=tuple(a), variant=variant, features=None,
+                                   contact=sol.contact)
                 Fn[mm], Ft[mm] = np.atleast_2d(c.F_n), np.atleast_2d(c.F_t)
         res.Fn, res.Ft = Fn, Ft
     return res
 
 
-def attach(res, t_eval, dense_output, params, variant, features, order, record_energies):
+def attach(res, t_eval, dense_output, params, variant, features, order, record_energies,
+           contact=None):
     """Give a Result its dense output (``res.sol``) and, with t_eval, its samples there."""
     sol = DenseOutput(res.t, res.x, res.flags, params, variant, features,
-                      3 if order <= 3 else 5)
+                      3 if order <= 3 else 5, contact)
     if t_eval is not None:
         resample(res, sol, t_eval, params, variant)
         if record_energies:

@@ -7,11 +7,13 @@ foreign file is a `pdw.InvalidInputError` naming the field, never a Result that 
 from __future__ import annotations
 
 import json
+import os
 import zipfile
 
 import numpy as np
 
 from ..core import _layout, checks
+from ..core.contact import Contact
 from ..core.errors import InvalidInputError
 from ..core.integrators import METHODS
 from ..core.params import Params
@@ -80,6 +82,11 @@ def _check(arrays, meta):
     if not isinstance(params, dict) or set(params) - set(Params.paper().as_dict()):
         raise _Bad("settings.params must hold Params fields only, got %r" % (params,))
     params = Params(**params)                 # range checks: InvalidInputError naming the field
+    contact = s.get("contact")
+    if contact is not None and not isinstance(contact, dict):
+        raise _Bad("settings.contact must be a table of pdw.Contact fields, got %r" % (contact,))
+    contact = Contact.coerce(contact)         # InvalidInputError naming the field
+    nx = contact.nx                           # the state layout of its friction law
     status = _field(meta, "status")
     if status not in STATUSES:
         raise _Bad("status must be one of %s, got %r" % (", ".join(STATUSES), status))
@@ -88,7 +95,7 @@ def _check(arrays, meta):
         raise _Bad("stop_reason must be one of %s, got %r" % (", ".join(STOP_REASONS), stop))
     t = _array(arrays, "t", (-1,))
     n = len(t)
-    x = _array(arrays, "x", (n, len(_layout.STATE)))
+    x = _array(arrays, "x", (n, nx))
     flags = _array(arrays, "flags", (n, 2), kind="iu")
     if not np.isin(flags, (0, 1)).all():
         raise _Bad("array 'flags' must hold 0 or 1 only")
@@ -101,7 +108,7 @@ def _check(arrays, meta):
                         and np.isin(ev[:, 2], range(len(_layout.EVENT_KIND))).all()):
         raise _Bad("array 'events' must have legs 1, 2 and kinds 0 ... %d"
                    % (len(_layout.EVENT_KIND) - 1))
-    x_final = _array(arrays, "x_final", (len(_layout.STATE),))
+    x_final = _array(arrays, "x_final", (nx,))
     gait = {k[5:]: _array(arrays, k, (-1,), finite=False) for k in arrays if k.startswith("gait_")}
     if gait and (set(gait) != set(_layout.STEP) or len({len(v) for v in gait.values()}) != 1):
         raise _Bad("the gait_* arrays must be the fields %s, all of one length"
@@ -110,7 +117,7 @@ def _check(arrays, meta):
     failure = meta.get("failure")
     if failure is not None:
         fx = _array({"failure.x": np.asarray(_field(failure, "x", "failure"))}, "failure.x",
-                    (len(_layout.STATE),))
+                    (nx,))
         leg = _field(failure, "leg", "failure")
         if leg not in (None, 1, 2) or not isinstance(_field(failure, "reason", "failure"), str):
             raise _Bad("failure.leg must be null, 1 or 2 and failure.reason a text")
@@ -137,13 +144,23 @@ def _check(arrays, meta):
         n_gait_steps=_count("n_gait_steps", _field(meta, "n_gait_steps")),
         event_counts={str(k): _count("event_counts." + str(k), v) for k, v in counts.items()},
         events_recorded=recorded, stop_reason=stop, energies=energies,
-        features=tuple(features))
+        features=tuple(features), contact=contact)
 
 
-def load(path) -> Result:
-    """Read a Result written by `Result.save` (``.npz`` or ``.nc``); ``res.provenance`` holds
-    the metadata (pdw version, INPUT_HASH, pdw's source revision, settings, scene, time of
-    writing).
+def load(path: str | os.PathLike) -> Result:
+    """Read a Result written by `Result.save`.
+
+    Parameters
+    ----------
+    path : str or path-like
+        An ``.npz`` file, or ``.nc`` (NetCDF, needs xarray).
+
+    Returns
+    -------
+    Result
+        The run's recorded arrays (t (M,) [s], x (M, nx), flags (M, 2), Fn, Ft (M, 2) [N]),
+        events, gait descriptors and settings; ``res.provenance`` holds the metadata (pdw
+        version, INPUT_HASH, pdw's source revision, settings, scene, time of writing).
 
     Raises
     ------

@@ -21,10 +21,16 @@ its events (``record_events=False``) it returns `Result.gait`.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 
 from ..core import _layout
+
+if TYPE_CHECKING:                 # annotations only (simulation imports this module)
+    import pandas
+
+    from .simulation import Event, Result
 
 FIELDS = _layout.STEP
 UNITS = {"leg": "", "t_lift_off": "s", "t_touch_down": "s", "L": "m", "travel": "m", "P": "s",
@@ -33,9 +39,18 @@ UNITS = {"leg": "", "t_lift_off": "s", "t_touch_down": "s", "L": "m", "travel": 
 
 @dataclass
 class Steps:
-    """Per-step gait descriptors; ``table[name]`` is an array with one entry per step."""
+    """Per-step gait descriptors (docs/model.md section 8), one entry per complete step.
 
-    table: dict
+    Attributes
+    ----------
+    table : dict of str -> ndarray (n_steps,)
+        ``leg`` (the swing leg, 1 or 2), ``t_lift_off`` and ``t_touch_down`` [s], step length
+        ``L`` and hip ``travel`` [m], step period ``P`` [s], speed ``v`` [m/s], ``cycle`` [s],
+        ``double_support`` [s] and its share of the step, ``ds_fraction`` [-].
+        ``steps["L"]`` is ``steps.table["L"]``; ``len(steps)`` the number of steps.
+    """
+
+    table: dict[str, np.ndarray]
 
     def __len__(self):
         return len(self.table["leg"])
@@ -43,10 +58,23 @@ class Steps:
     def __getitem__(self, name):
         return self.table[name]
 
-    def steady(self, last: int = 4) -> dict:
-        """Mean of the last ``last`` complete steps, and how much successive steps still
-        differ there (``spread_<name>``: largest absolute difference between consecutive steps)."""
-        out = {"n_steps": len(self), "last": min(last, len(self))}
+    def steady(self, last: int = 4) -> dict[str, float | int]:
+        """The steady gait: the mean of the last ``last`` complete steps.
+
+        Parameters
+        ----------
+        last : int
+            Steps to average (fewer when the run has fewer; NaN entries are skipped).
+
+        Returns
+        -------
+        dict
+            ``n_steps`` (all steps), ``last`` (steps averaged), the means of ``L``, ``travel``
+            [m], ``P``, ``cycle``, ``double_support`` [s], ``v`` [m/s], ``ds_fraction`` [-],
+            and for each ``spread_<name>``: the largest absolute difference between
+            consecutive averaged steps (how far from steady they still are; NaN for one step).
+        """
+        out: dict[str, float | int] = {"n_steps": len(self), "last": min(last, len(self))}
         for name in ("L", "travel", "P", "v", "cycle", "double_support", "ds_fraction"):
             a = self.table[name]
             a = a[np.isfinite(a)][-last:]
@@ -54,8 +82,9 @@ class Steps:
             out["spread_" + name] = float(np.max(np.abs(np.diff(a)))) if len(a) > 1 else float("nan")
         return out
 
-    def to_dataframe(self):
-        """One row per step as a pandas DataFrame (`pdw.sim.io.steps_to_dataframe`)."""
+    def to_dataframe(self) -> pandas.DataFrame:
+        """One row per step as a pandas DataFrame (`pdw.sim.io.steps_to_dataframe`; needs
+        pandas): the columns of `table`, units in ``df.attrs["units"]``."""
         from .io import steps_to_dataframe
         return steps_to_dataframe(self)
 
@@ -105,7 +134,7 @@ def steps_from_rows(rows, capacity: int = _layout.STEP_RING) -> Steps:
     return Steps(table)
 
 
-def steps(result_or_events) -> Steps:
+def steps(result_or_events: Result | Sequence[Event]) -> Steps:
     """Gait descriptors of every complete step of a run.
 
     Parameters
@@ -122,12 +151,12 @@ def steps(result_or_events) -> Steps:
         Steps whose swing leg has a known lift-off and whose other foot has a known
         touch-down (the first, partial step of a run is skipped).
     """
-    if getattr(result_or_events, "events_recorded", True) is False:
-        return result_or_events.gait
-    events = getattr(result_or_events, "events", result_or_events)
-    events = sorted(events, key=lambda e: e.t)
-    last_td = {1: None, 2: None}     # (t, x_D) of each leg's latest touch-down
-    last_lo = {1: None, 2: None}     # (t, x_D) of each leg's latest lift-off
+    src: Any = result_or_events       # duck-typed: a Result, or a sequence of events
+    if getattr(src, "events_recorded", True) is False:
+        return src.gait
+    events = sorted(getattr(src, "events", src), key=lambda e: e.t)
+    last_td: dict[int, Any] = {1: None, 2: None}     # (t, x_D) of each leg's latest touch-down
+    last_lo: dict[int, Any] = {1: None, 2: None}     # (t, x_D) of each leg's latest lift-off
     prev_td_t = None
     rows = []
     for k, e in enumerate(events):

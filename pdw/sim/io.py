@@ -24,6 +24,16 @@ from ..core.provenance import provenance
 STEP_UNITS = {"leg": "", "t_lift_off": "s", "t_touch_down": "s", "L": "m", "travel": "m",
               "P": "s", "v": "m/s", "cycle": "s", "double_support": "s", "ds_fraction": ""}
 UNITS = dict(zip(_layout.STATE, ("m", "m", "rad", "rad", "m/s", "m/s", "rad/s", "rad/s")))
+UNITS.update({name: "m" for name in _layout.BRISTLE})      # LuGre's bristle deflections
+
+
+def _names(res):
+    """The column names of res.x (its friction law's state layout)."""
+    return tuple(getattr(res, "state_names", _layout.STATE))
+
+
+def _units(res):
+    return {n: UNITS[n] for n in _names(res)}
 FORMAT = "pdw-result-1"
 
 
@@ -41,7 +51,9 @@ def metadata(res) -> dict:
             "written": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
             "settings": {"method": res.method, "variant": res.variant, "dt": res.dt,
                          "t_end": res.t_end, "features": list(res.features),
-                         "params": res.params.as_dict()},
+                         "params": res.params.as_dict(),
+                         "contact": (res.contact.as_dict() if getattr(res, "contact", None)
+                                     is not None else None)},
             "status": res.status, "stop_reason": res.stop_reason, "failure": None,
             "t_final": res.t_final, "n_steps": int(res.n_steps), "wall_time": res.wall_time,
             "stats": {k: int(v) for k, v in res.stats.items()},
@@ -49,7 +61,7 @@ def metadata(res) -> dict:
             "event_counts": {k: int(v) for k, v in res.event_counts.items()},
             "events_recorded": bool(res.events_recorded),
             "scene": scene.to_toml() if scene is not None and hasattr(scene, "to_toml") else None,
-            "units": {"t": "s", "x": UNITS, "Fn": "N", "Ft": "N", "energies": "J"}}
+            "units": {"t": "s", "x": _units(res), "Fn": "N", "Ft": "N", "energies": "J"}}
     if res.failure:
         meta["failure"] = {"t": float(res.failure["t"]), "x": list(map(float, res.failure["x"])),
                            "reason": res.failure["reason"], "leg": res.failure["leg"]}
@@ -106,12 +118,12 @@ def read(path):
 
 
 def result_to_dataframe(res):
-    """One row per recorded sample, indexed by t [s]: the state (`pdw.STATE`), the support
+    """One row per recorded sample, indexed by t [s]: the state (`Result.state_names`), the support
     flags ``flag1, flag2``, the contact forces ``Fn1, Fn2, Ft1, Ft2`` [N] (if recorded) and the
     energies [J] (if recorded). Units in ``df.attrs["units"]``."""
     pd = _need("pandas")
-    cols = {name: res.x[:, i] for i, name in enumerate(_layout.STATE)}
-    units = dict(UNITS)
+    cols = {name: res.x[:, i] for i, name in enumerate(_names(res))}
+    units = _units(res)
     cols.update(flag1=res.flags[:, 0], flag2=res.flags[:, 1])
     if len(res.Fn) == len(res.t):
         for i in (0, 1):
@@ -145,10 +157,10 @@ def result_to_xarray(res):
     xr = _need("xarray")
     meta = metadata(res)
     a = _arrays(res)
-    dv = {"x": (("time", "state"), a["x"], {"units": json.dumps(UNITS)}),
+    dv = {"x": (("time", "state"), a["x"], {"units": json.dumps(_units(res))}),
           "flags": (("time", "leg"), a["flags"], {"units": "1", "long_name": "support flag"}),
           "events": (("event", "event_field"), a["events"], {"units": "s, -, -, m, m"}),
-          "x_final": (("state",), a["x_final"], {"units": json.dumps(UNITS)})}
+          "x_final": (("state",), a["x_final"], {"units": json.dumps(_units(res))})}
     if len(a["Fn"]) == len(a["t"]):
         dv["Fn"] = (("time", "leg"), a["Fn"], {"units": "N", "long_name": "normal contact force"})
         dv["Ft"] = (("time", "leg"), a["Ft"], {"units": "N",
@@ -162,7 +174,7 @@ def result_to_xarray(res):
         elif k.startswith("gait_"):
             dv[k] = (("step",), v, {"units": STEP_UNITS.get(k[5:], "")})
     ds = xr.Dataset(dv, coords={"time": ("time", a["t"], {"units": "s"}),
-                                "state": list(_layout.STATE), "leg": [1, 2],
+                                "state": list(_names(res)), "leg": [1, 2],
                                 "event_field": list(_layout.EVENT)})
     prov = meta["provenance"]
     ds.attrs.update({"pdw_version": prov["pdw_version"], "input_hash": prov["input_hash"],

@@ -57,20 +57,26 @@ TOML layout (every key optional; defaults are `Scene()`'s)::
     # fall_hip_height, fall_depth [m]: the fall thresholds (default 0.5 l, 0.25 l)
 
 Unknown keys and values of the wrong type are errors naming the key (``record.evry``).
+
+Why this module is long: it is the scene's schema, every section's fields with their TOML
+types, units, meaning and checks (the field metadata), next to the reading, checking and
+writing that use them; split, a field and its check would live apart.
 """
 from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import pathlib
 from dataclasses import dataclass, field
+from typing import Any
 
 from ..core import _layout, _toml
 from ..core.contact import Contact
 from ..core.errors import InvalidInputError
 from ..core.integrators import METHODS
 from ..core.params import X0_PAPER, Params
-from .simulation import simulate
+from .simulation import Result, simulate
 
 PRESETS = ("paper", "paper_steady")
 ON_FAILURE = ("raise", "return")
@@ -207,7 +213,7 @@ class _Section:
         prefix = cls.SECTION if prefix is None else prefix
         if not isinstance(data, dict):
             raise _err(prefix, "must be a table, got %r" % (data,))
-        names = [f.name for f in dataclasses.fields(cls)]
+        names = [f.name for f in dataclasses.fields(cls)]  # type: ignore[arg-type]
         for key in data:
             if key not in names:
                 full = "%s.%s" % (prefix, key) if prefix else key
@@ -216,8 +222,8 @@ class _Section:
 
     def to_dict(self) -> dict:
         """Plain dict (nested for sections); None values left out (TOML has no null)."""
-        out = {}
-        for f in dataclasses.fields(self):
+        out: dict[str, Any] = {}
+        for f in dataclasses.fields(self):  # type: ignore[arg-type]
             v = getattr(self, f.name)
             if isinstance(v, _Section):
                 out[f.name] = v.to_dict()
@@ -353,6 +359,12 @@ class ContactLaws(_Section):
     d: float | None = _f(None, "float?", "normal damping [N s/m^2.5; kelvin_voigt N s/m]")
     e: float | None = _f(None, "float?", "coefficient of restitution (lankarani_nikravesh, flores)")
     v_in_min: float | None = _f(None, "float?", "smallest approach speed [m/s] (idem)")
+    sigma0: float | None = _f(None, "float?", "LuGre bristle stiffness per unit normal force [1/m]")
+    sigma1: float | None = _f(None, "float?", "LuGre bristle damping per unit normal force [s/m]")
+    sigma2: float | None = _f(None, "float?", "LuGre viscous friction per unit normal force [s/m]")
+    mu_s: float | None = _f(None, "float?", "LuGre static friction coefficient [-]")
+    mu_c: float | None = _f(None, "float?", "LuGre Coulomb friction coefficient [-]")
+    v_s: float | None = _f(None, "float?", "LuGre Stribeck velocity [m/s]")
 
     def _check(self):
         try:
@@ -436,15 +448,37 @@ class Scene(_Section):
             periodic_steps=st.periodic_steps if st.periodic else 0,
             periodic_tol=st.periodic_tol, contact=self.contact.to_contact())
 
-    def run(self):
-        """Run the scene: a `pdw.Result` (with ``result.scene`` set to this scene)."""
+    def run(self) -> Result:
+        """Run the scene (`pdw.simulate` with the scene's settings).
+
+        Returns
+        -------
+        Result
+            With ``result.scene`` set to this scene (saved with the result's provenance).
+        """
         return simulate(self)
 
     # --- TOML ----------------------------------------------------------------------------
     @classmethod
-    def from_toml(cls, text: str, source: str = "scene") -> "Scene":
-        """Read a scene from TOML text. Unknown keys, wrong types and invalid values are
-        `pdw.InvalidInputError` naming the key."""
+    def from_toml(cls, text: str, source: str = "scene") -> Scene:
+        """Read a scene from TOML text (docs/scenes.md).
+
+        Parameters
+        ----------
+        text : str
+            The TOML document.
+        source : str
+            Where the text came from, for error messages.
+
+        Returns
+        -------
+        Scene
+
+        Raises
+        ------
+        InvalidInputError
+            Invalid TOML, an unknown key, a wrong type or an invalid value, naming the key.
+        """
         try:
             data = _toml.loads(text)
         except _toml.TOMLDecodeError as e:
@@ -457,8 +491,23 @@ class Scene(_Section):
             raise InvalidInputError("%s: %s" % (source, e)) from None
 
     @classmethod
-    def load(cls, path) -> "Scene":
-        """Read a scene file (TOML)."""
+    def load(cls, path: str | os.PathLike) -> Scene:
+        """Read a scene file (TOML, docs/scenes.md; `Scene.save` writes one).
+
+        Parameters
+        ----------
+        path : str or path-like
+            The file.
+
+        Returns
+        -------
+        Scene
+
+        Raises
+        ------
+        InvalidInputError
+            The file cannot be read, or its content is not a valid scene (naming the key).
+        """
         path = pathlib.Path(path)
         try:
             text = path.read_text()
@@ -470,15 +519,32 @@ class Scene(_Section):
         """TOML text of the scene; `Scene.from_toml` reads it back to an equal scene."""
         return _toml.dumps(self.to_dict(), "pdw scene (docs/scenes.md); run it with `pdw run FILE`")
 
-    def save(self, path) -> pathlib.Path:
-        """Write the scene as a TOML file."""
+    def save(self, path: str | os.PathLike) -> pathlib.Path:
+        """Write the scene as a TOML file (`Scene.to_toml`); `Scene.load` reads it back to an
+        equal scene. Returns the path written."""
         path = pathlib.Path(path)
         path.write_text(self.to_toml())
         return path
 
 
-def run(scene):
-    """Run a `Scene` (or a scene file's path): a `pdw.Result`."""
+def run(scene: Scene | str | os.PathLike) -> Result:
+    """Run a scene: ``pdw.run("walk.toml")`` or ``pdw.run(scene)``.
+
+    Parameters
+    ----------
+    scene : Scene, str or path-like
+        A `Scene`, or the path of a scene file (TOML, docs/scenes.md; read with `Scene.load`).
+
+    Returns
+    -------
+    Result
+        The simulated run (`pdw.simulate`), ``result.scene`` set.
+
+    Raises
+    ------
+    InvalidInputError
+        Anything else than a scene or a path, or an invalid scene file.
+    """
     if isinstance(scene, (str, pathlib.Path)):
         scene = Scene.load(scene)
     if not isinstance(scene, Scene):

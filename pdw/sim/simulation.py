@@ -3,16 +3,23 @@
 The loop (C, GIL released) carries the support flags, the arming of the scuffing
 guard and the tangential anchors as discrete state, updated once per step (paper
 Fig. 3, docs/model.md sections 5-7). Python is entered once per simulation.
+
+Why this module is long: `simulate` is the one entry point of a run, with about 30
+parameters, each typed, documented (numpydoc, units) and checked here before the compiled
+loop is entered, and `Result` is what it returns; the checks stay next to the documentation
+of what they check.
 """
 from __future__ import annotations
 
 import math
+import os
+import pathlib
 import time
-import warnings
 from dataclasses import dataclass, field
-from typing import NamedTuple
+from typing import TYPE_CHECKING, Iterable, Literal, NamedTuple, Protocol
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..core import _core, _layout, checks
 from ..core import contact as _contact
@@ -21,8 +28,6 @@ from ..core.errors import (
     DivergedError,
     InvalidInputError,
     SingularSystemError,
-    StepSizeError,
-    StepSizeWarning,
 )
 from ..core.integrators import METHODS
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
@@ -32,6 +37,16 @@ from . import io as _io
 from . import stepsize as _stepsize
 from .buffers import RecordBuffer
 from .gait import Steps, steps_from_rows
+
+if TYPE_CHECKING:                       # annotations only: optional dependencies
+    import pandas
+    import xarray
+
+
+class SceneLike(Protocol):
+    """What `simulate` takes in place of ``x0``: a `pdw.Scene` (duck-typed, scene.py is above)."""
+
+    def simulate_kwargs(self) -> dict: ...
 
 _STATUS = {i: s for i, s in enumerate(_layout.STATUS)}
 _REASONS = {
@@ -74,8 +89,9 @@ class Result:
     ----------
     t : ndarray (N,)
         Recorded times [s] (every ``record_every``-th step).
-    x : ndarray (N, 8)
-        Recorded states, layout `pdw.STATE`.
+    x : ndarray (N, nx)
+        Recorded states, columns `state_names`: layout `pdw.STATE` (nx = 8), with LuGre's
+        bristle states z1, z2 [m] after it (nx = 10).
     flags : ndarray (N, 2)
         Support flags of legs 1, 2 at those times.
     Fn, Ft : ndarray (N, 2)
@@ -140,16 +156,23 @@ class Result:
     scene: object = None
     sol: object = None
     provenance: dict | None = None
-    contact: object = None      # the pdw.Contact simulated (laws and parameters)
+    contact: _contact.Contact | None = None      # the pdw.Contact simulated (laws, parameters)
 
     @property
     def walked(self) -> bool:
         """Did the walker keep walking to the end of the run (t_end or a stop condition)?"""
         return self.status in ("walked", "periodic")
 
+    @property
+    def state_names(self) -> tuple:
+        """Names of the columns of `x`: `pdw.STATE`, and the bristle states z1, z2 under the
+        LuGre friction law (`pdw.core._layout.STATE_LAYOUTS`)."""
+        return self.contact.state_names if self.contact is not None else STATE
+
     def state(self, name: str) -> np.ndarray:
-        """Recorded time series of one state component by name, e.g. ``"thetad1"``."""
-        return self.x[:, STATE.index(name)]
+        """Recorded time series of one state component by name (`state_names`), e.g.
+        ``res.state("thetad1")``: ndarray (M,) aligned with ``res.t`` [m, rad, m/s or rad/s]."""
+        return self.x[:, self.state_names.index(name)]
 
     def __repr__(self):
         counts = self.event_counts or {}
@@ -168,19 +191,37 @@ class Result:
             lines.append("  failure: %s at t = %.6g s" % (self.failure["reason"], self.failure["t"]))
         return "\n".join(lines) + ">"
 
-    def to_dataframe(self):
-        """The recorded samples as a pandas DataFrame (`pdw.sim.io.result_to_dataframe`)."""
+    def to_dataframe(self) -> pandas.DataFrame:
+        """The recorded samples as a pandas DataFrame (`pdw.sim.io.result_to_dataframe`; needs
+        pandas): one row per sample, index t [s], columns the state (`pdw.STATE`), the flags,
+        the forces and (if recorded) the energies; units in ``df.attrs["units"]``."""
         return _io.result_to_dataframe(self)
 
-    def to_xarray(self):
-        """The run as an xarray Dataset with units and provenance (`pdw.sim.io`)."""
+    def to_xarray(self) -> xarray.Dataset:
+        """The run as an xarray Dataset (`pdw.sim.io.result_to_xarray`; needs xarray):
+        ``x`` (time x state), ``flags`` and forces (time x leg), units in each variable's
+        ``attrs["units"]``, provenance and settings in ``ds.attrs``."""
         return _io.result_to_xarray(self)
 
-    def save(self, path):
-        """Write to ``path`` (.npz or .nc) with provenance; read back with `pdw.load`."""
+    def save(self, path: str | os.PathLike) -> pathlib.Path:
+        """Write the run with its provenance (pdw version, INPUT_HASH, source revision,
+        settings, scene, time); `pdw.load` reads it back.
+
+        Parameters
+        ----------
+        path : str or path-like
+            ``.npz`` (NumPy, compressed, metadata as JSON) or ``.nc`` (NetCDF through xarray).
+
+        Returns
+        -------
+        pathlib.Path
+            The file written.
+        """
         return _io.save(self, path)
 
     def summary(self) -> str:
+        """One line: method, status, steps and step size, end time, events, gait steps (and the
+        stop condition that ended the run)."""
         n_ev = sum(self.event_counts.values()) if self.event_counts else len(self.events)
         s = "%s: %s, %d steps of %.3g s to t = %.4f s, %d events, %d gait steps" % (
             self.method, self.status, self.n_steps, self.dt, self.t_final, n_ev, self.n_gait_steps)
@@ -196,7 +237,10 @@ def _check_positive(name, value):
 
 
 def check_state(x0, name="x0"):
-    return checks.real_array(name, x0, [(_core.NX,)], labels=STATE)
+    """x0: the mechanical state (`pdw.STATE`) or a friction law's (`Contact.run_state`)."""
+    n = np.shape(x0)[0] if np.ndim(x0) == 1 else _core.NX
+    shape = (n,) if n in {len(v) for v in _layout.STATE_LAYOUTS.values()} else (_core.NX,)
+    return checks.real_array(name, x0, [shape], labels=STATE if shape == (_core.NX,) else None)
 
 
 _DEFAULTS = dict(t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm", flags0=(0, 1),
@@ -205,16 +249,23 @@ _DEFAULTS = dict(t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
                  features=None, record_events=True, record_energies=False, stop_steps=0,
                  periodic_steps=0, periodic_tol=1e-3, check_step="warn", t_eval=None,
                  dense_output=False, out=None, max_steps=None,
-                 contact=None)
+                 contact=None, approach_speeds0=None)
 
 
-def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
-             flags0=(0, 1), record_every=1, record_forces=True, on_failure="raise",
-             fall_hip_height=None, fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8,
-             h_max=None, event_tol=1e-9, *, features=None, record_events=True,
-             record_energies=False, stop_steps=0, periodic_steps=0, periodic_tol=1e-3,
-             check_step="warn", t_eval=None, dense_output=False, out=None, max_steps=None,
-             contact=None):
+def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float = 1e-4,
+             params: Params | None = None, variant: Literal["paper", "consistent"] = "paper",
+             method: str = "cdm", flags0: tuple[int, int] = (0, 1), record_every: int = 1,
+             record_forces: bool = True, on_failure: Literal["raise", "return"] = "raise",
+             fall_hip_height: float | None = None, fall_depth: float | None = None,
+             max_speed: float = 1e3, rtol: float = 1e-6, atol: float = 1e-8,
+             h_max: float | None = None, event_tol: float = 1e-9, *,
+             features: Iterable[str] | None = None, record_events: bool = True,
+             record_energies: bool = False, stop_steps: int = 0, periodic_steps: int = 0,
+             periodic_tol: float = 1e-3, check_step: Literal["warn", "error", "off"] = "warn",
+             t_eval: ArrayLike | None = None, dense_output: bool = False,
+             out: RecordBuffer | None = None, max_steps: int | None = None,
+             contact: _contact.Contact | dict | str | None = None,
+             approach_speeds0: tuple[float, float] | None = None) -> Result:
     """Simulate the walker from ``x0`` for ``t_end`` seconds (or run a `pdw.Scene`).
 
     ``simulate(scene)`` runs the scene (as `pdw.run`); no other argument may be given then.
@@ -295,9 +346,16 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
         Record into these reusable arrays (`pdw.sim.buffers.RecordBuffer`) instead of fresh
         ones: no page faults on a repeated run. The Result's t, x, flags, Fn, Ft are then views
         into ``out``, overwritten by the next run that uses it.
+    max_steps : int, optional
+        Budget of integration steps of the adaptive methods (default 10^6 + 2 10^6 t_end/s);
+        a run that uses it up stops early, saying so. Fixed-step methods take t_end/dt steps
+        and refuse a budget below that.
     contact : pdw.Contact, dict or str, optional
         Normal and friction contact laws and their parameters (`pdw.Contact`,
         docs/contact_laws.md); default the paper's Hunt-Crossley and smooth Coulomb laws.
+    approach_speeds0 : (float, float), optional
+        Approach speeds [m/s] (>= 0) of the feet that start in support (the damping of
+        lankarani_nikravesh and flores); default max(-v_y(x0), 0) of each.
 
     Returns
     -------
@@ -349,7 +407,7 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
     atol = _check_positive("atol", atol)
     h_max = 0.0 if h_max is None else _check_positive("h_max", h_max)
     event_tol = _check_positive("event_tol", event_tol)
-    feats = _check_features(features)
+    feats = checks.features(features, _layout.FEATURES)
     for name, flag in (("record_forces", record_forces), ("record_events", record_events),
                        ("record_energies", record_energies)):
         if not isinstance(flag, (bool, np.bool_)):
@@ -371,20 +429,20 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
                                 "record_every must be 1, got %r" % (record_every,))
 
     contact = _contact.Contact.coerce(contact)
-    if (t_eval is not None or dense_output) and contact.normal != "hunt_crossley":
-        raise InvalidInputError("t_eval and dense_output interpolate with the default contact law's "
-                                "f(x); with contact.normal = %r they are not available yet: record "
-                                "every step (record_every=1) instead" % (contact.normal,))
+    x = contact.run_state(x, feats == _layout.FEATURES, t_eval is not None or dense_output,
+                          out is not None)
     params = contact.parameters(params)
-    k = kernel_index(variant, feats, contact.normal)
+    k = kernel_index(variant, feats, contact.normal, contact.friction)
     if feats != _layout.FEATURES:
         params = params.without(feats)
-    if contact.normal == "hunt_crossley":
+    if contact.normal == "hunt_crossley" and contact.friction == "coulomb":
         try:
             _stepsize.check_step(dt, params, method, variant, check_step)
         except (np.linalg.LinAlgError, FloatingPointError, OverflowError) as e:
-            _step_unknown(dt, method, check_step, e)
-    p = contact.vector(parameter_vector(params), feats)
+            _stepsize.step_unknown(dt, method, check_step, e)
+    p = contact.vector(parameter_vector(params), feats, params)
+    v_in0 = None if approach_speeds0 is None else tuple(checks.real_array(
+        "approach_speeds0", approach_speeds0, [(2,)], lo=0.0))
     start = time.perf_counter()
     buffers = None
     if out is not None and not isinstance(out, RecordBuffer):
@@ -398,33 +456,22 @@ def simulate(x0=X0_PAPER, t_end=3.5, dt=1e-4, params=None, variant="paper", meth
                     bool(record_forces), hip, depth, max_speed, rtol, atol, h_max,
                     event_tol=event_tol, record_events=bool(record_events), stop_steps=stop_steps,
                     periodic_k=periodic_steps, periodic_tol=periodic_tol, t_end=t_end,
-                    max_steps=budget, buffers=buffers)
+                    max_steps=budget, buffers=buffers, approach_speeds0=v_in0)
     wall = time.perf_counter() - start
     energies = None
     if record_energies and raw["interrupted"] is None:
-        e = np.empty((len(raw["x"]), len(_layout.ENERGY)))
-        if len(e):
-            _core.energies_batch(k, np.ascontiguousarray(raw["x"]), p, e)
-        energies = {name: e[:, i] for i, name in enumerate(_layout.ENERGY)}
-        energies["E"] = e.sum(axis=1)
+        en = np.empty((len(raw["x"]), len(_layout.ENERGY)))
+        if len(en):
+            _core.energies_batch(k, np.ascontiguousarray(raw["x"]), p, en)
+        energies = {name: en[:, i] for i, name in enumerate(_layout.ENERGY)}
+        energies["E"] = en.sum(axis=1)
     res = _result(raw, params, variant, method, dt, t_end, wall, on_failure, feats,
                   bool(record_events), energies, x)
     res.contact = contact
     if t_eval is not None or dense_output:
         res = _dense.attach(res, t_eval, dense_output, params, variant, feats,
-                            _integrators.get(method).order, record_energies)
+                            _integrators.get(method).order, record_energies, contact)
     return res
-
-
-def _step_unknown(dt, method, mode, e):
-    """`pdw.stability.check_step` could not estimate the limit (a force law so stiff that the
-    linearisation is not finite, e.g. v_s <= 1e-150): say so (warning or error)."""
-    msg = ("the stability limit of %s at these parameters could not be estimated (%s): a force "
-           "law is too stiff to linearise in double precision; dt = %g is probably far too large "
-           "(use an adaptive method, or check_step='off')" % (method, e, dt))
-    if mode == "error":
-        raise StepSizeError(msg, dt=dt, limit=0.0, force="unknown") from None
-    warnings.warn(StepSizeWarning(msg, dt=dt, limit=0.0, force="unknown"), stacklevel=3)
 
 
 def _same(a, b):
@@ -441,31 +488,13 @@ def _check_count(name, value):
     return checks.count(name, value)
 
 
-def _check_features(features):
-    if features is None:
-        return _layout.FEATURES
-    if isinstance(features, str):
-        raise InvalidInputError("features must be a collection of names, got the string %r"
-                                % features)
-    try:
-        feats = set(features)
-    except TypeError:
-        raise InvalidInputError("features must be a collection of names from %s, got %r"
-                                % (", ".join(_layout.FEATURES), features)) from None
-    unknown = feats - set(_layout.FEATURES)
-    if unknown:
-        raise InvalidInputError("unknown feature(s) %s; allowed: %s"
-                                % (", ".join(sorted(map(str, unknown))), ", ".join(_layout.FEATURES)))
-    return tuple(f for f in _layout.FEATURES if f in feats)
-
-
 def _honest(raw, status, params, x0, energies):
     """The status of a run that reached its end, checked: a runaway or airborne state, or
     non-finite energies, make it "diverged" (raw["failure"] filled in: the first offending
     sample); no touch-down at all in a long enough run makes it "no_steps"."""
     if status != "done":
         return status
-    X = raw["x"] if len(raw["x"]) else np.empty((0, _core.NX))
+    X = raw["x"] if len(raw["x"]) else np.empty((0, len(raw["x_final"])))
     T = raw["t"]
     X = np.vstack([X, raw["x_final"][None, :]])
     T = np.append(T, raw["t_final"])

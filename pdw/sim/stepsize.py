@@ -454,6 +454,17 @@ def step_limit(params: Params | None = None, method: str = "cdm", variant: str =
     return _step_limit(params, method, variant)
 
 
+def step_unknown(dt, method, mode, e):
+    """`check_step` could not estimate the limit (a force law so stiff that the linearisation
+    is not finite, e.g. v_s <= 1e-150): say so (warning or error), for `pdw.simulate`."""
+    msg = ("the stability limit of %s at these parameters could not be estimated (%s): a force "
+           "law is too stiff to linearise in double precision; dt = %g is probably far too large "
+           "(use an adaptive method, or check_step='off')" % (method, e, dt))
+    if mode == "error":
+        raise StepSizeError(msg, dt=dt, limit=0.0, force="unknown") from None
+    warnings.warn(StepSizeWarning(msg, dt=dt, limit=0.0, force="unknown"), stacklevel=3)
+
+
 def check_step(dt: float, params: Params, method: str, variant: str, mode: str = "warn"):
     """The check `pdw.simulate` runs before a fixed-step run (``check_step`` argument).
 

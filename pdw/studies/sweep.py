@@ -25,7 +25,7 @@ the local cores (the compiled loop releases the GIL, so threads run in parallel)
 pool (``backend="process"``), or a Dask cluster unchanged (``executor=client.get_executor()``).
 Each finished point is appended to the CSV at once (flushed), so an interrupted sweep resumes
 from its CSV: rerunning skips the points already there and computes only the others
-(``resume=False`` starts afresh). A progress bar is written to stderr on a terminal (`pdw.core.progress`: tqdm if installed).
+(``resume=False`` starts afresh). ``progress=True`` writes a bar to stderr on a terminal (`pdw.core.progress`: tqdm if installed).
 """
 from __future__ import annotations
 
@@ -49,80 +49,10 @@ import time
 import numpy as np
 
 from ..core.errors import InvalidInputError, PdwError
-from ..core.params import Params
-from ..core.progress import Progress  # noqa: F401 (pdw.sweep.Progress)
+from ..core.progress import Progress, progress_bar  # noqa: F401 (pdw.sweep.Progress)
 from ..core.provenance import source_revision
+from .points import _classify, _newton_point, batchable, groups, run_point, run_points  # noqa: F401 (pdw.sweep.run_point)
 from .study import COLUMNS, Study, check_name, load_study, parse_study, settings_hash  # noqa: F401 (pdw.sweep.parse_study)
-
-# --- the worker -------------------------------------------------------------------------------
-
-def _classify(table, steady, tol):
-    """'period-1', 'period-2' or 'none' from the last steps' L and cycle."""
-    L, T = table["L"], table["cycle"]
-    ok = np.isfinite(L) & np.isfinite(T)
-    L, T = L[ok], T[ok]
-    n = max(steady, 2)
-    if len(L) >= n and max(np.ptp(L[-n:]), np.ptp(T[-n:])) < tol:
-        return "period-1"
-    if len(L) >= 2 * n and max(np.max(np.abs(L[-n:] - L[-n - 2:-2])),
-                               np.max(np.abs(T[-n:] - T[-n - 2:-2]))) < tol:
-        return "period-2"
-    return "none"
-
-
-def run_point(task) -> dict:
-    """Compute one point of a study (module-level, so that process pools and Dask workers can
-    import it). ``task``: `Study.task`. Returns the CSV row (a flat dict of numbers and short
-    strings); an invalid point gives ``status = "error"`` instead of raising."""
-    from ..sim.gait import steps
-    from ..sim.scene import Scene
-    from ..sim.simulation import simulate
-    t0 = time.perf_counter()
-    row = {"index": int(task["index"]), **task["values"]}
-    row.update({c: "" for c in COLUMNS})
-    row["settings"] = task.get("settings", "")
-    run = task["run"]
-    try:
-        params = Params(**task["params"])
-        scene = Scene.from_dict(task["scene"])
-        if run["mode"] == "simulate":
-            res = simulate(**{**scene.simulate_kwargs(), "params": params})
-            st = steps(res)
-            s = st.steady(run["steady"])
-            row.update(status=res.status, n_steps=len(st), t_final=res.t_final, source="simulate",
-                       gait=_classify(st.table, run["steady"], run["period_tol"])
-                       if res.status == "walked" else "")
-            if res.status == "walked" and len(st) >= run["steady"]:
-                row.update({k: s[k] for k in ("L", "P", "v", "cycle", "double_support",
-                                              "ds_fraction", "travel")},
-                           spread_L=s["spread_L"], spread_cycle=s["spread_cycle"])
-        if run["mode"] == "newton" or (run["fallback"] and row["gait"] != "period-1"):
-            _newton_point(row, params, scene)
-    except (PdwError, ValueError) as e:
-        row.update(status="error", error=str(e)[:300])
-    row["wall_s"] = time.perf_counter() - t0
-    return row
-
-
-def _newton_point(row, params, scene):
-    """Fill ``row`` from `pdw.find_gait` (default guesses); keeps ``row`` if none is found."""
-    from ..analysis.gait_types import GaitNotFoundError
-    from ..analysis.limit_cycle import find_gait
-    try:
-        g = find_gait(params, variant=scene.variant, method=scene.integrator.method, workers=1,
-                      max_iter=12)
-    except GaitNotFoundError as e:
-        if row["status"] == "":
-            row.update(status="no_gait", source="newton", error=str(e)[:200])
-        return
-    sp = g.details["swing_period"]
-    mu = float(np.max(np.abs(g.multipliers)))
-    row.update(status="walked" if mu < 1 else "unstable", source="newton",
-               gait="period-1" if mu < 1 else "unstable", L=g.step_length, P=sp,
-               v=g.step_length / sp, cycle=g.period, double_support=g.double_support,
-               ds_fraction=g.double_support / g.period, travel=g.details["travel"],
-               spread_L=g.details["residual"], spread_cycle="", max_multiplier=mu, error="")
-
 
 # --- CSV (resumable) ------------------------------------------------------------------------------
 
@@ -222,7 +152,8 @@ def provenance(study, **extra) -> dict:
 @dataclasses.dataclass
 class StudyResult:
     """Outcome of `run_study`: ``rows`` (list of dicts sorted by index), ``paths`` written,
-    ``computed`` (indices computed in this call), ``resumed`` (indices read from the CSV)."""
+    ``computed`` (indices computed in this call), ``resumed`` (indices read from the CSV),
+    ``engine`` ("batch": groups of points through `pdw.studies.points.run_points`; "scalar")."""
 
     study: Study
     rows: list
@@ -230,6 +161,7 @@ class StudyResult:
     computed: list
     resumed: list
     wall_s: float
+    engine: str = "scalar"
 
     def column(self, name):
         return np.array([np.nan if r[name] == "" else r[name] for r in self.rows], dtype=float) \
@@ -318,7 +250,7 @@ def _make_executor(backend, workers):
 
 
 def run_study(study, out=None, *, executor=None, workers=None, backend="thread", resume=True,
-              progress=True, figures=None) -> StudyResult:
+              progress=False, figures=None, batch=True) -> StudyResult:
     """Run a study (a `Study` or a path to its TOML file).
 
     Parameters
@@ -336,13 +268,17 @@ def run_study(study, out=None, *, executor=None, workers=None, backend="thread",
     resume : bool
         Keep the points already in the CSV and compute only the others (default). False
         starts afresh (the CSV is overwritten).
-    progress : bool
-        Progress bar on stderr.
+    progress : bool or pdw.Progress
+        Progress bar over points (`pdw.core.progress.progress_bar`): False (default) none,
+        True on stderr when it is a terminal (``pdw sweep`` does that unless --no-progress).
     figures : callable, optional
         ``figures(study, rows, path) -> path`` draws the study's figure into ``path``
         (``<name>.png``); `pdw.present.study_plots.plot_study` is the standard one (``pdw sweep``
         passes it). None or False: no figure. The figure belongs to the presentation layer, so it is
         passed in rather than imported here (docs/architecture.md).
+    batch : bool
+        Run the points as batches through the ensemble engine when the study qualifies
+        (`pdw.studies.points.batchable`; the rows are the same); False: point by point.
 
     If a point's task fails in the executor (a killed worker, an interrupt), the points finished
     so far are already in the CSV; the error is re-raised, and a rerun resumes.
@@ -356,10 +292,11 @@ def run_study(study, out=None, *, executor=None, workers=None, backend="thread",
     out = pathlib.Path(out or pathlib.Path("out") / "studies" / study.name)
     out.mkdir(parents=True, exist_ok=True)
     with _FolderLock(out):
-        return _run_locked(study, out, executor, workers, backend, resume, progress, figures)
+        return _run_locked(study, out, executor, workers, backend, resume, progress, figures,
+                           batch)
 
 
-def _run_locked(study, out, executor, workers, backend, resume, progress, figures):
+def _run_locked(study, out, executor, workers, backend, resume, progress, figures, batch):
     csv_path, json_path = out / (study.name + ".csv"), out / (study.name + ".json")
     header = _header(study)
     t_start = time.perf_counter()
@@ -380,23 +317,33 @@ def _run_locked(study, out, executor, workers, backend, resume, progress, figure
         exec_desc = "%s.%s" % (type(executor).__module__, type(executor).__qualname__)
     else:
         exec_desc = "serial"
-    bar = Progress(len(points), len(done), label=study.name, enabled=progress)
+    bar = progress_bar(progress, len(points), study.name, done=len(done))
     computed = []
     error = None
+    # points that share the scene run as batches (pdw.studies.points), one task a group
+    engine = "batch" if batch and todo and batchable(study) else "scalar"
+    if engine == "batch":
+        fn, units = run_points, [[study.task(k, v) for k, v in g]
+                                 for g in groups(todo, workers or os.cpu_count() or 1)]
+    else:
+        fn, units = run_point, [study.task(k, v) for k, v in todo]
     with open(csv_path, "a", newline="") as f:
-        def record(row):
-            f.write(_csv_line(row, header))
-            f.flush()
-            done[row["index"]] = row
-            computed.append(row["index"])
-            bar.update(1)
+        def record(out):
+            for row in (out if engine == "batch" else [out]):
+                if row["index"] in done:      # already written (the interrupt path)
+                    continue
+                f.write(_csv_line(row, header))
+                f.flush()
+                done[row["index"]] = row
+                computed.append(row["index"])
+                bar.update(1)
         try:
             if executor is None and own is None:
-                for k, v in todo:
-                    record(run_point(study.task(k, v)))
+                for u in units:
+                    record(fn(u))
             else:
                 ex = executor if executor is not None else own
-                futs = [ex.submit(run_point, study.task(k, v)) for k, v in todo]
+                futs = [ex.submit(fn, u) for u in units]
                 try:
                     for fut in cf.as_completed(futs):
                         record(fut.result())
@@ -406,9 +353,7 @@ def _run_locked(study, out, executor, workers, backend, resume, progress, figure
                     # keep what finished meanwhile
                     for fut in futs:
                         if fut.done() and not fut.cancelled() and fut.exception() is None:
-                            row = fut.result()
-                            if row["index"] not in done:
-                                record(row)
+                            record(fut.result())
                     raise
         except BaseException as e:      # noqa: BLE001 - re-raised below after bookkeeping
             error = e
@@ -427,7 +372,7 @@ def _run_locked(study, out, executor, workers, backend, resume, progress, figure
     meta = provenance(study, started=started,
                       finished=datetime.datetime.now(datetime.timezone.utc).isoformat(
                           timespec="seconds"),
-                      wall_s=wall, executor=exec_desc, n_points=len(points),
+                      wall_s=wall, executor=exec_desc, engine=engine, n_points=len(points),
                       n_resumed=len(points) - len(computed), n_computed=len(computed),
                       cpu_s_points=float(sum(r["wall_s"] for r in rows if r["wall_s"] != "")),
                       status_counts=statuses, csv=csv_path.name)
@@ -439,7 +384,7 @@ def _run_locked(study, out, executor, workers, backend, resume, progress, figure
             meta["figure"] = "not written: matplotlib is not installed"
     _write_atomic(json_path, json.dumps(meta, indent=2, default=_jsonable) + "\n")
     return StudyResult(study=study, rows=rows, paths=paths, computed=sorted(computed),
-                       resumed=sorted(set(done) - set(computed)), wall_s=wall)
+                       resumed=sorted(set(done) - set(computed)), wall_s=wall, engine=engine)
 
 
 def _jsonable(o):

@@ -19,7 +19,7 @@ static void finish(const pdw_batch_job *job, long i, const pdw_sim *s)
     job->stop_reason[i] = s->stop_reason;
     job->flags_final[2*i] = s->disc.flags[0];
     job->flags_final[2*i + 1] = s->disc.flags[1];
-    memcpy(job->x_final + i*PDW_NX, s->x, sizeof s->x);
+    memcpy(job->x_final + i*PDW_NX, s->x, PDW_NX * sizeof(double));
     job->t_final[i] = s->t;
     job->n_taken[i] = s->n;
     job->n_gait[i] = s->gait.n_steps;
@@ -48,6 +48,7 @@ static int start(const pdw_batch_job *job, long i, pdw_sim *s)
     int flags0[2];
     memset(s, 0, sizeof *s);
     s->kernel = job->kernel;
+    s->nx = PDW_NX;             /* the smooth Coulomb law only (_batch.pyx checks) */
     memcpy(s->p, job->p + i*job->p_stride, PDW_NP * sizeof(double));
     s->dt = dt;
     s->n_steps = job->n_steps;
@@ -59,7 +60,7 @@ static int start(const pdw_batch_job *job, long i, pdw_sim *s)
     s->periodic_k = job->periodic_k;
     s->periodic_tol = job->periodic_tol;
     pdw_gait_init(&s->gait);
-    memcpy(s->x, job->x0 + i*PDW_NX, sizeof s->x);
+    memcpy(s->x, job->x0 + i*PDW_NX, PDW_NX * sizeof(double));
     flags0[0] = job->flags0[2*i];
     flags0[1] = job->flags0[2*i + 1];
     pdw_discrete_init(s->kernel, s->p, s->x, flags0, &s->disc, s->work);
@@ -151,6 +152,251 @@ long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *l
                 finish(job, i, &lanes[l]);
                 done++;
             }
+        }
+    }
+    return done;
+}
+
+/* Load walker i into lane s with the settings pdw/core/_core.pyx's run gives pdw.simulate's
+ * pdw_sim (nothing recorded, events only counted), polling after every step. */
+static void start_method(const pdw_batch_job *job, long i, pdw_sim *s)
+{
+    int flags0[2];
+    const pdw_method *m = &pdw_methods[job->method];
+    memset(s, 0, sizeof *s);
+    s->kernel = job->kernel;
+    s->nx = PDW_NX;             /* the smooth Coulomb law only (_batch.pyx checks) */
+    memcpy(s->p, job->p + i*job->p_stride, PDW_NP * sizeof(double));
+    s->t_end = job->t_end;
+    s->rtol = job->rtol;
+    s->atol = job->atol;
+    s->h_max = job->h_max > 0 ? job->h_max : job->t_end;
+    s->h = job->dt;
+    s->event_tol = job->event_tol;
+    s->dt = job->dt;
+    s->n_steps = job->n_steps;
+    s->fall_hip_height = job->fall_hip_height[i];
+    s->fall_depth = job->fall_depth[i];
+    s->max_speed = job->max_speed;
+    s->max_steps = m->adaptive ? job->max_steps : 0;
+    /* a poll every 2 loop iterations returns after each (accepted) step: the drivers poll at
+     * the top of an iteration, where a resumed call continues exactly */
+    s->poll_every = 2;
+    s->stop_steps = job->stop_steps;
+    s->periodic_k = job->periodic_k;
+    s->periodic_tol = job->periodic_tol;
+    pdw_gait_init(&s->gait);
+    memcpy(s->x, job->x0 + i*PDW_NX, PDW_NX * sizeof(double));
+    flags0[0] = job->flags0[2*i];
+    flags0[1] = job->flags0[2*i + 1];
+    pdw_discrete_init(s->kernel, s->p, s->x, flags0, &s->disc, s->work);
+}
+
+/* Every PDW_BATCH_POLL rounds: job->poll; if it says stop, write the running walkers as they
+ * are (status running) and return 1. */
+static int poll_stop(const pdw_batch_job *job, long *since_poll, const long *walker, int W,
+                     const pdw_sim *lanes)
+{
+    if (!job->poll || ++*since_poll < PDW_BATCH_POLL) return 0;
+    *since_poll = 0;
+    if (!job->poll(job->poll_ctx)) return 0;
+    for (int l = 0; l < W; ++l)
+        if (walker[l] >= 0) finish(job, walker[l], &lanes[l]);
+    return 1;
+}
+
+long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes)
+{
+    long walker[PDW_BATCH_MAXW], next = i0;
+    const pdw_advance_fn advance = pdw_methods[job->method].advance;
+    int running = 0;
+    long since_poll = 0, done = 0;
+    if (W < 1) W = 1;
+    if (W > PDW_BATCH_MAXW) W = PDW_BATCH_MAXW;
+    for (int l = 0; l < W; ++l) {
+        walker[l] = -1;
+        if (next < i1) { walker[l] = next; start_method(job, next++, &lanes[l]); running++; }
+    }
+    while (running > 0) {
+        if (poll_stop(job, &since_poll, walker, W, lanes)) {
+            /* a lane stopped inside its round holds the state of its last accepted step */
+            for (int l = 0; l < W; ++l)
+                if (walker[l] >= 0) job->status[walker[l]] = PDW_STATUS_RUNNING;
+            return done;
+        }
+        for (int l = 0; l < W; ++l) {
+            if (walker[l] < 0) continue;
+            /* nothing recorded and events not stored: RECORDS_FULL and EVENTS_FULL cannot
+             * occur, POLL is the end of this lane's step */
+            if (advance(&lanes[l]) == PDW_STATUS_POLL) continue;
+            finish(job, walker[l], &lanes[l]);
+            walker[l] = -1;
+            running--;
+            done++;
+            if (next < i1) { walker[l] = next; start_method(job, next++, &lanes[l]); running++; }
+        }
+    }
+    return done;
+}
+
+/* ---- the structure-of-arrays lane loop ------------------------------------------------ */
+
+void pdw_soa_cdm_step_base(int kernel, pdw_soa_state *S, int W, double dt,
+                           double max_speed, int vector);
+void pdw_soa_cdm_step_avx2(int kernel, pdw_soa_state *S, int W, double dt,
+                           double max_speed, int vector);
+void pdw_soa_cdm_step_avx512(int kernel, pdw_soa_state *S, int W, double dt,
+                             double max_speed, int vector);
+
+int pdw_soa_has_kernel_base(int kernel);
+
+int pdw_batch_isa_supported(int isa)
+{
+    if (isa == PDW_ISA_SCALAR || isa == PDW_ISA_BASE) return 1;
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+    __builtin_cpu_init();
+    if (isa == PDW_ISA_AVX2) return __builtin_cpu_supports("avx2") != 0;
+    if (isa == PDW_ISA_AVX512) return __builtin_cpu_supports("avx512f") != 0;
+#endif
+    return 0;
+}
+
+void pdw_soa_trig_libm(pdw_soa_state *S, int W, int only_first)
+{
+    const double *x = S->x;
+    double *trig = S->trig;
+    for (int l = 0; l < W; ++l) {
+        if (only_first && S->upd[l]) continue;
+        /* both angles first: GCC then fuses each sin/cos pair into one sincos call, as in
+         * pdw_trig (the same results: glibc's sincos is its sin and cos) */
+        const double a1 = x[PDW_X_THETA1*PDW_SOA_STRIDE + l], a2 = x[PDW_X_THETA2*PDW_SOA_STRIDE + l];
+        const double s1 = sin(a1), c1 = cos(a1), s2 = sin(a2), c2 = cos(a2);
+        trig[PDW_TRIG_SIN_THETA1*PDW_SOA_STRIDE + l] = s1;
+        trig[PDW_TRIG_COS_THETA1*PDW_SOA_STRIDE + l] = c1;
+        trig[PDW_TRIG_SIN_THETA2*PDW_SOA_STRIDE + l] = s2;
+        trig[PDW_TRIG_COS_THETA2*PDW_SOA_STRIDE + l] = c2;
+    }
+}
+
+/* Lane l of S from its pdw_sim (after a start or a scalar step). */
+static void soa_load(pdw_soa_state *S, int l, const pdw_sim *s)
+{
+    for (int i = 0; i < PDW_NX; ++i) S->x[i*PDW_SOA_STRIDE + l] = s->x[i];
+    for (int i = 0; i < PDW_NQ; ++i) S->u_prev[i*PDW_SOA_STRIDE + l] = s->u_prev[i];
+    for (int i = 0; i < PDW_NANCHOR; ++i) S->anchors[i*PDW_SOA_STRIDE + l] = s->disc.anchors[i];
+    for (int i = 0; i < 2; ++i) {
+        S->flags[i*PDW_SOA_STRIDE + l] = s->disc.flags[i];
+        S->armed[i*PDW_SOA_STRIDE + l] = s->disc.armed[i];
+    }
+    S->upd[l] = s->n > 0;
+}
+
+/* The parts of lane l's pdw_sim that the SoA step advances, from S. */
+static void soa_store(const pdw_soa_state *S, int l, pdw_sim *s)
+{
+    for (int i = 0; i < PDW_NX; ++i) s->x[i] = S->x[i*PDW_SOA_STRIDE + l];
+    for (int i = 0; i < PDW_NQ; ++i) s->u_prev[i] = S->u_prev[i*PDW_SOA_STRIDE + l];
+    for (int i = 0; i < 2; ++i) s->disc.armed[i] = S->armed[i*PDW_SOA_STRIDE + l];
+}
+
+/* Start walker i in lane l (pdw_sim and S). Returns 1 if it runs, 0 if it finished at once. */
+static int soa_start(const pdw_batch_job *job, long i, pdw_sim *s, pdw_soa_state *S, int l)
+{
+    if (!start(job, i, s)) return 0;
+    for (int j = 0; j < PDW_NP; ++j) S->p[j*PDW_SOA_STRIDE + l] = s->p[j];
+    S->hip[l] = s->fall_hip_height;
+    S->depth[l] = s->fall_depth;
+    soa_load(S, l, s);
+    return 1;
+}
+
+/* Fill lane l with the next walker of [next, i1) that does not finish at its start. */
+static long soa_refill(const pdw_batch_job *job, long *next, long i1, pdw_sim *s,
+                       pdw_soa_state *S, int l, long *done)
+{
+    while (*next < i1) {
+        const long i = (*next)++;
+        if (soa_start(job, i, s, S, l)) return i;
+        finish(job, i, s);
+        ++*done;
+    }
+    return -1;
+}
+
+long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
+                       int vector, int isa, pdw_soa_state *S)
+{
+    const long kid = job->kernel - pdw_kernels;
+    void (*stepfn)(int, pdw_soa_state *, int, double, double, int) = NULL;
+    if (isa == PDW_ISA_BASE) stepfn = pdw_soa_cdm_step_base;
+    else if (isa == PDW_ISA_AVX2) stepfn = pdw_soa_cdm_step_avx2;
+    else if (isa == PDW_ISA_AVX512) stepfn = pdw_soa_cdm_step_avx512;
+    if (kid < 0 || kid >= PDW_NKERNELS || !pdw_soa_has_kernel_base((int)kid)
+        || stepfn == NULL || !pdw_batch_isa_supported(isa))
+        return pdw_batch_cdm(job, i0, i1, W, lanes, vector);
+    long walker[PDW_BATCH_MAXW], next = i0;
+    int running = 0;
+    long since_poll = 0, done = 0;
+    if (W < 1) W = 1;
+    if (W > PDW_BATCH_MAXW) W = PDW_BATCH_MAXW;
+    memset(S, 0, sizeof *S);
+    for (int l = 0; l < W; ++l) {
+        walker[l] = soa_refill(job, &next, i1, &lanes[l], S, l, &done);
+        if (walker[l] >= 0) running++;
+    }
+    /* lanes without a walker and the padding lanes up to a multiple of 8 (computed, never
+     * read) step a copy of lane 0: ordinary numbers, no denormal or NaN slow paths (if lane 0
+     * has no walker, none has) */
+    for (int l = 1; l < ((W + 7) & ~7) && walker[0] >= 0; ++l) {
+        if (l < W && walker[l] >= 0) continue;
+        for (int j = 0; j < PDW_NP; ++j) S->p[j*PDW_SOA_STRIDE + l] = S->p[j*PDW_SOA_STRIDE];
+        S->hip[l] = S->hip[0];
+        S->depth[l] = S->depth[0];
+        soa_load(S, l, &lanes[0]);
+    }
+    while (running > 0) {
+        if (job->poll && ++since_poll >= PDW_BATCH_POLL) {
+            since_poll = 0;
+            if (job->poll(job->poll_ctx)) {   /* stopped: the running walkers as they are */
+                for (int l = 0; l < W; ++l) {
+                    if (walker[l] < 0) continue;
+                    soa_store(S, l, &lanes[l]);
+                    finish(job, walker[l], &lanes[l]);
+                }
+                return done;
+            }
+        }
+        stepfn((int)kid, S, W, job->dt, job->max_speed, vector);
+        for (int l = 0; l < W; ++l) {
+            if (walker[l] < 0) continue;
+            pdw_sim *s = &lanes[l];
+            int more;
+            if (S->rare[l]) {
+                /* the scalar step from the same state and trig: it takes the event, the fall
+                 * or the failure exactly as pdw_cdm_advance */
+                soa_store(S, l, s);
+                for (int j = 0; j < PDW_NTRIG; ++j)
+                    s->work[PDW_WORK_TRIG + j] = S->trig[j*PDW_SOA_STRIDE + l];
+                more = step(s);
+                if (more) soa_load(S, l, s);
+            } else {
+                s->n++;
+                s->t = s->n * s->dt;
+                s->n_rhs++;
+                S->upd[l] = 1;
+                more = s->n < s->n_steps;
+                if (!more) {
+                    /* final flags at t_end (scalar trig), as step() */
+                    soa_store(S, l, s);
+                    if (pdw_update_flags(s, s->n * s->dt) == 0) s->status = PDW_STATUS_DONE;
+                }
+            }
+            if (more) continue;
+            finish(job, walker[l], s);
+            running--;
+            done++;
+            walker[l] = soa_refill(job, &next, i1, s, S, l, &done);
+            if (walker[l] >= 0) running++;
         }
     }
     return done;

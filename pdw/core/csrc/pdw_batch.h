@@ -13,6 +13,8 @@
 #include "pdw_sim.h"
 
 enum { PDW_BATCH_MAXW = 64 };
+/* the row stride of pdw_soa_state: the generated stages' PDW_SOA (generated/pdw_batch_gen.h) */
+enum { PDW_SOA_STRIDE = 72 };
 
 typedef struct pdw_batch_job {
     /* --- inputs --- */
@@ -30,6 +32,12 @@ typedef struct pdw_batch_job {
     long stop_steps;            /* 0: off */
     int periodic_k;             /* 0: off */
     double periodic_tol;
+    /* methods other than cdm (pdw_batch_method): the settings of pdw_sim as pdw.simulate
+     * (pdw/core/_core.pyx run) sets them */
+    int method;                 /* index into pdw_methods */
+    double t_end;               /* end time [s] (adaptive methods end exactly here) */
+    double rtol, atol, h_max, event_tol;  /* adaptive methods; dt is the first step */
+    long max_steps;             /* adaptive methods' step budget (accepted + rejected); 0: none */
     /* --- outputs, per walker (caller-allocated) --- */
     int *status;                /* (n,) PDW_STATUS_* */
     int *stop_reason;           /* (n,) PDW_STOP_* */
@@ -52,6 +60,41 @@ typedef struct pdw_batch_job {
 
 enum { PDW_BATCH_POLL = 512 };
 
+/* The lanes of a block as structure of arrays: element i of lane l at a[i*PDW_SOA_STRIDE + l],
+ * caller-allocated (64-byte aligned: a row's first 8 lanes are one cache line). The lane's pdw_sim holds everything else
+ * (events, gait, counters, failure) and is brought up to date (x, u_prev, armed) whenever a
+ * lane leaves the vector path. */
+typedef struct pdw_soa_state {
+    double x[PDW_NX*PDW_SOA_STRIDE], u_prev[PDW_NQ*PDW_SOA_STRIDE];
+    double p[PDW_NP*PDW_SOA_STRIDE], anchors[PDW_NANCHOR*PDW_SOA_STRIDE];
+    double hip[PDW_SOA_STRIDE], depth[PDW_SOA_STRIDE];
+    int flags[2*PDW_SOA_STRIDE], armed[2*PDW_SOA_STRIDE], armed_next[2*PDW_SOA_STRIDE];
+    int upd[PDW_SOA_STRIDE];    /* 1: past the first step (the flags are updated first) */
+    int rare[PDW_SOA_STRIDE];   /* out: 1 = nothing committed, run the scalar step */
+    double trig[PDW_NTRIG*PDW_SOA_STRIDE], kin[2*PDW_NKIN*PDW_SOA_STRIDE];
+    double contact[2*PDW_NCONTACT*PDW_SOA_STRIDE];
+    double M[PDW_NQ*PDW_NQ*PDW_SOA_STRIDE], C[PDW_NQ*PDW_NQ*PDW_SOA_STRIDE];
+    double QmG[PDW_NQ*PDW_SOA_STRIDE];
+} pdw_soa_state;
+
+/* The trig of lanes l < W from libm (bitwise pdw_trig): all lanes, or (only_first != 0) only
+ * those at their first step (upd[l] == 0). */
+void pdw_soa_trig_libm(pdw_soa_state *S, int W, int only_first);
+
+/* Instruction sets of the structure-of-arrays step (pdw_batch_soa_*.c); PDW_ISA_SCALAR: no
+ * SoA step, every lane through the generated scalar stages (pdw_batch_cdm). */
+enum { PDW_ISA_SCALAR = -1, PDW_ISA_BASE = 0, PDW_ISA_AVX2 = 1, PDW_ISA_AVX512 = 2 };
+
+/* 1 if this CPU (and this build) can run the SoA step compiled for isa. */
+int pdw_batch_isa_supported(int isa);
+
+/* Advance walkers [i0, i1) of job as pdw_batch_cdm does, the ordinary steps of a block through
+ * the structure-of-arrays step compiled for isa (S: caller-allocated). Falls back to
+ * pdw_batch_cdm when the kernel has no batched stages or isa is PDW_ISA_SCALAR or unsupported.
+ * Bitwise pdw_batch_cdm (and `pdw.simulate`) with vector = 0. Returns as pdw_batch_cdm. */
+long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
+                       int vector, int isa, pdw_soa_state *S);
+
 /* sin and cos of the n angles a into s and c through glibc's vector routines (libmvec). */
 void pdw_batch_sincos(int n, const double *a, double *s, double *c);
 
@@ -59,5 +102,13 @@ void pdw_batch_sincos(int n, const double *a, double *s, double *c);
  * caller-allocated pdw_sim. vector: 1 = vector sin/cos, 0 = scalar (bitwise `pdw.simulate`).
  * Returns the number of walkers finished (i1 - i0; fewer when job->poll stopped the range). */
 long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes, int vector);
+
+/* Advance walkers [i0, i1) of job with any method of pdw_methods (job->method), W lanes in
+ * rounds: each round takes one step (one accepted step of an adaptive method) of every lane
+ * through the method's own advance (pdw_sim.h's contract, resumed exactly through
+ * PDW_STATUS_POLL), so that each lane keeps its own time, step size, accept/reject, flags and
+ * located events and every walker is bitwise its `pdw.simulate` run; a finished lane takes the
+ * next walker. Returns the walkers finished (fewer when job->poll stopped the range). */
+long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes);
 
 #endif /* PDW_BATCH_H */

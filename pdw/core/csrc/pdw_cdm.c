@@ -6,6 +6,7 @@
  *
  * M, C, Q_f, G are evaluated at (U_n, U'_n) with the flags updated from that state first (Fig. 3).
  * First order: Eq. 17's velocity is the centred velocity at t_n, used at t_{n+1}. */
+#include <math.h>
 #include <string.h>
 #include "pdw_sim.h"
 #include "pdw_linalg.h"
@@ -15,7 +16,7 @@
 void pdw_cdm_start(pdw_sim *s)
 {
     const double dt = s->dt;
-    double xdot[PDW_NX];
+    double xdot[PDW_NX_MAX];
     s->kernel->rhs(s->x, s->p, s->disc.flags, s->disc.anchors, xdot, s->work);
     for (int i = 0; i < PDW_NQ; ++i)
         s->u_prev[i] = s->x[i] - dt*s->x[PDW_NQ + i] + 0.5*dt*dt*xdot[PDW_NQ + i];
@@ -29,10 +30,31 @@ void pdw_cdm_start(pdw_sim *s)
  * x_n: (M/dt^2 + C/2dt) U_{n+1} = ..., the centred velocity, the state check, n advanced.
  * Returns 0, or 1 when the run stops (singular system or failed state check; s->status set).
  * Shared with the lane loop of pdw_batch.c. */
+/* LuGre's bristle states under the central difference method, which integrates q only: with the
+ * slip velocity v frozen at x_n (the state the step's forces are taken at), dz/dt = v - a z
+ * (a = sigma0 |v| / g(v) >= 0) is linear in z and integrated exactly over the step:
+ *     z_{n+1} = z_n + dt phi(a dt) zdot_n,   phi(y) = (1 - exp(-y)) / y   (phi(0) = 1),
+ * i.e. z relaxes toward z_ss = v/a with factor exp(-a dt). First order (v is held over the step,
+ * as Eq. 17's velocity), exact for constant v, and unconditionally stable: 0 < phi <= 1. zdot_n
+ * and a come from the contact stage of x_n, in s->work. */
+#if defined(__GNUC__)
+__attribute__((noinline))       /* off the default law's hot path (its registers stay as they were) */
+#endif
+static void bristle_update(const pdw_sim *s, double dt, double *xnew)
+{
+    const double *contact = s->work + PDW_WORK_CONTACT;
+    for (int i = 0; i < 2; ++i) {
+        const double zd = contact[i*PDW_NCONTACT + PDW_CONTACT_ZDOT];
+        const double y = contact[i*PDW_NCONTACT + PDW_CONTACT_Z_RATE] * dt;
+        const double phi = y > 1e-300 ? -expm1(-y) / y : 1.0;
+        xnew[PDW_X_Z1 + i] = s->x[PDW_X_Z1 + i] + dt * phi * zd;
+    }
+}
+
 int pdw_cdm_update(pdw_sim *s, const double *M, const double *C, const double *QmG, double t)
 {
     const double dt = s->dt, idt2 = 1.0/(dt*dt), ih = 0.5/dt;
-    double K[PDW_NQ*PDW_NQ], b[PDW_NQ], u[PDW_NQ], xnew[PDW_NX];
+    double K[PDW_NQ*PDW_NQ], b[PDW_NQ], u[PDW_NQ], xnew[PDW_NX_MAX];
     for (int i = 0; i < PDW_NQ; ++i) {
         double mu = 0.0, ku = 0.0;
         for (int j = 0; j < PDW_NQ; ++j) {
@@ -53,9 +75,10 @@ int pdw_cdm_update(pdw_sim *s, const double *M, const double *C, const double *Q
         xnew[i] = u[i];
         xnew[PDW_NQ + i] = (u[i] - s->u_prev[i]) * ih;
     }
+    if (s->nx > PDW_NX) bristle_update(s, dt, xnew);
     if (pdw_check_state(s, xnew, t)) return 1;
     for (int i = 0; i < PDW_NQ; ++i) s->u_prev[i] = s->x[i];
-    memcpy(s->x, xnew, sizeof xnew);
+    pdw_copy_state(s, s->x, xnew);
     s->n++;
     s->t = s->n * dt;
     s->n_rhs++;

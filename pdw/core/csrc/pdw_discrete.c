@@ -165,6 +165,7 @@ int pdw_update_flags_trig(pdw_sim *s, double t)
             d->armed[i] = 0;
             d->anchors[i] = ki[PDW_KIN_S];
             d->anchors[PDW_ANCHOR_V_IN1 + i] = -vy;           /* approach speed, > 0 */
+            if (s->nx > PDW_NX) s->x[PDW_X_Z1 + i] = 0.0;     /* LuGre: relaxed bristles */
             const int st = push_event(s, t, i, PDW_EVKIND_TOUCH_DOWN, ki);
             if (st != PDW_STOP_NONE && stop == PDW_STOP_NONE) stop = st;
             changed = 1;
@@ -201,9 +202,12 @@ int pdw_check_feet(pdw_sim *s, double t)
 
 int pdw_check_state(pdw_sim *s, const double *xnew, double t)
 {
-    for (int i = 0; i < PDW_NX; ++i) {
-        if (!isfinite(xnew[i])) { fail(s, PDW_STATUS_DIVERGED, PDW_REASON_NONFINITE, -1, t); return 1; }
-    }
+    /* the walker's 8 states with a compile-time loop (the common case costs what it did before
+     * LuGre), then the friction law's extra states, if any */
+    double nan_if_any = 0.0;                 /* x*0 is 0 for finite x, NaN for inf or NaN */
+    for (int i = 0; i < PDW_NX; ++i) nan_if_any += xnew[i] * 0.0;
+    for (int i = PDW_NX; i < s->nx; ++i) nan_if_any += xnew[i] * 0.0;
+    if (nan_if_any != 0.0) { fail(s, PDW_STATUS_DIVERGED, PDW_REASON_NONFINITE, -1, t); return 1; }
     for (int i = PDW_NQ; i < PDW_NX; ++i) {
         if (fabs(xnew[i]) > s->max_speed) { fail(s, PDW_STATUS_DIVERGED, PDW_REASON_SPEED, -1, t); return 1; }
     }
@@ -247,7 +251,7 @@ void pdw_record_now(pdw_sim *s, double t)
     if (s->n_rec >= s->rec_capacity) return;
     const long r = s->n_rec++;
     s->rec_t[r] = t;
-    memcpy(s->rec_x + r*PDW_NX, s->x, sizeof s->x);
+    pdw_copy_state(s, s->rec_x + r*s->nx, s->x);
     s->rec_flags[2*r] = s->disc.flags[0];
     s->rec_flags[2*r + 1] = s->disc.flags[1];
     if (s->rec_contact) {

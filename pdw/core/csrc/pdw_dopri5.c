@@ -12,11 +12,11 @@
 static double dopri5_step(pdw_sim *s, void *ctx, const double *fx, double h, int new_point,
                           double *xnew, double *fnew, int *fnew_valid)
 {
-    double k[PDW_RK_MAXSTAGES][PDW_NX], errv[PDW_NX];
+    double k[PDW_RK_MAXSTAGES][PDW_NX_MAX], errv[PDW_NX_MAX];
     (void)ctx; (void)new_point;
     memcpy(k[0], fx, sizeof k[0]);
     pdw_rk_stages(s, &pdw_tableau_dopri5, s->x, h, k, xnew, errv);
-    memcpy(fnew, k[6], sizeof k[6]);
+    pdw_copy_state(s, fnew, k[6]);
     *fnew_valid = 1;
     return pdw_err_norm(s, s->x, xnew, errv);
 }

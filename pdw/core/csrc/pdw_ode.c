@@ -4,19 +4,21 @@
 #include <string.h>
 #include "pdw_ode.h"
 
-void pdw_rk_stages(pdw_sim *s, const pdw_rk_tableau *T, const double *x, double h,
-                   double (*k)[PDW_NX], double *xnew, double *errv)
+/* The stages for a state of nx entries; inlined with nx = PDW_NX a compile-time constant
+ * (pdw_rk_stages), so that the common size keeps its unrolled loops. */
+static inline void rk_stages(pdw_sim *s, const pdw_rk_tableau *T, const double *x, double h,
+                             double (*k)[PDW_NX_MAX], double *xnew, double *errv, const int nx)
 {
-    double xs[PDW_NX];
+    double xs[PDW_NX_MAX];
     for (int i = 1; i < T->stages; ++i) {
-        for (int c = 0; c < PDW_NX; ++c) {
+        for (int c = 0; c < nx; ++c) {
             double acc = 0.0;
             for (int j = 0; j < i; ++j) acc += T->a[i][j] * k[j][c];
             xs[c] = x[c] + h * acc;
         }
         pdw_ode_f(s, xs, k[i]);
     }
-    for (int c = 0; c < PDW_NX; ++c) {
+    for (int c = 0; c < nx; ++c) {
         double acc = 0.0, err = 0.0;
         for (int j = 0; j < T->stages; ++j) {
             acc += T->b[j] * k[j][c];
@@ -27,18 +29,25 @@ void pdw_rk_stages(pdw_sim *s, const pdw_rk_tableau *T, const double *x, double 
     }
     /* FSAL: the last stage point is the new solution up to rounding; use that exact point so
      * that k[stages-1] is f(xnew) bit for bit */
-    if (T->fsal) memcpy(xnew, xs, sizeof xs);
+    if (T->fsal) pdw_copy_state(s, xnew, xs);
+}
+
+void pdw_rk_stages(pdw_sim *s, const pdw_rk_tableau *T, const double *x, double h,
+                   double (*k)[PDW_NX_MAX], double *xnew, double *errv)
+{
+    if (s->nx == PDW_NX) rk_stages(s, T, x, h, k, xnew, errv, PDW_NX);
+    else rk_stages(s, T, x, h, k, xnew, errv, s->nx);
 }
 
 double pdw_err_norm(const pdw_sim *s, const double *x, const double *xnew, const double *errv)
 {
     double acc = 0.0;
-    for (int i = 0; i < PDW_NX; ++i) {
+    for (int i = 0; i < s->nx; ++i) {
         const double sc = s->atol + s->rtol * fmax(fabs(x[i]), fabs(xnew[i]));
         const double r = errv[i] / sc;
         acc += r * r;
     }
-    return sqrt(acc / PDW_NX);
+    return sqrt(acc / s->nx);
 }
 
 /* Contact forces of s->x into s->work (for the recorded sample), then store the sample. */
@@ -65,7 +74,7 @@ static int forces_changed(const pdw_discrete *a, const pdw_discrete *b)
 int pdw_fixed_advance(pdw_sim *s, pdw_fixed_step_fn step)
 {
     const double dt = s->dt;
-    double xnew[PDW_NX];
+    double xnew[PDW_NX_MAX];
     s->status = PDW_STATUS_RUNNING;
     if (!s->started) {
         const int r = pdw_update_flags(s, 0.0);
@@ -92,7 +101,7 @@ int pdw_fixed_advance(pdw_sim *s, pdw_fixed_step_fn step)
         }
         if (step(s, dt, xnew)) return s->status;
         if (pdw_check_state(s, xnew, s->t)) return s->status;
-        memcpy(s->x, xnew, sizeof xnew);
+        pdw_copy_state(s, s->x, xnew);
         s->n++;
         s->t = s->n * dt;
     }
@@ -120,10 +129,10 @@ static int settle_flags(pdw_sim *s, double t)
 }
 
 /* Cubic Hermite interpolant on [0, h] at theta in [0, 1] (Hairer, Norsett & Wanner I, II.6). */
-static void hermite(const double *x0, const double *f0, const double *x1, const double *f1,
-                    double h, double th, double *out)
+static void hermite(int nx, const double *x0, const double *f0, const double *x1,
+                    const double *f1, double h, double th, double *out)
 {
-    for (int i = 0; i < PDW_NX; ++i)
+    for (int i = 0; i < nx; ++i)
         out[i] = (1.0 - th)*x0[i] + th*x1[i]
                + th*(th - 1.0)*((1.0 - 2.0*th)*(x1[i] - x0[i]) + (th - 1.0)*h*f0[i] + th*h*f1[i]);
 }
@@ -134,11 +143,11 @@ static void hermite(const double *x0, const double *f0, const double *x1, const 
 static double locate_switch(pdw_sim *s, const double *x0, const double *f0, const double *x1,
                             const double *f1, double h)
 {
-    double ta = 0.0, tb = h, xi[PDW_NX];
+    double ta = 0.0, tb = h, xi[PDW_NX_MAX];
     while (tb - ta > s->event_tol) {
         const double tm = 0.5 * (ta + tb);
         if (tm <= ta || tm >= tb) break;
-        hermite(x0, f0, x1, f1, h, tm / h, xi);
+        hermite(s->nx, x0, f0, x1, f1, h, tm / h, xi);
         if (pdw_switch_pending(s, xi, s->work)) tb = tm; else ta = tm;
     }
     return tb;
@@ -156,7 +165,7 @@ static int fail_step_size(pdw_sim *s)
 
 int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx)
 {
-    double xnew[PDW_NX], fnew[PDW_NX];
+    double xnew[PDW_NX_MAX], fnew[PDW_NX_MAX];
     const double alpha = m->err_exponent - 0.75 * m->pi_beta;
     const double t_end = s->t_end;
     int new_point = 1, last_rejected = 0;
@@ -245,8 +254,8 @@ int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx)
             }
         }
         if (pdw_check_state(s, xnew, s->t)) return s->status;
-        memcpy(s->x, xnew, sizeof xnew);
-        memcpy(s->cache, fnew, sizeof fnew);
+        pdw_copy_state(s, s->x, xnew);
+        pdw_copy_state(s, s->cache, fnew);
         s->cache_valid = 1;
         s->t = last ? t_end : s->t + h_acc;
         s->n++;

@@ -23,11 +23,11 @@ static inline void pdw_ode_f(pdw_sim *s, const double *x, double *f)
     s->n_rhs++;
 }
 
-/* Explicit Runge-Kutta step of size h from x with tableau T. k: (T->stages, PDW_NX) stage
- * derivatives; k[0] must hold f(x) on entry. Writes xnew = x + h sum b_i k_i and, if errv is
+/* Explicit Runge-Kutta step of size h from x with tableau T. k: (T->stages, PDW_NX_MAX) stage
+ * derivatives (the first s->nx entries); k[0] must hold f(x) on entry. Writes xnew = x + h sum b_i k_i and, if errv is
  * not NULL, errv = h sum e_i k_i. For an FSAL tableau k[stages-1] is f(xnew) on return. */
 void pdw_rk_stages(pdw_sim *s, const pdw_rk_tableau *T, const double *x, double h,
-                   double (*k)[PDW_NX], double *xnew, double *errv);
+                   double (*k)[PDW_NX_MAX], double *xnew, double *errv);
 
 /* Scaled RMS norm of an error vector (Hairer's): sqrt(mean((e_i / sc_i)^2)),
  * sc_i = atol + rtol * max(|x_i|, |xnew_i|). */

@@ -6,7 +6,7 @@
 
 static int rk4_step(pdw_sim *s, double h, double *xnew)
 {
-    double k[4][PDW_NX];
+    double k[4][PDW_NX_MAX];
     pdw_ode_f(s, s->x, k[0]);
     pdw_rk_stages(s, &pdw_tableau_rk4, s->x, h, k, xnew, NULL);
     return 0;

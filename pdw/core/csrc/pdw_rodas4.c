@@ -12,6 +12,8 @@
  * J is kept across rejected attempts and the event redo from the same x_n; S is refactored
  * when h changes. Step size: I controller h_new = h * clamp(0.9 err^(-1/4), 0.2, 6), no
  * increase right after a rejection; a singular E counts as a rejection (h * 0.2).
+ * With LuGre's bristle states (s->nx > PDW_NX) J has no such form: the full nx x nx E is factored
+ * (partial pivoting) instead.
  * L-stability damps the stuck-friction mode (eigenvalue near -1e6 /s) in one step, so the
  * steps follow accuracy, not stability: no friction chatter at steps of milliseconds. */
 #include <math.h>
@@ -20,7 +22,10 @@
 #include "pdw_lu.h"
 
 typedef struct rodas_ctx {
-    double J[PDW_NX * PDW_NX];
+    int nx;                 /* state size: PDW_NX (Schur path) or more (LuGre: full LU of E) */
+    double J[PDW_NX_MAX * PDW_NX_MAX];
+    double E[PDW_NX_MAX * PDW_NX_MAX];  /* nx > PDW_NX: LU factors of I/(gamma h) - J */
+    int pivE[PDW_NX_MAX];
     double S[PDW_NQ * PDW_NQ];  /* LU factors of the Schur complement d I - B - A/d */
     int piv[PDW_NQ];
     double gh;              /* gamma h = 1/d of the factors */
@@ -34,6 +39,13 @@ typedef struct rodas_ctx {
 static int rodas_factor(rodas_ctx *c, double gh)
 {
     const double d = 1.0 / gh;
+    if (c->nx != PDW_NX) {          /* with the bristle states J has no [[0, I], [A, B]] form */
+        const int n = c->nx;
+        for (int i = 0; i < n * n; ++i) c->E[i] = -c->J[i];
+        for (int i = 0; i < n; ++i) c->E[i * n + i] += d;
+        c->gh = gh;
+        return pdw_lu_factor(n, c->E, c->pivE);
+    }
     for (int i = 0; i < PDW_NQ; ++i)
         for (int j = 0; j < PDW_NQ; ++j)
             c->S[i * PDW_NQ + j] = -J_B(c->J, i, j) - gh * J_A(c->J, i, j);
@@ -46,6 +58,7 @@ static int rodas_factor(rodas_ctx *c, double gh)
 static inline void rodas_solve(const rodas_ctx *c, double *b)
 {
     double w[PDW_NQ];
+    if (c->nx != PDW_NX) { pdw_lu_solve(c->nx, c->E, c->pivE, b); return; }
     for (int i = 0; i < PDW_NQ; ++i) {
         double acc = 0.0;
         for (int j = 0; j < PDW_NQ; ++j) acc += J_A(c->J, i, j) * b[j];
@@ -63,7 +76,8 @@ static double rodas4_step(pdw_sim *s, void *vctx, const double *fx, double h, in
 {
     const pdw_ros_tableau *T = &pdw_tableau_rodas4;
     rodas_ctx *c = (rodas_ctx *)vctx;
-    double u[PDW_ROS_MAXSTAGES][PDW_NX], xs[PDW_NX], errv[PDW_NX];
+    double u[PDW_ROS_MAXSTAGES][PDW_NX_MAX], xs[PDW_NX_MAX], errv[PDW_NX_MAX];
+    const int nx = s->nx;
     (void)fnew; (void)fnew_valid;
     if (new_point) {
         s->kernel->jacobian(s->x, s->p, s->disc.flags, s->disc.anchors, c->J, s->work);
@@ -76,23 +90,23 @@ static double rodas4_step(pdw_sim *s, void *vctx, const double *fx, double h, in
         c->lu_h = h;
     }
     const double ih = 1.0 / h;
-    memcpy(u[0], fx, sizeof u[0]);
+    pdw_copy_state(s, u[0], fx);
     rodas_solve(c, u[0]);
     for (int i = 1; i < T->stages; ++i) {
-        for (int k = 0; k < PDW_NX; ++k) {
+        for (int k = 0; k < nx; ++k) {
             double acc = 0.0;
             for (int j = 0; j < i; ++j) acc += T->a[i][j] * u[j][k];
             xs[k] = s->x[k] + acc;
         }
         pdw_ode_f(s, xs, u[i]);
-        for (int k = 0; k < PDW_NX; ++k) {
+        for (int k = 0; k < nx; ++k) {
             double acc = 0.0;
             for (int j = 0; j < i; ++j) acc += T->C[i][j] * u[j][k];
             u[i][k] += ih * acc;
         }
         rodas_solve(c, u[i]);
     }
-    for (int k = 0; k < PDW_NX; ++k) {
+    for (int k = 0; k < nx; ++k) {
         double acc = 0.0, err = 0.0;
         for (int j = 0; j < T->stages; ++j) { acc += T->m[j] * u[j][k]; err += T->e[j] * u[j][k]; }
         xnew[k] = s->x[k] + acc;
@@ -109,5 +123,6 @@ int pdw_rodas4_advance(pdw_sim *s)
 {
     rodas_ctx c;
     c.lu_h = 0.0;
+    c.nx = s->nx;
     return pdw_adaptive_advance(s, &rodas4, &c);
 }

@@ -7,6 +7,7 @@
 #ifndef PDW_SIM_H
 #define PDW_SIM_H
 
+#include <string.h>
 #include "pdw_model.h"
 
 /* Discrete state carried by every loop (docs/model.md sections 5 and 6). */
@@ -21,7 +22,7 @@ typedef struct pdw_discrete {
 /* Why and where a loop failed. */
 typedef struct pdw_failure {
     double t;           /* time of the last good state [s] */
-    double x[PDW_NX];   /* that state */
+    double x[PDW_NX_MAX];   /* that state (the first pdw_sim.nx entries) */
     int leg;            /* leg involved (fell through the ground), or -1 */
     int reason;         /* PDW_REASON_* */
 } pdw_failure;
@@ -69,6 +70,8 @@ enum { PDW_REASON_BUDGET = 7 };
 typedef struct pdw_sim {
     /* --- model and settings (inputs) --- */
     const pdw_kernel *kernel;
+    int nx;                     /* size of the continuous state: kernel->nx (PDW_NX, or
+                                 * PDW_NX_LUGRE with the bristle states) */
     double p[PDW_NP];           /* parameters + derived constants (pdw_precompute) */
     double dt;                  /* step [s] */
     long n_steps;               /* number of steps to take */
@@ -90,7 +93,7 @@ typedef struct pdw_sim {
     double periodic_tol;
     /* --- outputs (caller-allocated) --- */
     double *rec_t;              /* (rec_capacity,) */
-    double *rec_x;              /* (rec_capacity, PDW_NX) */
+    double *rec_x;              /* (rec_capacity, nx) */
     int *rec_flags;             /* (rec_capacity, 2) */
     double *rec_contact;        /* (rec_capacity, PDW_NREC), may be NULL */
     long rec_capacity, n_rec;
@@ -100,12 +103,12 @@ typedef struct pdw_sim {
     long n;                     /* steps taken (accepted) */
     double t;                   /* time of x [s] */
     double h;                   /* next step size of adaptive methods [s] */
-    double x[PDW_NX];           /* state at step n: [U_n, U'_n] */
+    double x[PDW_NX_MAX];       /* state at step n: [U_n, U'_n] (and the bristle states z) */
     double u_prev[PDW_NQ];      /* U_{n-1} (central difference) */
     int started;
     pdw_discrete disc;
     double work[PDW_NWORK];
-    double cache[PDW_NX];       /* method-private: f(x) (FSAL) or verlet's a_n, for exact resumption */
+    double cache[PDW_NX_MAX];   /* method-private: f(x) (FSAL) or verlet's a_n, for exact resumption */
     int cache_valid;            /* cache holds a value for the current x and discrete state */
     double err_prev;            /* adaptive methods: previous accepted error (step controllers) */
     double h_prev;              /* adaptive methods: previous accepted step (0: none yet) */
@@ -123,6 +126,14 @@ typedef struct pdw_sim {
     long max_steps;             /* adaptive methods: fail (PDW_REASON_BUDGET) once accepted +
                                  * rejected steps reach this; 0: no budget */
 } pdw_sim;
+
+/* Copy a state of s's size (s->nx); the common size PDW_NX as a compile-time constant, so that
+ * the copy stays inline in the time loops. */
+static inline void pdw_copy_state(const pdw_sim *s, double *dst, const double *src)
+{
+    if (s->nx == PDW_NX) memcpy(dst, src, PDW_NX * sizeof(double));
+    else memcpy(dst, src, (size_t)s->nx * sizeof(double));
+}
 
 /* Is a poll due (counts one loop iteration)? Sets s->status = PDW_STATUS_POLL when it is. */
 static inline int pdw_poll_due(pdw_sim *s)

@@ -20,7 +20,7 @@
 static int verlet_step(pdw_sim *s, double h, double *xnew)
 {
     double *a = s->cache + PDW_NQ;      /* cache = f(q_n, v_n*) = [v, a]; a_n in the lower half */
-    double xp[PDW_NX], vh[PDW_NQ];
+    double xp[PDW_NX_MAX], vh[PDW_NQ], zd[PDW_NX_MAX];
     const double *q = s->x, *v = s->x + PDW_NQ;
     if (!s->cache_valid) { pdw_ode_f(s, s->x, s->cache); s->cache_valid = 1; }
     for (int i = 0; i < PDW_NQ; ++i) {
@@ -28,11 +28,17 @@ static int verlet_step(pdw_sim *s, double h, double *xnew)
         xp[i] = q[i] + h * vh[i];
         xp[PDW_NQ + i] = vh[i] + 0.5 * h * a[i];
     }
+    /* LuGre's bristle states (beyond [q, qd]): Heun, like v -- Euler predictor, trapezoid */
+    for (int i = PDW_NX; i < s->nx; ++i) {
+        zd[i] = s->cache[i];
+        xp[i] = s->x[i] + h * zd[i];
+    }
     pdw_ode_f(s, xp, s->cache);          /* a_{n+1} at (q_{n+1}, v*) */
     for (int i = 0; i < PDW_NQ; ++i) {
         xnew[i] = xp[i];
         xnew[PDW_NQ + i] = vh[i] + 0.5 * h * a[i];
     }
+    for (int i = PDW_NX; i < s->nx; ++i) xnew[i] = s->x[i] + 0.5 * h * (zd[i] + s->cache[i]);
     return 0;
 }
 

@@ -1,0 +1,160 @@
+"""Emit ``generated/pdw_batch_gen.h``: structure-of-arrays (SoA) variants of the cdm stages.
+
+A batched stage computes one stage of the scalar kernel for W walkers at once, one per lane:
+every array of the scalar stage (``x``, ``p``, ``trig``, ``anchors``, ``kin``, ``contact``,
+``M``, ``C``, ``QmG``) becomes lane-minor, element ``a[i]`` of lane ``l`` at
+``a[i*PDW_SOA + l]`` (``PDW_SOA`` = 72: room for the most lanes, 64, and not a power of
+two, so that the rows a stage touches fall in different cache sets), and the body runs in a
+``#pragma omp simd`` loop over the lanes that the C compiler vectorizes (one lane per SIMD
+slot). The expressions are the scalar stages' (`derive.stages`), eliminated by the same
+`derive.printer.c_block` into the same statements, so a lane computes exactly the scalar
+kernel's operations in the same order; they use only + - * / sqrt fabs and comparisons, all
+correctly rounded in SIMD, so with no FMA contraction (ISO C mode) a lane's result is bitwise
+the scalar one. The contact stage's branch (a penetrating support foot) becomes a mask: every
+lane evaluates the force law and keeps it only where its foot is one (``on ? force : 0.0``).
+
+The functions are ``static``: the header is included by each instruction-set variant of the
+lane loop (pdw/core/csrc/pdw_batch_soa.inc), compiled once per target (run-time dispatch,
+docs/ensemble.md). Kernels with a normal law other than Hunt-Crossley or a friction law other
+than the smooth Coulomb one have no batched stages (NULL in the table): the lane loop then runs
+them through the scalar stages (or the batch refuses them).
+
+Deterministic, stamped with `derive.emit.input_hash` like the other generated files.
+"""
+from __future__ import annotations
+
+import re
+
+from . import layout, stages
+from . import model as mdl
+
+_ELEM = re.compile(r"^(\w+)\[(.+)\]$")
+
+
+def _soa(ref: str) -> str:
+    """``a[i]`` -> ``a[(i)*PDW_SOA + l]``; a local name stays as it is."""
+    m = _ELEM.match(ref)
+    return ref if m is None else "%s[(%s)*PDW_SOA + l]" % (m.group(1), m.group(2))
+
+
+# lanes in chunks of PDW_SOA_CHUNK = 8 (a constant trip count, a multiple of every vector
+# width: no scalar remainder, no profitability threshold at run time; a block of W lanes
+# computes ceil(W/8)*8, the padding lanes' values unused)
+LOOP = ("    for (int l0 = 0; l0 < W; l0 += PDW_SOA_CHUNK) {\n"
+        "    #pragma omp simd\n    for (int l = l0; l < l0 + PDW_SOA_CHUNK; ++l) {\n%s\n    }\n    }")
+
+
+def _function(signature, body):
+    return "%s\n{\n%s\n}\n" % (signature, body)
+
+
+def emit_kernel(spec, names, c_block, nforces):
+    """C source of the batched kinematics, contact and cdm_terms stages of one kernel."""
+    k = "pdw_soa_" + spec.name
+    soa = {s: _soa(c) for s, c in names.items()}
+    out = ["/* ---- kernel %s, batched (SoA) ---- */\n" % spec.name]
+
+    targets = [_soa("kin[%d*PDW_NKIN + PDW_KIN_%s]" % (i, f.upper()))
+               for i in range(2) for f in layout.KIN]
+    code, _ = c_block(stages.kinematics(spec), targets, soa, indent="        ")
+    out.append(_function(
+        "static void %s_kinematics(int W, const double *restrict x, const double *restrict trig,\n"
+        "    const double *restrict p, const double *restrict anchors, double *restrict kin)" % k,
+        "    (void)anchors;\n" + LOOP % code))
+
+    fields = layout.CONTACT[:nforces]
+    outs = ["o_%s" % f.lower() for f in fields]
+    exprs = stages.contact(spec)[:nforces]
+    # the parameters as locals loaded up front: the law's branches then hold no loads, and the
+    # compiler turns them into selects (a branch with a load would need a masked load)
+    used = set().union(*(e.free_symbols for e in exprs))
+    pre = {s_: "pv_%s" % n for n, s_ in mdl.P.items() if s_ in used}
+    loads = "".join("            const double %s = %s;\n" % (pre[s_], soa[s_])
+                    for s_ in sorted(pre, key=lambda s_: pre[s_]))
+    code, _ = c_block(exprs, outs, {**soa, **pre}, indent="            ")
+    code = loads + code
+    store = "\n".join("            c[PDW_CONTACT_%s*PDW_SOA + l] = on ? %s : 0.0;"
+                      % (f.upper(), o) for f, o in zip(fields, outs))
+    out.append(_function(
+        "static void %s_contact(int W, const double *restrict kin, const int *restrict flags,\n"
+        "    const double *restrict p, double *restrict contact)" % k,
+        "    for (int i = 0; i < 2; ++i) {\n"
+        "        const double *restrict ki = kin + i*PDW_NKIN*PDW_SOA;\n"
+        "        double *restrict c = contact + i*PDW_NCONTACT*PDW_SOA;\n"
+        "        const int *restrict fl = flags + i*PDW_SOA;\n"
+        "        for (int l0 = 0; l0 < W; l0 += PDW_SOA_CHUNK) {\n"
+        "        #pragma omp simd\n"
+        "        for (int l = l0; l < l0 + PDW_SOA_CHUNK; ++l) {\n"
+        "            /* mask: a penetrating support foot (the scalar stage's branch) */\n"
+        "            const int on = (fl[l] != 0) & (ki[PDW_KIN_Y_D*PDW_SOA + l] < 0.0);\n"
+        "            const double delta = -ki[PDW_KIN_Y_D*PDW_SOA + l];\n"
+        "            const double deltad = -ki[PDW_KIN_V_Y*PDW_SOA + l];\n"
+        "            const double v_t = ki[PDW_KIN_V_X*PDW_SOA + l];\n"
+        "            const double xi = ki[PDW_KIN_XI*PDW_SOA + l];\n"
+        "            const double v_in = ki[PDW_KIN_V_IN*PDW_SOA + l];\n"
+        "            (void)delta; (void)deltad; (void)v_t; (void)xi; (void)v_in;\n"
+        "            double %s;\n"
+        "%s\n%s\n        }\n        }\n    }" % (", ".join(outs), code, store)))
+
+    targets = [_soa("M[%d]" % i) for i in range(16)] + [_soa("C[%d]" % i) for i in range(16)] \
+        + [_soa("QmG[%d]" % i) for i in range(4)]
+    code, _ = c_block(stages.cdm_terms(spec), targets, soa, indent="        ")
+    out.append(_function(
+        "static void %s_cdm_terms(int W, const double *restrict x, const double *restrict trig,\n"
+        "    const double *restrict p, const double *restrict contact,\n"
+        "    double *restrict M, double *restrict C, double *restrict QmG)" % k, LOOP % code))
+    return "\n".join(out)
+
+
+HEADER = """\
+{banner}
+/* Structure-of-arrays stages for the ensemble engine (derive/emit_batch.py, docs/ensemble.md):
+ * element i of lane l at a[i*PDW_SOA + l]. Included by each instruction-set variant of the
+ * lane loop (pdw/core/csrc/pdw_batch_soa.inc); every function is static. */
+#ifndef PDW_BATCH_GEN_H
+#define PDW_BATCH_GEN_H
+
+#include <math.h>
+#include <stddef.h>
+#include "pdw_model.h"
+
+/* derive/ input hash these stages were generated from (= PDW_INPUT_HASH of pdw_model.h) */
+#define PDW_BATCH_INPUT_HASH "{hash}"
+
+/* the stride of a structure-of-arrays row: room for the most lanes of a block (64), and 9
+ * cache lines, not a power of two, so that the many rows a stage touches at the same lane
+ * fall in different cache sets (a 512-byte stride thrashes an 8-way L1 in 8 sets) */
+enum {{ PDW_SOA = 72 }};
+/* lanes are computed in chunks of this many (the stages compute ceil(W/8)*8 lanes) */
+enum {{ PDW_SOA_CHUNK = 8 }};
+
+/* The batched stages of one kernel (NULL: none, run the scalar stages). */
+typedef struct pdw_soa_kernel {{
+    void (*kinematics)(int W, const double *x, const double *trig, const double *p,
+                       const double *anchors, double *kin);
+    void (*contact)(int W, const double *kin, const int *flags, const double *p,
+                    double *contact);
+    void (*cdm_terms)(int W, const double *x, const double *trig, const double *p,
+                      const double *contact, double *M, double *C, double *QmG);
+}} pdw_soa_kernel;
+
+{body}
+/* indexed like pdw_kernels[] */
+static const pdw_soa_kernel pdw_soa_kernels[PDW_NKERNELS] = {{
+{table}
+}};
+
+#endif /* PDW_BATCH_GEN_H */
+"""
+
+
+def header(banner, h, kernels, names_of, c_block, nforces):
+    """The text of generated/pdw_batch_gen.h."""
+    body, rows = [], []
+    for spec in kernels:
+        if spec.normal != "hunt_crossley" or getattr(spec, "friction", "coulomb") != "coulomb":
+            rows.append("    {NULL, NULL, NULL},   /* %s */" % spec.name)
+            continue
+        body.append(emit_kernel(spec, names_of(spec), c_block, nforces))
+        rows.append("    {%s_kinematics, %s_contact, %s_cdm_terms}," % (("pdw_soa_" + spec.name,) * 3))
+    return HEADER.format(banner=banner, hash=h, body="\n".join(body), table="\n".join(rows))
