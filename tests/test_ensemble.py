@@ -209,14 +209,15 @@ def _rows_equal(rows, ref):
             {k: v for k, v in s.items() if k != "wall_s"}, (r, s)
 
 
-@pytest.mark.parametrize("backend", ["serial", "process"])
-def test_sweep_points_as_batches_are_the_scalar_rows(tmp_path, backend):
-    """A cdm study runs as batches (groups of points with per-walker Params): every row is
-    the row `run_point` computes for that point alone; the CSV read back is the same."""
+@pytest.mark.parametrize("method,backend", [("cdm", "serial"), ("cdm", "process"),
+                                            ("rodas4", "serial")])
+def test_sweep_points_as_batches_are_the_scalar_rows(tmp_path, method, backend):
+    """A cdm or rodas4 study runs as batches (groups of points with per-walker Params): every
+    row is the row `run_point` computes for that point alone; the CSV read back is the same."""
     from pdw.studies.points import batchable
     from pdw.studies.study import parse_study
     from pdw.studies.sweep import read_rows, run_point, run_study
-    st = parse_study(STUDY % "cdm")
+    st = parse_study(STUDY % method)
     assert batchable(st)
     res = run_study(st, tmp_path / backend, backend=backend, workers=2, progress=False)
     assert res.engine == "batch"
@@ -248,7 +249,7 @@ def test_sweep_with_a_method_the_engine_refuses_runs_point_by_point(tmp_path, mo
     b = run_study(st, tmp_path / "b", backend="serial", progress=False)
     assert b.engine == "batch"
     _rows_equal(b.rows, res.rows)
-    assert not sweep_batch.batchable(parse_study(STUDY % "rodas4")) or E.supports("rodas4")
+    assert sweep_batch.batchable(parse_study(STUDY % "rodas4")) == E.supports("rodas4")
     off = run_study(st, tmp_path / "off", backend="serial", progress=False, batch=False)
     assert off.engine == "scalar"
     _rows_equal(off.rows, b.rows)

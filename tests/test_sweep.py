@@ -153,9 +153,11 @@ class KillAfter(cf.Executor):
 
 
 def test_killed_sweep_resumes_without_recomputing(tiny_serial, tmp_path, monkeypatch):
+    # point by point (batch=False): the kill and the counting of run_point are per point
     study = S.parse_study(TINY)
     with pytest.raises(KeyboardInterrupt):
-        S.run_study(study, tmp_path, executor=KillAfter(4), progress=False, figures=False)
+        S.run_study(study, tmp_path, executor=KillAfter(4), progress=False, figures=False,
+                      batch=False)
     rows = _csv(tmp_path / "tiny.csv")
     assert sorted(int(r["index"]) for r in rows) == [0, 1, 2, 3]
     # a write cut by the kill: a torn last line is dropped on resumption
@@ -170,7 +172,7 @@ def test_killed_sweep_resumes_without_recomputing(tiny_serial, tmp_path, monkeyp
 
     monkeypatch.setattr(S, "run_point", counting)
     res = S.run_study(study, tmp_path, backend="thread", workers=2, progress=False,
-                      figures=False)
+                      figures=False, batch=False)
     assert sorted(calls) == [4, 5] and res.computed == [4, 5] and res.resumed == [0, 1, 2, 3]
     rows = _csv(tmp_path / "tiny.csv")
     assert [int(r["index"]) for r in rows] == list(range(6))           # each point once
@@ -179,7 +181,8 @@ def test_killed_sweep_resumes_without_recomputing(tiny_serial, tmp_path, monkeyp
     assert meta["n_resumed"] == 4 and meta["n_computed"] == 2
     # all done: a rerun computes nothing
     calls.clear()
-    res = S.run_study(study, tmp_path, progress=False, figures=False)
+    res = S.run_study(study, tmp_path, progress=False, figures=False,
+                      batch=False)
     assert calls == [] and res.computed == []
 
 
@@ -188,9 +191,11 @@ def test_resume_refuses_a_csv_of_another_study(tmp_path):
     other = S.parse_study(TINY.replace("values = [0.8e5, 1.0e5, 1.2e5]",
                                        "values = [0.7e5, 1.0e5, 1.2e5]"))
     with pytest.raises(KeyboardInterrupt):
-        S.run_study(study, tmp_path, executor=KillAfter(1), progress=False, figures=False)
+        S.run_study(study, tmp_path, executor=KillAfter(1), progress=False, figures=False,
+                      batch=False)
     with pytest.raises(pdw.PdwError, match="does not match"):
-        S.run_study(other, tmp_path, progress=False, figures=False)
+        S.run_study(other, tmp_path, progress=False, figures=False,
+                      batch=False)
     res = S.run_study(other, tmp_path, resume=False, backend="serial", progress=False,
                       figures=False)
     assert len(res.computed) == 6

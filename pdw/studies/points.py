@@ -13,8 +13,8 @@ fallback (``[run] fallback``) of a point that is not period-1 runs per point as 
 ``wall_s`` of a batched point is its share of the group's time (plus its own Newton time).
 
 `batchable` says when a study qualifies: ``mode = "simulate"``, a method the batch engine runs
-bitwise (`BITWISE_METHODS`: cdm; a method the engine runs only within a tolerance would change
-the rows) and that it supports (`pdw.sim.ensemble.supports`), every force
+bitwise (`BITWISE_METHODS`: every method of `pdw.METHODS`; a method the engine ran only
+within a tolerance would change the rows) and that it supports (`pdw.sim.ensemble.supports`), every force
 element and the default contact laws (the engine's kernels), no recorded samples (the scalar
 run's end-of-run check then looks at the final state only, as the batch's does),
 ``on_failure = "return"``, and ``steady`` small enough for the last `STEP_RING` steps the
@@ -29,16 +29,17 @@ import numpy as np
 
 from ..core import _layout
 from ..core.errors import PdwError
+from ..core.integrators import METHODS
 from ..core.params import Params
 from ..sim import ensemble
 from ..sim.scene import Scene
 from .study import COLUMNS, Study
 
-#: Methods whose batch runs are bitwise `pdw.simulate`'s (cdm with ``vector=False``, tested in
-#: tests/test_batch.py): only these batch a sweep, so that its rows do not change. A method the
-#: engine learns later (rodas4 per lane, within its tolerance rather than bitwise) joins here
-#: once its rows are shown to be `run_point`'s.
-BITWISE_METHODS = ("cdm",)
+#: Methods whose batch runs are bitwise `pdw.simulate`'s (tests/test_batch.py: cdm with
+#: ``vector=False`` and every adaptive or fixed-step method of the engine, one lane per walker
+#: through the scalar integrator's own steps): only these batch a sweep, so that its rows do not
+#: change (tests/test_ensemble.py compares the rows with `run_point`'s for cdm and rodas4).
+BITWISE_METHODS = METHODS
 #: Points per batched task at most (a task's rows reach the CSV together).
 MAX_GROUP = 64
 
