@@ -14,6 +14,16 @@ the stiffest forces of the model (docs/stability.md has the measured maps). This
 * the **criteria of the stability maps** (`typical_start`, `reference`, `judge`,
   `largest_step`, `chatter`), and the **energy balance** of a run (`energy_balance`).
 
+Other contact laws (`pdw.Contact`). The linear estimate is the default law's (Hunt-Crossley with
+Eq. 10's friction) at the run's parameters (``contact.parameters(params)``: the law's k and d
+in k_n, d_n), times a per-law, per-method factor `LAW_CALIBRATION` fitted on the limits measured
+with each law calibrated to the paper's ground on `paper_steady`
+(benchmarks/step_limits_laws.py, docs/contact_laws.md). The factor keeps each law's check the
+same margin below its measured limit as the default law's has there. It carries the law's own
+physics -- Kelvin-Voigt's force jump d delta' at first contact, LuGre's bristle damping
+sigma1 F_n -- only at the calibrated parameters; the rest of the estimate follows the walker's
+parameters as the default law's does.
+
 Chatter. With the foot stuck, the friction law's slope dmu/dv ~ 0.75/v_s gives a real
 eigenvalue of about -F_n |dmu/dv| / m_eff ~ -1e6 /s at the paper's values: every explicit
 method is unstable above a step of ~2 us there. The instability does not diverge -- mu saturates
@@ -26,6 +36,7 @@ chatter changes the gait, and the limit is capped at a few times the chatter lim
 """
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 import warnings
@@ -69,6 +80,24 @@ CALIBRATION = {"paper": {"cdm": 0.1, "verlet": 0.17, "rk4": 0.22},
 #: CHATTER_CALIBRATION x `StepLimit.dt_chatter`.
 FRICTION_LOAD = 0.8
 CHATTER_CALIBRATION = 5.0
+#: Per contact law and fixed-step method: dt_max = factor x the default law's estimate at the
+#: run's parameters. Fitted by benchmarks/step_limits_laws.py (benchmarks/results/
+#: step_limits_laws.txt) with the laws calibrated to the paper's ground on `paper_steady`: the
+#: law's walking edge (the largest step that walks with the rodas4 reference's touch-downs)
+#: over its estimate, divided by the same ratio for hunt_crossley, rounded down to two digits.
+#: So each law's limit sits as far below its measured edge as the default law's does there.
+#: hertz does not walk at any step (it falls after one step under rodas4 too): it keeps the
+#: default law's factor. "lugre" is LuGre friction on the Hunt-Crossley ground (its bristle
+#: damping sigma1 F_n sets the limit, ~20 x below the default's); LuGre on another normal law
+#: takes the smaller of the two factors (not measured).
+LAW_CALIBRATION = {
+    "hunt_crossley": {"cdm": 1.0, "verlet": 1.0, "rk4": 1.0},
+    "hertz": {"cdm": 1.0, "verlet": 1.0, "rk4": 1.0},
+    "kelvin_voigt": {"cdm": 0.54, "verlet": 0.7, "rk4": 1.3},
+    "lankarani_nikravesh": {"cdm": 1.4, "verlet": 1.0, "rk4": 1.3},
+    "flores": {"cdm": 1.1, "verlet": 1.0, "rk4": 0.93},
+    "lugre": {"cdm": 0.045, "verlet": 0.012, "rk4": 0.011},
+}
 
 
 # --------------------------------------------------------------------------------------------
@@ -314,6 +343,10 @@ class StepLimit:
         The largest share of the static friction mu_s F_n that a stuck stance foot needs to hold
         the tangential spring-damper at the stance states; from `FRICTION_LOAD` on, dt_max is
         capped by the chatter limit and ``force`` is "v_s".
+    law : str
+        The contact law (a key of `LAW_CALIBRATION`; "hunt_crossley" for the default).
+    law_factor : float
+        `LAW_CALIBRATION` [law][method]: dt_max is this times the default law's estimate.
     """
 
     method: str
@@ -326,12 +359,23 @@ class StepLimit:
     eigenvalue: complex
     sensitivity: dict = field(default_factory=dict, compare=False)
     friction_load: float = 0.0
+    law: str = "hunt_crossley"
+    law_factor: float = 1.0
 
     @property
     def why(self) -> str:
         return FORCES.get(self.force, self.force)
 
     def message(self, dt: float) -> str:
+        if self.law != "hunt_crossley":
+            return ("dt = %.3g s exceeds the estimated stability limit %.2g s of method %r with "
+                    "the contact law %r (variant %r): the default law's estimate at these "
+                    "parameters, %.2g s, times the law's factor %.2g, fitted on its measured "
+                    "limit (docs/contact_laws.md). Above it the typical gait falls or diverges "
+                    "spuriously. Use dt <= %.2g, or method='rodas4' (L-stable, no step limit); "
+                    "check_step='off' disables this check."
+                    % (dt, self.dt_max, self.method, self.law, self.variant,
+                       self.dt_max / self.law_factor, self.law_factor, self.dt_max))
         if self.force == "v_s" and self.method in FIXED_STEP:
             return ("dt = %.3g s exceeds the estimated limit %.2g s of method %r for these "
                     "parameters (variant %r): the stuck stance foot needs %.0f %% of its static "
@@ -429,7 +473,24 @@ def _step_limit(params: Params, method: str, variant: str) -> StepLimit:
     return StepLimit(method, variant, dt_max, force, h, c, dt_chatter, _stiffest(J), sens, load)
 
 
-def step_limit(params: Params | None = None, method: str = "cdm", variant: str = "paper") -> StepLimit:
+def law_of(contact) -> str:
+    """The key of `LAW_CALIBRATION` for a `pdw.Contact` (None: the default law)."""
+    if contact is None:
+        return "hunt_crossley"
+    if contact.friction == "lugre":
+        return "lugre" if contact.normal == "hunt_crossley" else "lugre+" + contact.normal
+    return contact.normal
+
+
+def law_factor(law: str, method: str) -> float:
+    """`LAW_CALIBRATION` [law][method]; LuGre on another normal law: the smaller factor."""
+    if law.startswith("lugre+"):
+        return min(LAW_CALIBRATION["lugre"][method], LAW_CALIBRATION[law[6:]][method])
+    return LAW_CALIBRATION[law][method]
+
+
+def step_limit(params: Params | None = None, method: str = "cdm", variant: str = "paper",
+               contact=None) -> StepLimit:
     """Estimate the largest fixed step ``method`` can take on the walker with ``params``.
 
     The smallest linear stability limit (`linear_limit`) of the method on df/dx without the
@@ -441,6 +502,10 @@ def step_limit(params: Params | None = None, method: str = "cdm", variant: str =
     keeps below by itself); for rodas4: inf. Cached per
     (params, method, variant); about 40 ms the first time (the force's exponents take five
     more linear limits).
+
+    With a ``contact`` (`pdw.Contact`) other than the default law, ``params`` must be the run's
+    (``contact.parameters(params)``) and dt_max of a fixed-step method is multiplied by the law's
+    factor `LAW_CALIBRATION` (``law``, ``law_factor`` of the result).
     """
     params = Params.paper() if params is None else params
     if not isinstance(params, Params):
@@ -451,7 +516,12 @@ def step_limit(params: Params | None = None, method: str = "cdm", variant: str =
         check_variant(variant)
     except ValueError as e:
         raise InvalidInputError(str(e)) from None
-    return _step_limit(params, method, variant)
+    lim = _step_limit(params, method, variant)
+    law = law_of(contact)
+    if law == "hunt_crossley" or method not in FIXED_STEP:
+        return lim
+    f = law_factor(law, method)
+    return dataclasses.replace(lim, dt_max=f * lim.dt_max, law=law, law_factor=f)
 
 
 def step_unknown(dt, method, mode, e):
@@ -465,8 +535,12 @@ def step_unknown(dt, method, mode, e):
     warnings.warn(StepSizeWarning(msg, dt=dt, limit=0.0, force="unknown"), stacklevel=3)
 
 
-def check_step(dt: float, params: Params, method: str, variant: str, mode: str = "warn"):
+def check_step(dt: float, params: Params, method: str, variant: str, mode: str = "warn",
+               contact=None):
     """The check `pdw.simulate` runs before a fixed-step run (``check_step`` argument).
+
+    ``contact``: the run's `pdw.Contact` (None: the default law), ``params`` then the run's
+    (``contact.parameters(params)``); the limit is scaled by the law's `LAW_CALIBRATION` factor.
 
     ``mode``: "warn" (a `pdw.StepSizeWarning` when dt > `step_limit`), "error" (raise
     `pdw.StepSizeError` instead), "off". Adaptive methods are not checked (their dt is only
@@ -478,9 +552,9 @@ def check_step(dt: float, params: Params, method: str, variant: str, mode: str =
                                 % (", ".join(map(repr, CHECK_MODES)), mode))
     if mode == "off" or method not in FIXED_STEP:
         return None
-    if not dt > _dt_max(params, method, variant):
+    if not dt > law_factor(law_of(contact), method) * _dt_max(params, method, variant):
         return None
-    lim = step_limit(params, method, variant)
+    lim = step_limit(params, method, variant, contact)
     msg = lim.message(dt)
     if mode == "error":
         raise StepSizeError(msg, dt=dt, limit=lim.dt_max, force=lim.force)
