@@ -435,11 +435,11 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
     k = kernel_index(variant, feats, contact.normal, contact.friction)
     if feats != _layout.FEATURES:
         params = params.without(feats)
+    p = contact.vector(parameter_vector(params), feats, params)     # validates the law's values
     try:        # every contact law: the law's factor on the default estimate (stepsize.py)
         _stepsize.check_step(dt, params, method, variant, check_step, contact)
     except (np.linalg.LinAlgError, FloatingPointError, OverflowError) as e:
         _stepsize.step_unknown(dt, method, check_step, e)
-    p = contact.vector(parameter_vector(params), feats, params)
     v_in0 = None if approach_speeds0 is None else tuple(checks.real_array(
         "approach_speeds0", approach_speeds0, [(2,)], lo=0.0))
     start = time.perf_counter()
