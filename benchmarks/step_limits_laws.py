@@ -18,9 +18,14 @@ rodas4 reference (rtol 1e-9), as the stability maps of docs/stability.md:
   then sits as far below its walks edge as the default law's does on paper_steady.
   `LAW_CALIBRATION` holds these factors rounded down to two digits.
 
+Then LuGre's bristle damping sigma1 swept (1/3, 1, 3 x the calibrated value, and the default
+316.2 s/m): the walks edge of each method, and the check's dt_max (`stepsize.step_limit` with the
+contact: LAW_CALIBRATION x min(1, LUGRE_SIGMA1 / sigma1)).
+
 Writes benchmarks/results/step_limits_laws.txt.
 Usage: .venv/bin/python benchmarks/step_limits_laws.py   (about 1 minute)
 """
+import dataclasses
 import math
 import os
 import pathlib
@@ -100,6 +105,17 @@ def main():
     for law, m, a, b, ac, est in rows:
         lines.append("| %s | %s | %s | %s | %s | %.3g | %.3g | %.3g |" % (
             law, m, g(a), g(b), g(ac), est, ratio[law, m], ratio[law, m] / ratio["hunt_crossley", m]))
+    lines += ["", "LuGre's bristle damping (the walks edge against the check's dt_max):", "",
+              "| sigma1 [s/m] | method | walks up to [s] | fails at [s] | check dt_max [s] |",
+              "|---|---|---|---|---|"]
+    c0 = contacts["lugre"]
+    for s1 in (c0.sigma1 / 3, c0.sigma1, 3 * c0.sigma1, 316.2):
+        c = dataclasses.replace(c0, sigma1=s1)
+        ref = sim(c, x0=X0, t_end=3.5, method="rodas4", rtol=1e-9, atol=1e-11, record_every=0)
+        for m in METHODS:
+            a, b = limit(c, m, ref, 0)
+            lim = stepsize.step_limit(c.parameters(P), m, "paper", c).dt_max
+            lines.append("| %.4g | %s | %s | %s | %.3g |" % (s1, m, g(a), g(b), lim))
     lines += ["", "load average at end: %s" % (os.getloadavg(),),
               "total %.0f s" % (time.perf_counter() - t0)]
     publish("step_limits_laws.txt", lines)

@@ -45,6 +45,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core import _core, _layout
+from ..core.contact import LUGRE_DEFAULTS
 from ..core.errors import InvalidInputError, StepSizeError, StepSizeWarning
 from ..core.integrators import METHODS
 from ..core.model import check_variant, contact_forces, jacobian
@@ -89,7 +90,10 @@ CHATTER_CALIBRATION = 5.0
 #: hertz does not walk at any step (it falls after one step under rodas4 too): it keeps the
 #: default law's factor. "lugre" is LuGre friction on the Hunt-Crossley ground (its bristle
 #: damping sigma1 F_n sets the limit, ~20 x below the default's); LuGre on another normal law
-#: takes the smaller of the two factors (not measured).
+#: takes the smaller of the two factors (not measured). LuGre's factor is for its calibrated
+#: bristle damping `LUGRE_SIGMA1`; a larger sigma1 scales it by LUGRE_SIGMA1 / sigma1 (a
+#: damper's explicit limit; measured: the edges fall as sigma1^-0.2 ... -0.9 from 15 to 316 s/m,
+#: benchmarks/results/step_limits_laws.txt), a smaller one keeps it.
 LAW_CALIBRATION = {
     "hunt_crossley": {"cdm": 1.0, "verlet": 1.0, "rk4": 1.0},
     "hertz": {"cdm": 1.0, "verlet": 1.0, "rk4": 1.0},
@@ -98,6 +102,9 @@ LAW_CALIBRATION = {
     "flores": {"cdm": 1.1, "verlet": 1.0, "rk4": 0.93},
     "lugre": {"cdm": 0.045, "verlet": 0.012, "rk4": 0.011},
 }
+#: The bristle damping [s/m] of the LuGre law `LAW_CALIBRATION` was fitted with
+#: (`pdw.calibration.calibrate_lugre` on paper_steady: critically damped bristles).
+LUGRE_SIGMA1 = 45.09
 
 
 # --------------------------------------------------------------------------------------------
@@ -482,11 +489,17 @@ def law_of(contact) -> str:
     return contact.normal
 
 
-def law_factor(law: str, method: str) -> float:
-    """`LAW_CALIBRATION` [law][method]; LuGre on another normal law: the smaller factor."""
+def law_factor(law: str, method: str, contact=None) -> float:
+    """`LAW_CALIBRATION` [law][method]; LuGre on another normal law: the smaller factor; LuGre
+    with a bristle damping sigma1 above `LUGRE_SIGMA1`: times LUGRE_SIGMA1 / sigma1."""
     if law.startswith("lugre+"):
-        return min(LAW_CALIBRATION["lugre"][method], LAW_CALIBRATION[law[6:]][method])
-    return LAW_CALIBRATION[law][method]
+        f = min(LAW_CALIBRATION["lugre"][method], LAW_CALIBRATION[law[6:]][method])
+    else:
+        f = LAW_CALIBRATION[law][method]
+    if law.startswith("lugre") and contact is not None:
+        s1 = contact.sigma1 if contact.sigma1 is not None else LUGRE_DEFAULTS["sigma1"]
+        f *= min(1.0, LUGRE_SIGMA1 / s1) if s1 > 0 else 1.0
+    return f
 
 
 def step_limit(params: Params | None = None, method: str = "cdm", variant: str = "paper",
@@ -520,7 +533,7 @@ def step_limit(params: Params | None = None, method: str = "cdm", variant: str =
     law = law_of(contact)
     if law == "hunt_crossley" or method not in FIXED_STEP:
         return lim
-    f = law_factor(law, method)
+    f = law_factor(law, method, contact)
     return dataclasses.replace(lim, dt_max=f * lim.dt_max, law=law, law_factor=f)
 
 
@@ -552,7 +565,7 @@ def check_step(dt: float, params: Params, method: str, variant: str, mode: str =
                                 % (", ".join(map(repr, CHECK_MODES)), mode))
     if mode == "off" or method not in FIXED_STEP:
         return None
-    if not dt > law_factor(law_of(contact), method) * _dt_max(params, method, variant):
+    if not dt > law_factor(law_of(contact), method, contact) * _dt_max(params, method, variant):
         return None
     lim = step_limit(params, method, variant, contact)
     msg = lim.message(dt)
