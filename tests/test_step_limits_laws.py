@@ -88,7 +88,8 @@ def test_hertz_checked_too():
 
 
 def test_lugre_on_another_normal_law_takes_the_smaller_factor():
-    c = pdw.Contact(normal="kelvin_voigt", friction="lugre", k=7318.0, d=112.0)
+    c = pdw.Contact(normal="kelvin_voigt", friction="lugre", k=7318.0, d=112.0,
+                    sigma1=stepsize.LUGRE_SIGMA1)
     lim = stepsize.step_limit(c.parameters(P), "cdm", "paper", c)
     assert lim.law_factor == min(stepsize.LAW_CALIBRATION["lugre"]["cdm"],
                                  stepsize.LAW_CALIBRATION["kelvin_voigt"]["cdm"])
