@@ -14,42 +14,24 @@ the stiffest forces of the model (docs/stability.md has the measured maps). This
 * the **criteria of the stability maps** (`typical_start`, `reference`, `judge`,
   `largest_step`, `chatter`), and the **energy balance** of a run (`energy_balance`).
 
-Other contact laws (`pdw.Contact`). The linear estimate is the default law's (Hunt-Crossley with
-Eq. 10's friction) at the run's parameters (``contact.parameters(params)``: the law's k and d
-in k_n, d_n), times a per-law, per-method factor `LAW_CALIBRATION` fitted on the limits measured
-with each law calibrated to the paper's ground on `paper_steady`
-(benchmarks/step_limits_laws.py, docs/contact_laws.md). The factor keeps each law's check the
-same margin below its measured limit as the default law's has there. It carries the law's own
-physics -- Kelvin-Voigt's force jump d delta' at first contact, LuGre's bristle damping
-sigma1 F_n -- only at the calibrated parameters; the rest of the estimate follows the walker's
-parameters as the default law's does.
-
-Chatter. With the foot stuck, the friction law's slope dmu/dv ~ 0.75/v_s gives a real
-eigenvalue of about -F_n |dmu/dv| / m_eff ~ -1e6 /s at the paper's values: every explicit
-method is unstable above a step of ~2 us there. The instability does not diverge -- mu saturates
-at +-mu_s -- but the stuck foot then slides back and forth (cdm: the slip velocity reverses
-every other step) at up to 100 v_s. `check_step` does not warn about it (it happens at every
-step size anyone would use with an explicit method, including the paper's dt = 1e-4); the
-limit is reported as `StepLimit.dt_chatter` and documented. The exception: where the stuck
-foot needs most of its static friction to hold the tangential spring (`FRICTION_LOAD`),
-chatter changes the gait, and the limit is capped at a few times the chatter limit.
+Other contact laws (`pdw.Contact`): the default law's estimate at the run's parameters times a
+per-law, per-method factor fitted on measured limits (`pdw.sim.stepsize_laws`).
 """
 from __future__ import annotations
 
-import dataclasses
 import functools
 import math
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..core import _core, _layout
-from ..core.contact import LUGRE_DEFAULTS
 from ..core.errors import InvalidInputError, StepSizeError, StepSizeWarning
 from ..core.integrators import METHODS
 from ..core.model import check_variant, contact_forces, jacobian
 from ..core.params import X0_PAPER, Params
+from .stepsize_laws import LAW_CALIBRATION, LUGRE_SIGMA1, law_factor, law_message, law_of  # noqa: F401
 
 NQ = _core.NQ
 NX = _core.NX
@@ -81,30 +63,6 @@ CALIBRATION = {"paper": {"cdm": 0.1, "verlet": 0.17, "rk4": 0.22},
 #: CHATTER_CALIBRATION x `StepLimit.dt_chatter`.
 FRICTION_LOAD = 0.8
 CHATTER_CALIBRATION = 5.0
-#: Per contact law and fixed-step method: dt_max = factor x the default law's estimate at the
-#: run's parameters. Fitted by benchmarks/step_limits_laws.py (benchmarks/results/
-#: step_limits_laws.txt) with the laws calibrated to the paper's ground on `paper_steady`: the
-#: law's walking edge (the largest step that walks with the rodas4 reference's touch-downs)
-#: over its estimate, divided by the same ratio for hunt_crossley, rounded down to two digits.
-#: So each law's limit sits as far below its measured edge as the default law's does there.
-#: hertz does not walk at any step (it falls after one step under rodas4 too): it keeps the
-#: default law's factor. "lugre" is LuGre friction on the Hunt-Crossley ground (its bristle
-#: damping sigma1 F_n sets the limit, ~20 x below the default's); LuGre on another normal law
-#: takes the smaller of the two factors (not measured). LuGre's factor is for its calibrated
-#: bristle damping `LUGRE_SIGMA1`; a larger sigma1 scales it by LUGRE_SIGMA1 / sigma1 (a
-#: damper's explicit limit; measured: the edges fall as sigma1^-0.2 ... -0.9 from 15 to 316 s/m,
-#: benchmarks/results/step_limits_laws.txt), a smaller one keeps it.
-LAW_CALIBRATION = {
-    "hunt_crossley": {"cdm": 1.0, "verlet": 1.0, "rk4": 1.0},
-    "hertz": {"cdm": 1.0, "verlet": 1.0, "rk4": 1.0},
-    "kelvin_voigt": {"cdm": 0.54, "verlet": 0.7, "rk4": 1.3},
-    "lankarani_nikravesh": {"cdm": 1.4, "verlet": 1.0, "rk4": 1.3},
-    "flores": {"cdm": 1.1, "verlet": 1.0, "rk4": 0.93},
-    "lugre": {"cdm": 0.045, "verlet": 0.012, "rk4": 0.011},
-}
-#: The bristle damping [s/m] of the LuGre law `LAW_CALIBRATION` was fitted with
-#: (`pdw.calibration.calibrate_lugre` on paper_steady: critically damped bristles).
-LUGRE_SIGMA1 = 45.09
 
 
 # --------------------------------------------------------------------------------------------
@@ -350,10 +308,8 @@ class StepLimit:
         The largest share of the static friction mu_s F_n that a stuck stance foot needs to hold
         the tangential spring-damper at the stance states; from `FRICTION_LOAD` on, dt_max is
         capped by the chatter limit and ``force`` is "v_s".
-    law : str
-        The contact law (a key of `LAW_CALIBRATION`; "hunt_crossley" for the default).
-    law_factor : float
-        `LAW_CALIBRATION` [law][method]: dt_max is this times the default law's estimate.
+    law, law_factor : str, float
+        The contact law (`pdw.sim.stepsize_laws`) and its factor on the default law's estimate.
     """
 
     method: str
@@ -375,14 +331,7 @@ class StepLimit:
 
     def message(self, dt: float) -> str:
         if self.law != "hunt_crossley":
-            return ("dt = %.3g s exceeds the estimated stability limit %.2g s of method %r with "
-                    "the contact law %r (variant %r): the default law's estimate at these "
-                    "parameters, %.2g s, times the law's factor %.2g, fitted on its measured "
-                    "limit (docs/contact_laws.md). Above it the typical gait falls or diverges "
-                    "spuriously. Use dt <= %.2g, or method='rodas4' (L-stable, no step limit); "
-                    "check_step='off' disables this check."
-                    % (dt, self.dt_max, self.method, self.law, self.variant,
-                       self.dt_max / self.law_factor, self.law_factor, self.dt_max))
+            return law_message(self, dt)
         if self.force == "v_s" and self.method in FIXED_STEP:
             return ("dt = %.3g s exceeds the estimated limit %.2g s of method %r for these "
                     "parameters (variant %r): the stuck stance foot needs %.0f %% of its static "
@@ -480,28 +429,6 @@ def _step_limit(params: Params, method: str, variant: str) -> StepLimit:
     return StepLimit(method, variant, dt_max, force, h, c, dt_chatter, _stiffest(J), sens, load)
 
 
-def law_of(contact) -> str:
-    """The key of `LAW_CALIBRATION` for a `pdw.Contact` (None: the default law)."""
-    if contact is None:
-        return "hunt_crossley"
-    if contact.friction == "lugre":
-        return "lugre" if contact.normal == "hunt_crossley" else "lugre+" + contact.normal
-    return contact.normal
-
-
-def law_factor(law: str, method: str, contact=None) -> float:
-    """`LAW_CALIBRATION` [law][method]; LuGre on another normal law: the smaller factor; LuGre
-    with a bristle damping sigma1 above `LUGRE_SIGMA1`: times LUGRE_SIGMA1 / sigma1."""
-    if law.startswith("lugre+"):
-        f = min(LAW_CALIBRATION["lugre"][method], LAW_CALIBRATION[law[6:]][method])
-    else:
-        f = LAW_CALIBRATION[law][method]
-    if law.startswith("lugre") and contact is not None:
-        s1 = contact.sigma1 if contact.sigma1 is not None else LUGRE_DEFAULTS["sigma1"]
-        f *= min(1.0, LUGRE_SIGMA1 / s1) if s1 > 0 else 1.0
-    return f
-
-
 def step_limit(params: Params | None = None, method: str = "cdm", variant: str = "paper",
                contact=None) -> StepLimit:
     """Estimate the largest fixed step ``method`` can take on the walker with ``params``.
@@ -515,10 +442,8 @@ def step_limit(params: Params | None = None, method: str = "cdm", variant: str =
     keeps below by itself); for rodas4: inf. Cached per
     (params, method, variant); about 40 ms the first time (the force's exponents take five
     more linear limits).
-
-    With a ``contact`` (`pdw.Contact`) other than the default law, ``params`` must be the run's
-    (``contact.parameters(params)``) and dt_max of a fixed-step method is multiplied by the law's
-    factor `LAW_CALIBRATION` (``law``, ``law_factor`` of the result).
+    With another law (``contact``, `pdw.Contact`; ``params`` the run's, contact.parameters(params)),
+    a fixed-step method's dt_max is multiplied by the law's factor (`pdw.sim.stepsize_laws`).
     """
     params = Params.paper() if params is None else params
     if not isinstance(params, Params):
@@ -534,7 +459,7 @@ def step_limit(params: Params | None = None, method: str = "cdm", variant: str =
     if law == "hunt_crossley" or method not in FIXED_STEP:
         return lim
     f = law_factor(law, method, contact)
-    return dataclasses.replace(lim, dt_max=f * lim.dt_max, law=law, law_factor=f)
+    return replace(lim, dt_max=f * lim.dt_max, law=law, law_factor=f)
 
 
 def step_unknown(dt, method, mode, e):
@@ -551,9 +476,7 @@ def step_unknown(dt, method, mode, e):
 def check_step(dt: float, params: Params, method: str, variant: str, mode: str = "warn",
                contact=None):
     """The check `pdw.simulate` runs before a fixed-step run (``check_step`` argument).
-
-    ``contact``: the run's `pdw.Contact` (None: the default law), ``params`` then the run's
-    (``contact.parameters(params)``); the limit is scaled by the law's `LAW_CALIBRATION` factor.
+    ``contact``: the run's `pdw.Contact` (None: the default law), as in `step_limit`.
 
     ``mode``: "warn" (a `pdw.StepSizeWarning` when dt > `step_limit`), "error" (raise
     `pdw.StepSizeError` instead), "off". Adaptive methods are not checked (their dt is only
