@@ -3,8 +3,9 @@ of `pdw.sim.stepsize.LAW_CALIBRATION` (issue 12; docs/contact_laws.md, docs/stab
 
 For each law calibrated to the paper's ground on `paper_steady` (`pdw.calibration.calibrate`,
 `calibrate_lugre`; each has the same static sink, so `typical_start` carries the weight under
-each) and each fixed-step method (cdm, verlet, rk4), 3.5 s runs from `typical_start` against a
-rodas4 reference (rtol 1e-9), as the stability maps of docs/stability.md:
+each), each variant (paper, consistent) and each fixed-step method (cdm, verlet, rk4), 3.5 s runs
+from `typical_start` against a rodas4 reference (rtol 1e-9), as the stability maps of
+docs/stability.md:
 
 * "walks" edge: the largest dt at which the run walks with the reference's touch-downs (legs and
   count) -- the maps' "walks" (the edge the default law's check is calibrated on) without their
@@ -13,17 +14,17 @@ rodas4 reference (rtol 1e-9), as the stability maps of docs/stability.md:
   correctly", benchmarks/contact_laws.py's cdm limit);
   each by a half-decade scan from 1e-5 s, then 4 log-bisections (resolution 7.5 %);
 * reference estimate: the default law's check at the run's parameters,
-  ``stepsize._dt_max(contact.parameters(P), method, "paper")``;
+  ``stepsize._dt_max(contact.parameters(P), method, variant)``;
 * factor = (walks edge / estimate of the law) / (the same for hunt_crossley): the law's dt_max
   then sits as far below its walks edge as the default law's does on paper_steady.
   `LAW_CALIBRATION` holds these factors rounded down to two digits.
 
-Then LuGre's bristle damping sigma1 swept (1/3, 1, 3 x the calibrated value, and the default
+Then (paper variant) LuGre's bristle damping sigma1 swept (1/3, 1, 3 x the calibrated value, and the default
 316.2 s/m): the walks edge of each method, and the check's dt_max (`stepsize.step_limit` with the
 contact: LAW_CALIBRATION x min(1, LUGRE_SIGMA1 / sigma1)).
 
 Writes benchmarks/results/step_limits_laws.txt.
-Usage: .venv/bin/python benchmarks/step_limits_laws.py   (about 1 minute)
+Usage: .venv/bin/python benchmarks/step_limits_laws.py   (about a minute)
 """
 import dataclasses
 import math
@@ -44,6 +45,7 @@ from pdw.analysis.calibration import calibrate, calibrate_lugre  # noqa: E402
 from pdw.sim import stepsize  # noqa: E402
 
 METHODS = ("cdm", "verlet", "rk4")
+VARIANTS = ("paper", "consistent")
 X0 = stepsize.typical_start(P)
 
 
@@ -57,10 +59,12 @@ def verdict(r, ref):
     return True, err <= max(S.TD_TOL_ABS, S.TD_TOL_REL * cyc)
 
 
-def limit(contact, method, ref, which):
+def limit(contact, method, ref, which, variant="paper"):
     """(largest dt that passes, smallest that does not) by scan + 4 log-bisections."""
+    x0 = stepsize.typical_start(P, variant)
+
     def ok(dt):
-        r = sim(contact, x0=X0, t_end=3.5, method=method, dt=dt, record_every=0)
+        r = sim(contact, x0=x0, t_end=3.5, method=method, dt=dt, record_every=0, variant=variant)
         return verdict(r, ref)[which]
 
     grid = [1e-5 * 10 ** (k / 2) for k in range(0, 9)]
@@ -90,21 +94,25 @@ def main():
              "load average at start: %s" % (os.getloadavg(),), ""]
     for law, c in contacts.items():
         lines.append("%-20s %s" % (law, c.as_dict()))
-    lines += ["", "| law | method | walks up to [s] | fails at [s] | correct up to [s] | "
-              "reference estimate [s] | walks / estimate | factor |", "|---|---|---|---|---|---|---|---|"]
+    lines += ["", "| law | variant | method | walks up to [s] | fails at [s] | correct up to [s] | "
+              "reference estimate [s] | walks / estimate | factor |", "|---|---|---|---|---|---|---|---|---|"]
     ratio, rows = {}, []
-    for law, c in contacts.items():
-        ref = sim(c, x0=X0, t_end=3.5, method="rodas4", rtol=1e-9, atol=1e-11, record_every=0)
-        for m in METHODS:
-            a, b = limit(c, m, ref, 0)
-            ac, _ = limit(c, m, ref, 1)
-            est = stepsize._dt_max(c.parameters(P), m, "paper")
-            ratio[law, m] = a / est if a else math.nan
-            rows.append((law, m, a, b, ac, est))
+    for v in VARIANTS:
+        x0 = stepsize.typical_start(P, v)
+        for law, c in contacts.items():
+            ref = sim(c, x0=x0, t_end=3.5, method="rodas4", rtol=1e-9, atol=1e-11, record_every=0,
+                      variant=v)
+            for m in METHODS:
+                a, b = limit(c, m, ref, 0, v)
+                ac, _ = limit(c, m, ref, 1, v)
+                est = stepsize._dt_max(c.parameters(P), m, v)
+                ratio[law, v, m] = a / est if a else math.nan
+                rows.append((law, v, m, a, b, ac, est))
     g = lambda v: "%.3g" % v if v else "none"  # noqa: E731
-    for law, m, a, b, ac, est in rows:
-        lines.append("| %s | %s | %s | %s | %s | %.3g | %.3g | %.3g |" % (
-            law, m, g(a), g(b), g(ac), est, ratio[law, m], ratio[law, m] / ratio["hunt_crossley", m]))
+    for law, v, m, a, b, ac, est in rows:
+        lines.append("| %s | %s | %s | %s | %s | %s | %.3g | %.3g | %.3g |" % (
+            law, v, m, g(a), g(b), g(ac), est, ratio[law, v, m],
+            ratio[law, v, m] / ratio["hunt_crossley", v, m]))
     lines += ["", "LuGre's bristle damping (the walks edge against the check's dt_max):", "",
               "| sigma1 [s/m] | method | walks up to [s] | fails at [s] | check dt_max [s] |",
               "|---|---|---|---|---|"]

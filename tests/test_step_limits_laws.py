@@ -24,8 +24,8 @@ def _measured():
         if m:
             contacts[m.group(1)] = pdw.Contact(**ast.literal_eval(m.group(2)))
         cells = [c.strip() for c in line.split("|")[1:-1]]
-        if len(cells) == 8 and cells[1] in METHODS:
-            edges[cells[0], cells[1]] = None if cells[2] == "none" else float(cells[2])
+        if len(cells) == 9 and cells[2] in METHODS:
+            edges[cells[0], cells[1], cells[2]] = None if cells[3] == "none" else float(cells[3])
         if len(cells) == 5 and cells[1] in METHODS and cells[2] != "none":
             sigma1[float(cells[0]), cells[1]] = float(cells[2])
     return contacts, edges, sigma1
@@ -35,31 +35,32 @@ CONTACTS, EDGES, SIGMA1 = _measured()
 MEASURED = sorted(k for k, v in EDGES.items() if v is not None)
 
 
-def _run(contact, method, dt, mode):
+def _run(contact, method, dt, mode, variant="paper"):
     return pdw.simulate(params=P, contact=contact, method=method, dt=dt, t_end=5 * dt,
-                        record_every=0, check_step=mode, on_failure="return")
+                        record_every=0, check_step=mode, on_failure="return", variant=variant)
 
 
 def test_every_law_and_method_measured():
     assert set(CONTACTS) == set(pdw.core.contact.NORMAL_LAWS) | {"lugre"}
-    assert {law for law, _ in MEASURED} == set(CONTACTS) - {"hertz"}   # hertz never walks
+    assert {law for law, _, _ in MEASURED} == set(CONTACTS) - {"hertz"}   # hertz never walks
+    assert {v for _, v, _ in MEASURED} == {"paper", "consistent"}
     assert len({s for s, _ in SIGMA1}) == 4
-    assert set(stepsize.LAW_CALIBRATION) == set(CONTACTS)
+    assert all(set(c) == set(CONTACTS) for c in stepsize.LAW_CALIBRATION.values())
 
 
-@pytest.mark.parametrize("law,method", MEASURED)
-def test_flagged_above_the_measured_edge_not_below(law, method):
-    c, edge = CONTACTS[law], EDGES[law, method]
+@pytest.mark.parametrize("law,variant,method", MEASURED)
+def test_flagged_above_the_measured_edge_not_below(law, variant, method):
+    c, edge = CONTACTS[law], EDGES[law, variant, method]
     with pytest.raises(pdw.StepSizeError) as e:
-        _run(c, method, 3 * edge, "error")
+        _run(c, method, 3 * edge, "error", variant)
     assert e.value.limit < 3 * edge
     if law != "hunt_crossley":
         assert repr(law) in str(e.value)
     with pytest.warns(pdw.StepSizeWarning):
-        _run(c, method, 3 * edge, "warn")
+        _run(c, method, 3 * edge, "warn", variant)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        _run(c, method, edge / 3, "error")
+        _run(c, method, edge / 3, "error", variant)
 
 
 @pytest.mark.parametrize("s1,method", sorted(SIGMA1))
@@ -91,8 +92,8 @@ def test_lugre_on_another_normal_law_takes_the_smaller_factor():
     c = pdw.Contact(normal="kelvin_voigt", friction="lugre", k=7318.0, d=112.0,
                     sigma1=stepsize.LUGRE_SIGMA1)
     lim = stepsize.step_limit(c.parameters(P), "cdm", "paper", c)
-    assert lim.law_factor == min(stepsize.LAW_CALIBRATION["lugre"]["cdm"],
-                                 stepsize.LAW_CALIBRATION["kelvin_voigt"]["cdm"])
+    cal = stepsize.LAW_CALIBRATION["paper"]
+    assert lim.law_factor == min(cal["lugre"]["cdm"], cal["kelvin_voigt"]["cdm"])
 
 
 # the default law's limits before the per-law check (main at f622be9), to the last digit

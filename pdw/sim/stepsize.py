@@ -458,7 +458,7 @@ def step_limit(params: Params | None = None, method: str = "cdm", variant: str =
     law = law_of(contact)
     if law == "hunt_crossley" or method not in FIXED_STEP:
         return lim
-    f = law_factor(law, method, contact)
+    f = law_factor(law, method, contact, variant)
     return replace(lim, dt_max=f * lim.dt_max, law=law, law_factor=f)
 
 
@@ -488,7 +488,8 @@ def check_step(dt: float, params: Params, method: str, variant: str, mode: str =
                                 % (", ".join(map(repr, CHECK_MODES)), mode))
     if mode == "off" or method not in FIXED_STEP:
         return None
-    if not dt > law_factor(law_of(contact), method, contact) * _dt_max(params, method, variant):
+    f = law_factor(law_of(contact), method, contact, variant)
+    if not dt > f * _dt_max(params, method, variant):
         return None
     lim = step_limit(params, method, variant, contact)
     msg = lim.message(dt)

@@ -14,8 +14,8 @@ from __future__ import annotations
 
 from ..core.contact import LUGRE_DEFAULTS
 
-#: Per contact law and fixed-step method: dt_max = factor x the default law's estimate at the
-#: run's parameters. Fitted by benchmarks/step_limits_laws.py (benchmarks/results/
+#: Per variant, contact law and fixed-step method: dt_max = factor x the default law's estimate
+#: at the run's parameters. Fitted by benchmarks/step_limits_laws.py (benchmarks/results/
 #: step_limits_laws.txt) with the laws calibrated to the paper's ground on `paper_steady`: the
 #: law's walking edge (the largest step that walks with the rodas4 reference's touch-downs)
 #: over its estimate, divided by the same ratio for hunt_crossley, rounded down to two digits.
@@ -28,12 +28,22 @@ from ..core.contact import LUGRE_DEFAULTS
 #: damper's explicit limit; measured: the edges fall as sigma1^-0.2 ... -0.9 from 15 to 316 s/m,
 #: benchmarks/results/step_limits_laws.txt), a smaller one keeps it.
 LAW_CALIBRATION = {
-    "hunt_crossley": {"cdm": 1.0, "verlet": 1.0, "rk4": 1.0},
-    "hertz": {"cdm": 1.0, "verlet": 1.0, "rk4": 1.0},
-    "kelvin_voigt": {"cdm": 0.54, "verlet": 0.7, "rk4": 1.3},
-    "lankarani_nikravesh": {"cdm": 1.4, "verlet": 1.0, "rk4": 1.3},
-    "flores": {"cdm": 1.1, "verlet": 1.0, "rk4": 0.93},
-    "lugre": {"cdm": 0.045, "verlet": 0.012, "rk4": 0.011},
+    "paper": {
+        "hunt_crossley": {"cdm": 1.0, "verlet": 1.0, "rk4": 1.0},
+        "hertz": {"cdm": 1.0, "verlet": 1.0, "rk4": 1.0},
+        "kelvin_voigt": {"cdm": 0.54, "verlet": 0.7, "rk4": 1.3},
+        "lankarani_nikravesh": {"cdm": 1.4, "verlet": 1.0, "rk4": 1.3},
+        "flores": {"cdm": 1.1, "verlet": 1.0, "rk4": 0.93},
+        "lugre": {"cdm": 0.045, "verlet": 0.012, "rk4": 0.011},
+    },
+    "consistent": {
+        "hunt_crossley": {"cdm": 1.0, "verlet": 1.0, "rk4": 1.0},
+        "hertz": {"cdm": 1.0, "verlet": 1.0, "rk4": 1.0},
+        "kelvin_voigt": {"cdm": 0.011, "verlet": 0.0045, "rk4": 0.028},
+        "lankarani_nikravesh": {"cdm": 0.29, "verlet": 0.36, "rk4": 0.42},
+        "flores": {"cdm": 0.48, "verlet": 0.52, "rk4": 0.48},
+        "lugre": {"cdm": 0.06, "verlet": 0.015, "rk4": 0.012},
+    },
 }
 #: The bristle damping [s/m] of the LuGre law `LAW_CALIBRATION` was fitted with
 #: (`pdw.calibration.calibrate_lugre` on paper_steady: critically damped bristles).
@@ -49,13 +59,15 @@ def law_of(contact) -> str:
     return contact.normal
 
 
-def law_factor(law: str, method: str, contact=None) -> float:
-    """`LAW_CALIBRATION` [law][method]; LuGre on another normal law: the smaller factor; LuGre
-    with a bristle damping sigma1 above `LUGRE_SIGMA1`: times LUGRE_SIGMA1 / sigma1."""
+def law_factor(law: str, method: str, contact=None, variant: str = "paper") -> float:
+    """`LAW_CALIBRATION` [variant][law][method]; LuGre on another normal law: the smaller
+    factor; LuGre with a bristle damping sigma1 above `LUGRE_SIGMA1`: times
+    LUGRE_SIGMA1 / sigma1."""
+    cal = LAW_CALIBRATION[variant]
     if law.startswith("lugre+"):
-        f = min(LAW_CALIBRATION["lugre"][method], LAW_CALIBRATION[law[6:]][method])
+        f = min(cal["lugre"][method], cal[law[6:]][method])
     else:
-        f = LAW_CALIBRATION[law][method]
+        f = cal[law][method]
     if law.startswith("lugre") and contact is not None:
         s1 = contact.sigma1 if contact.sigma1 is not None else LUGRE_DEFAULTS["sigma1"]
         f *= min(1.0, LUGRE_SIGMA1 / s1) if s1 > 0 else 1.0
