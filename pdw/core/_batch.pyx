@@ -102,21 +102,7 @@ def best_isa():
     return [n for n in ("avx512", "avx2", "base") if isa_supported(n)][0]
 
 
-cdef int _poll(void *ctx) noexcept nogil:
-    """The lane loop's poll (every PDW_BATCH_POLL lockstep steps, GIL released): Python's
-    signal handlers (main thread) and the thread's cancel token (`pdw.core.interrupt`); an
-    exception is kept in ctx (a list) and stops the range."""
-    with gil:
-        pending = <list> ctx
-        if pending:
-            return 1
-        try:
-            PyErr_CheckSignals()
-            _interrupt.check()
-        except BaseException as e:
-            pending.append(e)
-            return 1
-    return 0
+include "_poll.pxi"
 
 
 _OUT_KEYS = ("status", "stop_reason", "flags_final", "x_final", "t_final", "n_steps",

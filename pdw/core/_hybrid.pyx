@@ -99,21 +99,7 @@ cdef dict _opts_dict(pdw_hybrid_opts *o):
             "fall_angle": o.fall_angle, "max_steps": o.max_steps, "dt_out": o.dt_out}
 
 
-cdef int _poll(void *ctx) noexcept nogil:
-    """The step's poll (every PDW_HYBRID_POLL_RHS right-hand sides, GIL released): Python's
-    signal handlers (main thread) and the thread's cancel token (`pdw.core.interrupt`); an
-    exception is kept in ctx (a list) and stops the step."""
-    with gil:
-        pending = <list> ctx
-        if pending:
-            return 1
-        try:
-            PyErr_CheckSignals()
-            _interrupt.check()
-        except BaseException as e:
-            pending.append(e)
-            return 1
-    return 0
+include "_poll.pxi"
 
 
 cdef object _raised(list pending, partial=None):

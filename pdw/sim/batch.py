@@ -22,9 +22,8 @@ from ..core.errors import InvalidInputError
 from ..core.integrators import METHODS
 from ..core.integrators import get as _method_info
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
-from ..core.params import Params
 from . import stepsize as _stepsize
-from .chunks import honest, record_subset, run_chunked
+from .chunks import _plist, honest, record_subset, run_chunked
 from .gait import Steps, steps_from_rows
 from .simulation import _REASONS, _check_count, _check_positive
 
@@ -284,26 +283,7 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
         budget = _check_count("max_steps", max_steps)
         if budget < 1:
             raise InvalidInputError("max_steps must be >= 1, got %d" % budget)
-    if params is None or isinstance(params, Params):
-        plist = [Params.paper() if params is None else params]
-    else:
-        if isinstance(params, (str, bytes, dict)):
-            plist = None
-        else:
-            try:
-                plist = list(params)
-            except TypeError:
-                plist = None
-        if plist is None:
-            raise InvalidInputError("params must be a pdw.Params or a sequence of N = %d Params, "
-                                    "got %r" % (n, params))
-        if len(plist) != n:
-            raise InvalidInputError("params must be one Params or a sequence of N = %d, got %d"
-                                    % (n, len(plist)))
-    for i, p in enumerate(plist):
-        if not isinstance(p, Params):
-            raise InvalidInputError("params row %d must be a pdw.Params, got %s"
-                                    % (i, type(p).__name__))
+    plist = _plist(params, n, shared=True)      # one shared Params or a checked row each
     f0 = _flags(flags0, n)
     if not t_end / dt <= checks.MAX_COUNT:           # also inf (t_end near the largest float)
         raise InvalidInputError("t_end / dt = %g steps is too many (at most %d)"

@@ -27,9 +27,11 @@ _NOT_SIMULATE = ("x0", "params", "flags0", "threads", "lanes", "vector", "execut
                  "chunk_size", "record", "record_every")
 
 
-def _plist(params, n):
+def _plist(params, n, shared=False):
+    """params (None, one Params, or a sequence of n) as a list of Params, checked: n entries,
+    or one entry for one shared Params when ``shared``."""
     if params is None or isinstance(params, Params):
-        return [Params.paper() if params is None else params] * n
+        return [Params.paper() if params is None else params] * (1 if shared else n)
     plist = None
     if not isinstance(params, (str, bytes, dict)):
         try:
