@@ -75,6 +75,7 @@ study: $(STAMP)
 	PDW_UPDATE_DOCS=$(if $(UPDATE_DOCS),1,0) $(PY) -m pytest -q -m slow
 	$(PY) benchmarks/stability_maps.py $(UPDATE_DOCS)
 	$(PY) benchmarks/step_edge_grid.py $(UPDATE_DOCS)
+	$(PY) benchmarks/step_limits_laws.py $(UPDATE_DOCS)
 	$(PY) benchmarks/basin_study.py 400 200 $(UPDATE_DOCS)
 
 ## sanitize: the compiled core built with AddressSanitizer + UndefinedBehaviorSanitizer (in

@@ -330,9 +330,9 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
     check_step : {"warn", "error", "off"}
         Fixed-step methods: compare dt with `pdw.sim.stepsize.step_limit` (the method's estimated
         stability limit for these parameters) and warn (`pdw.StepSizeWarning`) or refuse
-        (`pdw.StepSizeError`) above it, naming the limit and the force that sets it. The
-        limit is calibrated on the default contact law only: runs with another normal law are
-        not checked.
+        (`pdw.StepSizeError`) above it, naming the limit and the force that sets it. With
+        another contact law, the default law's estimate times the law's factor fitted on its
+        measured limits (`pdw.sim.stepsize.LAW_CALIBRATION`, docs/contact_laws.md).
     t_eval : array_like (M,), optional
         Times [s] (non-decreasing, in [0, t_end]) at which to return the solution, as
         ``solve_ivp``: ``Result.t`` is then t_eval (up to the run's end) and ``x``, ``flags``,
@@ -435,12 +435,11 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
     k = kernel_index(variant, feats, contact.normal, contact.friction)
     if feats != _layout.FEATURES:
         params = params.without(feats)
-    if contact.normal == "hunt_crossley" and contact.friction == "coulomb":
-        try:
-            _stepsize.check_step(dt, params, method, variant, check_step)
-        except (np.linalg.LinAlgError, FloatingPointError, OverflowError) as e:
-            _stepsize.step_unknown(dt, method, check_step, e)
-    p = contact.vector(parameter_vector(params), feats, params)
+    p = contact.vector(parameter_vector(params), feats, params)     # validates the law's values
+    try:        # every contact law: the law's factor on the default estimate (stepsize.py)
+        _stepsize.check_step(dt, params, method, variant, check_step, contact)
+    except (np.linalg.LinAlgError, FloatingPointError, OverflowError) as e:
+        _stepsize.step_unknown(dt, method, check_step, e)
     v_in0 = None if approach_speeds0 is None else tuple(checks.real_array(
         "approach_speeds0", approach_speeds0, [(2,)], lo=0.0))
     start = time.perf_counter()

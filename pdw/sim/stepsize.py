@@ -14,22 +14,15 @@ the stiffest forces of the model (docs/stability.md has the measured maps). This
 * the **criteria of the stability maps** (`typical_start`, `reference`, `judge`,
   `largest_step`, `chatter`), and the **energy balance** of a run (`energy_balance`).
 
-Chatter. With the foot stuck, the friction law's slope dmu/dv ~ 0.75/v_s gives a real
-eigenvalue of about -F_n |dmu/dv| / m_eff ~ -1e6 /s at the paper's values: every explicit
-method is unstable above a step of ~2 us there. The instability does not diverge -- mu saturates
-at +-mu_s -- but the stuck foot then slides back and forth (cdm: the slip velocity reverses
-every other step) at up to 100 v_s. `check_step` does not warn about it (it happens at every
-step size anyone would use with an explicit method, including the paper's dt = 1e-4); the
-limit is reported as `StepLimit.dt_chatter` and documented. The exception: where the stuck
-foot needs most of its static friction to hold the tangential spring (`FRICTION_LOAD`),
-chatter changes the gait, and the limit is capped at a few times the chatter limit.
+Other contact laws (`pdw.Contact`): the default law's estimate at the run's parameters times a
+per-law, per-method factor fitted on measured limits (`pdw.sim.stepsize_laws`).
 """
 from __future__ import annotations
 
 import functools
 import math
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -38,6 +31,7 @@ from ..core.errors import InvalidInputError, StepSizeError, StepSizeWarning
 from ..core.integrators import METHODS
 from ..core.model import check_variant, contact_forces, jacobian
 from ..core.params import X0_PAPER, Params
+from .stepsize_laws import LAW_CALIBRATION, LUGRE_SIGMA1, law_factor, law_message, law_of  # noqa: F401
 
 NQ = _core.NQ
 NX = _core.NX
@@ -314,6 +308,8 @@ class StepLimit:
         The largest share of the static friction mu_s F_n that a stuck stance foot needs to hold
         the tangential spring-damper at the stance states; from `FRICTION_LOAD` on, dt_max is
         capped by the chatter limit and ``force`` is "v_s".
+    law, law_factor : str, float
+        The contact law (`pdw.sim.stepsize_laws`) and its factor on the default law's estimate.
     """
 
     method: str
@@ -326,12 +322,16 @@ class StepLimit:
     eigenvalue: complex
     sensitivity: dict = field(default_factory=dict, compare=False)
     friction_load: float = 0.0
+    law: str = "hunt_crossley"
+    law_factor: float = 1.0
 
     @property
     def why(self) -> str:
         return FORCES.get(self.force, self.force)
 
     def message(self, dt: float) -> str:
+        if self.law != "hunt_crossley":
+            return law_message(self, dt)
         if self.force == "v_s" and self.method in FIXED_STEP:
             return ("dt = %.3g s exceeds the estimated limit %.2g s of method %r for these "
                     "parameters (variant %r): the stuck stance foot needs %.0f %% of its static "
@@ -429,7 +429,8 @@ def _step_limit(params: Params, method: str, variant: str) -> StepLimit:
     return StepLimit(method, variant, dt_max, force, h, c, dt_chatter, _stiffest(J), sens, load)
 
 
-def step_limit(params: Params | None = None, method: str = "cdm", variant: str = "paper") -> StepLimit:
+def step_limit(params: Params | None = None, method: str = "cdm", variant: str = "paper",
+               contact=None) -> StepLimit:
     """Estimate the largest fixed step ``method`` can take on the walker with ``params``.
 
     The smallest linear stability limit (`linear_limit`) of the method on df/dx without the
@@ -441,6 +442,8 @@ def step_limit(params: Params | None = None, method: str = "cdm", variant: str =
     keeps below by itself); for rodas4: inf. Cached per
     (params, method, variant); about 40 ms the first time (the force's exponents take five
     more linear limits).
+    With another law (``contact``, `pdw.Contact`; ``params`` the run's, contact.parameters(params)),
+    a fixed-step method's dt_max is multiplied by the law's factor (`pdw.sim.stepsize_laws`).
     """
     params = Params.paper() if params is None else params
     if not isinstance(params, Params):
@@ -451,7 +454,12 @@ def step_limit(params: Params | None = None, method: str = "cdm", variant: str =
         check_variant(variant)
     except ValueError as e:
         raise InvalidInputError(str(e)) from None
-    return _step_limit(params, method, variant)
+    lim = _step_limit(params, method, variant)
+    law = law_of(contact)
+    if law == "hunt_crossley" or method not in FIXED_STEP:
+        return lim
+    f = law_factor(law, method, contact, variant)
+    return replace(lim, dt_max=f * lim.dt_max, law=law, law_factor=f)
 
 
 def step_unknown(dt, method, mode, e):
@@ -465,8 +473,10 @@ def step_unknown(dt, method, mode, e):
     warnings.warn(StepSizeWarning(msg, dt=dt, limit=0.0, force="unknown"), stacklevel=3)
 
 
-def check_step(dt: float, params: Params, method: str, variant: str, mode: str = "warn"):
+def check_step(dt: float, params: Params, method: str, variant: str, mode: str = "warn",
+               contact=None):
     """The check `pdw.simulate` runs before a fixed-step run (``check_step`` argument).
+    ``contact``: the run's `pdw.Contact` (None: the default law), as in `step_limit`.
 
     ``mode``: "warn" (a `pdw.StepSizeWarning` when dt > `step_limit`), "error" (raise
     `pdw.StepSizeError` instead), "off". Adaptive methods are not checked (their dt is only
@@ -478,9 +488,10 @@ def check_step(dt: float, params: Params, method: str, variant: str, mode: str =
                                 % (", ".join(map(repr, CHECK_MODES)), mode))
     if mode == "off" or method not in FIXED_STEP:
         return None
-    if not dt > _dt_max(params, method, variant):
+    f = law_factor(law_of(contact), method, contact, variant)
+    if not dt > f * _dt_max(params, method, variant):
         return None
-    lim = step_limit(params, method, variant)
+    lim = step_limit(params, method, variant, contact)
     msg = lim.message(dt)
     if mode == "error":
         raise StepSizeError(msg, dt=dt, limit=lim.dt_max, force=lim.force)
