@@ -50,6 +50,8 @@ setup(
                    extra_compile_args=extra, extra_link_args=link, libraries=["m"],
                    depends=depends)],
         compiler_directives={"language_level": "3", "boundscheck": False, "wraparound": False,
-                             "cdivision": True, "initializedcheck": False},
+                             "cdivision": True, "initializedcheck": False,
+                             # typed signatures in __doc__: _shapes.pxi's _named_buffers reads them
+                             "embedsignature": True},
     ),
 )

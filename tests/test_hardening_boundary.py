@@ -5,6 +5,7 @@ call, before it takes a pointer, and raises ValueError naming the argument, the 
 the given shape. The calls that used to read or write out of bounds run in a subprocess: a
 crash (segfault, abort) fails the test instead of killing the test run.
 """
+import re
 import subprocess
 import sys
 import textwrap
@@ -101,6 +102,110 @@ else:
         msg = line[len("VALUEERROR "):]
         assert msg.startswith(arg + " ") or ("%s must" % arg) in msg or arg in msg.split()[0], msg
         assert "shape" in msg or "rows" in msg, msg
+
+
+def _array_args(fn):
+    """(name, C type, ndim, const) of fn's typed-memoryview arguments, read from the typed
+    signature Cython embeds in __doc__, and the names of all its arguments."""
+    from pdw.core import _batch, _hybrid  # noqa: F401 - the modules under test
+    head = fn.__doc__.split("\n", 1)[0]
+    sig = head[head.index("(") + 1:head.rindex(")")]
+    raw = [p for p in re.split(r",(?![^\[]*\])", sig) if p.strip()]
+    parts = [p.split("=")[0].split() for p in raw]
+    # the required arguments (no default), with a valid scalar for the non-array ones
+    scalar = {"int": 0, "long": 0, "double": 0.0, "bint": False, "str": "rhs", "dict": {}}
+    names = [(p[-1], scalar.get(p[0], None)) for p, r in zip(parts, raw) if "=" not in r]
+    arrays = []
+    for p in parts:
+        m = re.fullmatch(r"(const )?(double|int|long)\[([:, 0-9]*)\] (\w+)", " ".join(p))
+        if m:
+            arrays.append((m.group(4), m.group(2), m.group(3).count(",") + 1, bool(m.group(1))))
+    return arrays, names
+
+
+def _entry_points():
+    from pdw.core import _batch, _hybrid
+    out = []
+    for mod in (_core, _hybrid, _batch):
+        for name in sorted(dir(mod)):
+            fn = getattr(mod, name)
+            if callable(fn) and not name.startswith("_") and "[" in (fn.__doc__ or "")[:300] \
+                    and _array_args(fn)[0]:
+                out.append((mod.__name__.rsplit(".", 1)[1], name))
+    return out
+
+
+ENTRY_POINTS = _entry_points()
+_WANT = {"double": np.float64, "int": np.intc, "long": np.int_}
+
+
+def test_every_typed_entry_point_is_covered():
+    """The dtype/layout test below reaches every compiled entry point that takes arrays."""
+    names = {n for _, n in ENTRY_POINTS}
+    assert {"run", "rhs_batch", "jacobian_batch", "precompute", "run_range", "step_batch",
+            "solve", "walk"} <= names, names
+    assert len(ENTRY_POINTS) >= 25, ENTRY_POINTS
+
+
+@pytest.mark.parametrize("mod,name", ENTRY_POINTS, ids=["%s.%s" % e for e in ENTRY_POINTS])
+def test_wrong_dtype_layout_or_type_names_the_argument(mod, name):
+    """Cython converts a typed-memoryview argument before the body runs, and its own messages
+    ("Buffer dtype mismatch ...", "ndarray is not C-contiguous") name no argument: every entry
+    point names it, with the expected array and what was given. Each array argument in turn
+    gets a wrong dtype, a non-contiguous view, a wrong ndim, a list (and a read-only array for
+    an output), the others being right; the call must fail naming exactly that argument."""
+    from pdw.core import _batch, _hybrid
+    fn = getattr({"_core": _core, "_hybrid": _hybrid, "_batch": _batch}[mod], name)
+    arrays, names = _array_args(fn)
+    good = {a: np.zeros((3,) * nd, dtype=_WANT[t]) for a, t, nd, _ in arrays}
+    for a, t, nd, const in arrays:
+        if a not in dict(names):
+            continue                       # an optional array argument: not reached here
+        wrong_dtype = np.float32 if t == "double" else np.float64
+        bad = [np.zeros((3,) * nd, dtype=wrong_dtype),
+               np.zeros((3,) * (nd - 1) + (6,), dtype=_WANT[t])[..., ::2],
+               np.zeros((3,) * (nd + 1), dtype=_WANT[t]),
+               np.zeros((3,) * nd).tolist()]
+        if not const:
+            ro = np.zeros((3,) * nd, dtype=_WANT[t])
+            ro.flags.writeable = False
+            bad.append(ro)
+        for value in bad:
+            args = [value if n == a else good.get(n, v) for n, v in names]
+            with pytest.raises((ValueError, TypeError)) as err:
+                fn(*args)
+            assert str(err.value).startswith(a + " must be a C-contiguous %d-D" % nd), \
+                (name, a, type(value), str(err.value))
+
+
+def test_batch_outputs_of_the_wrong_dtype_are_named():
+    """run_range's output arrays come in a dict: a wrong one is named by its key."""
+    from pdw.core import _batch
+    from pdw.sim import batch
+    x0 = np.array([pdw.X0_PAPER])
+    b = pdw.simulate_batch(x0, t_end=0.01, dt=1e-4)     # the right call works ...
+    assert b.status[0] == "walked"
+    calls = []
+    real = _batch.run_range
+
+    def spy(*args, **kw):
+        calls.append((args, kw))
+        return real(*args, **kw)
+    mp = pytest.MonkeyPatch()
+    mp.setattr(_batch, "run_range", spy)
+    try:
+        batch.simulate_batch(x0, t_end=0.01, dt=1e-4, threads=1)
+    finally:
+        mp.undo()
+    args, kw = calls[0]
+    i_out = next(i for i, v in enumerate(args) if isinstance(v, dict))
+    for key in ("n_steps", "x_final", "gait"):
+        out = dict(args[i_out])
+        out[key] = out[key].astype(np.float32 if out[key].dtype != np.float32 else np.float64)
+        bad = list(args)
+        bad[i_out] = out
+        with pytest.raises(ValueError, match=r"^out\['%s'\] must be a C-contiguous" % key):
+            real(*bad, **kw)
 
 
 def test_flags_outside_0_1_are_refused_by_the_compiled_batch():

@@ -103,13 +103,21 @@ def best_isa():
 
 
 include "_poll.pxi"
+include "_shapes.pxi"
 
 
-_OUT_KEYS = ("status", "stop_reason", "flags_final", "x_final", "t_final", "n_steps",
-             "n_gait_steps", "n_touch_down", "n_lift_off", "gait", "fail_reason", "fail_leg",
-             "fail_t", "fail_x")
+# the output arrays of run_range: (const, C type, ndim) as _shapes.pxi's _fault reads them
+_OUT_SPECS = {"status": (False, "int", 1), "stop_reason": (False, "int", 1),
+              "flags_final": (False, "int", 2), "x_final": (False, "double", 2),
+              "t_final": (False, "double", 1), "n_steps": (False, "long", 1),
+              "n_gait_steps": (False, "long", 1), "n_touch_down": (False, "long", 1),
+              "n_lift_off": (False, "long", 1), "gait": (False, "double", 3),
+              "fail_reason": (False, "int", 1), "fail_leg": (False, "int", 1),
+              "fail_t": (False, "double", 1), "fail_x": (False, "double", 2)}
+_OUT_KEYS = tuple(_OUT_SPECS)
 
 
+@_named_buffers
 def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[:, ::1] flags0,
               const double[::1] hip, const double[::1] depth, double dt, long n_steps,
               double max_speed, long stop_steps, int periodic_k, double periodic_tol,
@@ -161,6 +169,10 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
                                      or (flags0[r, 1] != 0 and flags0[r, 1] != 1)):
             raise ValueError("flags0 row %d must be 0 or 1, got (%d, %d)"
                              % (r, flags0[r, 0], flags0[r, 1]))
+    for key, spec in _OUT_SPECS.items():
+        why = _fault("out[%r]" % key, out[key], spec)
+        if why is not None:
+            raise ValueError(why)
     cdef int[::1] status = out["status"]
     cdef int[::1] stop_reason = out["stop_reason"]
     cdef int[:, ::1] flags_final = out["flags_final"]

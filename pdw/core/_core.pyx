@@ -208,6 +208,7 @@ cdef int _batch(const double[:, ::1] x, const double[::1] p, const int[:, ::1] f
     return 0
 
 
+@_named_buffers
 def precompute(const double[::1] params, double[::1] p):
     """Fill the kernel parameter vector p (NP,) from the physical parameters (NPARAM,)."""
     _len("params", params.shape[0], PDW_NPARAM)
@@ -230,6 +231,7 @@ cdef inline void _anchors(const double[:, ::1] anchors, Py_ssize_t i, int na,
         a[j] = anchors[i, j] if j < na else 0.0
 
 
+@_named_buffers
 def rhs_batch(int k, const double[:, ::1] x, const double[::1] p, const int[:, ::1] flags,
               const double[:, ::1] anchors, double[:, ::1] xdot, double[:, ::1] work):
     """f(x) (Eq. A.4) for each row; work (N, NWORK) receives every stage's output.
@@ -247,6 +249,7 @@ def rhs_batch(int k, const double[:, ::1] x, const double[::1] p, const int[:, :
             kern.rhs(&x[i, 0], &p[0], &flags[i, 0], a, &xdot[i, 0], &work[i, 0])
 
 
+@_named_buffers
 def jacobian_batch(int k, const double[:, ::1] x, const double[::1] p, const int[:, ::1] flags,
                    const double[:, ::1] anchors, double[:, ::1] J, double[:, ::1] work):
     """df/dx (nx x nx row-major per row of J, shape (N, nx^2), nx = kernel_nx(k)); work as in
@@ -262,6 +265,7 @@ def jacobian_batch(int k, const double[:, ::1] x, const double[::1] p, const int
             kern.jacobian(&x[i, 0], &p[0], &flags[i, 0], a, &J[i, 0], &work[i, 0])
 
 
+@_named_buffers
 def contact_batch(int k, const double[:, ::1] kin, const int[:, ::1] flags, const double[::1] p,
                   double[:, ::1] contact, bint partials=False):
     """The contact stage alone: per row, kin (N, 2*NKIN) -> contact (N, 2*NCONTACT) (forces
@@ -281,6 +285,7 @@ def contact_batch(int k, const double[:, ::1] kin, const int[:, ::1] flags, cons
                 kern.contact(&kin[i, 0], &flags[i, 0], &p[0], &contact[i, 0])
 
 
+@_named_buffers
 def energies_batch(int k, const double[:, ::1] x, const double[::1] p, double[:, ::1] e):
     """T, V_gravity, V_hip for each row of x (N, kernel_nx(k)) into e (N, NENERGY)."""
     cdef const pdw_kernel *kern = _kernel(k)
@@ -295,6 +300,7 @@ def energies_batch(int k, const double[:, ::1] x, const double[::1] p, double[:,
             kern.energies(&x[i, 0], trig, &p[0], &e[i, 0])
 
 
+@_named_buffers
 def cdm_terms(int k, const double[::1] x, const double[::1] p, const double[::1] contact,
               double[::1] M, double[::1] C, double[::1] QmG):
     """M, the appendix C matrix and Q_f - G at x for given contact forces (central difference).
@@ -312,6 +318,7 @@ def cdm_terms(int k, const double[::1] x, const double[::1] p, const double[::1]
     kern.cdm_terms(&x[0], trig, &p[0], &contact[0], &M[0], &C[0], &QmG[0])
 
 
+@_named_buffers
 def bench(int k, str what, const double[::1] x, const double[::1] p, int f1, int f2,
           double a1, double a2, long n):
     """Mean ns per evaluation of `what` ("rhs" or "jacobian") over n calls in a C loop."""
@@ -404,6 +411,7 @@ cdef object _grown(object a, long n):
     return out
 
 
+@_named_buffers
 def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, int f2,
         double dt, long n_steps, long record_every, bint record_contact,
         double fall_hip_height, double fall_depth, double max_speed,

@@ -146,6 +146,7 @@ cdef dict _result_dict(pdw_hybrid_result *r):
     }
 
 
+@_named_buffers
 def rhs(const double[::1] p, const double[::1] y):
     """dy/dt of the stance phase; raises on a singular reduced mass matrix."""
     _py(p, y)
@@ -156,6 +157,7 @@ def rhs(const double[::1] p, const double[::1] y):
     return out
 
 
+@_named_buffers
 def stance_terms(const double[::1] p, const double[::1] y):
     """(M_r (2, 2), f_r (2,)) of M_r phidd = f_r."""
     _py(p, y)
@@ -166,6 +168,7 @@ def stance_terms(const double[::1] p, const double[::1] y):
     return Mr.reshape(2, 2), fr
 
 
+@_named_buffers
 def ground_force(const double[::1] p, const double[::1] y, const double[::1] ydd):
     """Ground reaction (F_x, F_y) on the stance foot for accelerations ydd (2,)."""
     _py(p, y)
@@ -176,6 +179,7 @@ def ground_force(const double[::1] p, const double[::1] y, const double[::1] ydd
     return F
 
 
+@_named_buffers
 def swing_foot(const double[::1] p, const double[::1] y):
     """[y_sw, vy_sw, x_sw, x_st] (stance rolling coordinate 0)."""
     _py(p, y)
@@ -185,6 +189,7 @@ def swing_foot(const double[::1] p, const double[::1] y):
     return out
 
 
+@_named_buffers
 def energies(const double[::1] p, const double[::1] y):
     """[T, V_gravity, V_hip] of the stance phase (stance rolling coordinate 0)."""
     _py(p, y)
@@ -194,6 +199,7 @@ def energies(const double[::1] p, const double[::1] y):
     return out
 
 
+@_named_buffers
 def full_state_batch(const double[::1] p, const double[:, ::1] y, double[:, ::1] x):
     """Full-model states x (N, 8) of reduced states y (N, 4): stance leg = leg 1, s0 = 0."""
     cdef Py_ssize_t i, n = y.shape[0]
@@ -205,6 +211,7 @@ def full_state_batch(const double[::1] p, const double[:, ::1] y, double[:, ::1]
             pdw_hybrid_full_state(&y[i, 0], &p[0], &x[i, 0])
 
 
+@_named_buffers
 def impact_terms(const double[::1] p, const double[::1] q):
     """M(q) (4, 4) and the material-point Jacobians J (2 feet, 2, 4)."""
     _len("p", p.shape[0], PDW_NP)
@@ -216,6 +223,7 @@ def impact_terms(const double[::1] p, const double[::1] q):
     return out[:16].reshape(4, 4), out[16:].reshape(2, 2, 4)
 
 
+@_named_buffers
 def impact(const double[::1] p, const double[::1] y_minus):
     """The impact map at a pre-impact state; a dict (see pdw_hybrid_result)."""
     _py(p, y_minus, "y_minus")
@@ -225,6 +233,7 @@ def impact(const double[::1] p, const double[::1] y_minus):
     return _result_dict(&r)
 
 
+@_named_buffers
 def solve(double[:, ::1] A, double[::1] b):
     """x of A x = b by the C Gaussian elimination (A, b overwritten); for tests."""
     if not 1 <= A.shape[0] <= 8:
@@ -239,6 +248,7 @@ def solve(double[:, ::1] A, double[::1] b):
     return x
 
 
+@_named_buffers
 def step(const double[::1] p, const double[::1] y0, dict opts, double t0=0.0, double s0=0.0,
          long rec_cap=0):
     """One step of the hybrid map. Returns (result dict, rec_t, rec_y)."""
@@ -260,6 +270,7 @@ def step(const double[::1] p, const double[::1] y0, dict opts, double t0=0.0, do
     return d, rec_t[:r.n_rec], rec_y[:r.n_rec]
 
 
+@_named_buffers
 def step_batch(const double[::1] p, const double[:, ::1] y0, dict opts, double[:, ::1] y_plus,
                int[::1] status):
     """The step map of each row of y0 (N, 4) into y_plus (N, 4); status (N,) per row."""
@@ -283,6 +294,7 @@ def step_batch(const double[::1] p, const double[:, ::1] y0, dict opts, double[:
     _raised(pending)
 
 
+@_named_buffers
 def walk(const double[::1] p, const double[::1] y0, double s0, long n_steps, dict opts,
          long rec_cap):
     """n_steps steps; returns (list of result dicts, rec_t, rec_y, rec_step)."""
@@ -315,6 +327,7 @@ def walk(const double[::1] p, const double[::1] y0, double s0, long n_steps, dic
     return out, rec_t[:n_rec], rec_y[:n_rec], rec_step[:n_rec]
 
 
+@_named_buffers
 def rhs_jac(const double[::1] p, const double[::1] y):
     """(ydot (4,), A = d ydot / d y (4, 4)) of the stance phase (symbolic Jacobian)."""
     _py(p, y)
@@ -327,6 +340,7 @@ def rhs_jac(const double[::1] p, const double[::1] y):
     return yd, A
 
 
+@_named_buffers
 def swing_foot_grad(const double[::1] p, const double[::1] y):
     """d y_sw / d y (4,)."""
     _py(p, y)
@@ -336,6 +350,7 @@ def swing_foot_grad(const double[::1] p, const double[::1] y):
     return g
 
 
+@_named_buffers
 def impact_jac(const double[::1] p, const double[::1] y_minus):
     """d y+ / d y- (4, 4) of the impact-and-relabel map."""
     _py(p, y_minus, "y_minus")
@@ -346,6 +361,7 @@ def impact_jac(const double[::1] p, const double[::1] y_minus):
     return D
 
 
+@_named_buffers
 def step_jac_batch(const double[::1] p, const double[:, ::1] y0, dict opts,
                    double[:, ::1] y_plus, double[:, :, ::1] DP, int[::1] status):
     """The step map of each row of y0 (N, 4) and its exact Jacobian DP (N, 4, 4)."""
@@ -371,6 +387,7 @@ def step_jac_batch(const double[::1] p, const double[:, ::1] y0, dict opts,
     _raised(pending)
 
 
+@_named_buffers
 def step_jac(const double[::1] p, const double[::1] y0, dict opts):
     """One step and its exact Jacobian: (result dict, DP (4, 4)); DP is NaN unless ok."""
     cdef pdw_hybrid_opts o
