@@ -97,25 +97,7 @@ def cdm_limit(contact):
     def ok(dt):
         return _walks(sim(contact, t_end=3.5, method="cdm", dt=dt, record_every=0), ref)
 
-    grid = [1e-5 * 10 ** (k / 2) for k in range(0, 9)]
-    a = None
-    for dt in grid:
-        if ok(dt):
-            a = dt
-        else:
-            b = dt
-            break
-    else:
-        return grid[-1], None
-    if a is None:
-        return None, grid[0]
-    for _ in range(4):
-        mid = math.sqrt(a * b)
-        if ok(mid):
-            a = mid
-        else:
-            b = mid
-    return a, b
+    return S.edge_on_grid(ok, [1e-5 * 10 ** (k / 2) for k in range(0, 9)])
 
 
 def _walks(r, ref):

@@ -67,23 +67,7 @@ def limit(contact, method, ref, which, variant="paper"):
         r = sim(contact, x0=x0, t_end=3.5, method=method, dt=dt, record_every=0, variant=variant)
         return verdict(r, ref)[which]
 
-    grid = [1e-5 * 10 ** (k / 2) for k in range(0, 9)]
-    a = b = None
-    for dt in grid:
-        if ok(dt):
-            a = dt
-        else:
-            b = dt
-            break
-    if a is None or b is None:
-        return a, b
-    for _ in range(4):
-        mid = math.sqrt(a * b)
-        if ok(mid):
-            a = mid
-        else:
-            b = mid
-    return a, b
+    return S.edge_on_grid(ok, [1e-5 * 10 ** (k / 2) for k in range(0, 9)])
 
 
 def main():

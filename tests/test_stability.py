@@ -370,3 +370,21 @@ def test_maps_nominal_cell_and_claims():
     assert SL.step_limit(P, "cdm").dt_max < a
     for dt in (1e-5, 1e-4, 1e-3, 0.9 * a):
         assert S.chatter(P, "cdm", dt).chatters
+
+
+def test_edge_on_grid_brackets_the_edge():
+    """The benchmarks' edge finder: scan, then log-bisect; the bracket holds the true edge and
+    is sqrt(10)^(1/2^refine) wide; all-pass and first-fail grids say so."""
+    from pdw.analysis.stability_maps import edge_on_grid
+    grid = [1e-5 * 10 ** (k / 2) for k in range(9)]
+    seen = []
+
+    def ok(dt):
+        seen.append(dt)
+        return dt < 3.3e-4
+    a, b = edge_on_grid(ok, grid, refine=4)
+    assert a < 3.3e-4 <= b and ok(a) and not ok(b)
+    assert b / a == pytest.approx(10 ** (0.5 / 16), rel=1e-12)
+    assert len(seen) == 5 + 4 + 2          # scan to the first failure, 4 bisections (+ checks)
+    assert edge_on_grid(lambda dt: True, grid) == (grid[-1], None)
+    assert edge_on_grid(lambda dt: False, grid) == (None, grid[0])

@@ -289,6 +289,19 @@ def chatter_onset(params: Params, method: str, variant: str = "paper", key: str 
     return _bisect_log(ok, a, b, refine)
 
 
+def edge_on_grid(ok, grid, refine: int = 4):
+    """(largest step that passes, smallest that fails) of ``ok`` along an ascending ``grid``
+    of steps [s], narrowed by ``refine`` bisections in log(dt): the grid is scanned up to its
+    first failure b, a being the step before it. Every step passes: (grid[-1], None); the
+    first fails: (None, grid[0]). The benchmarks' edge finder (contact laws, step limits)."""
+    a = None
+    for dt in grid:
+        if not ok(dt):
+            return (None, dt) if a is None else _bisect_log(ok, a, dt, refine)
+        a = dt
+    return a, None
+
+
 def _bisect_log(ok, a, b, refine):
     """Narrow a bracket ok(a), not ok(b) by ``refine`` bisections in log(dt)."""
     for _ in range(refine):
