@@ -90,14 +90,16 @@ def _folded(params, features):
 
 
 def _evaluate(x, params, flags, anchors, variant, features=None, contact=None):
-    X, single = _states(x)
+    if contact is not None and features is not None:
+        contact = contact.for_features(checks.features(features, _layout.FEATURES))
+    X, single = _states(x, width=_core.NX if contact is None else contact.nx)
     f, a = _discrete(flags, anchors, len(X))
     if contact is None or contact.is_default:
         k = kernel_index(variant, features)
         p = parameter_vector(_folded(params, features))
-    else:                                       # a normal law beyond the paper's (Coulomb friction)
+    else:                                       # another normal law, or LuGre friction
         params = contact.parameters(_folded(params, features))
-        k = kernel_index(variant, features, contact.normal)
+        k = kernel_index(variant, features, contact.normal, contact.friction)
         p = contact.vector(parameter_vector(params), features, params)
     xdot = np.empty_like(X)
     work = np.empty((len(X), _core.NWORK))

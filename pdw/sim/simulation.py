@@ -429,8 +429,8 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
                                 "record_every must be 1, got %r" % (record_every,))
 
     contact = _contact.Contact.coerce(contact)
-    x = contact.run_state(x, feats == _layout.FEATURES, t_eval is not None or dense_output,
-                          out is not None)
+    x = contact.run_state(x, feats)
+    contact = contact.for_features(feats)       # LuGre without friction: no bristle states
     params = contact.parameters(params)
     k = kernel_index(variant, feats, contact.normal, contact.friction)
     if feats != _layout.FEATURES:
@@ -450,7 +450,7 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
         rows = n_steps // int(record_every) + 2
         if _integrators.get(method).adaptive:     # unknown step count: what the buffer has
             rows = max(min(rows, 4096), out.capacity)
-        buffers = out.arrays(rows)
+        buffers = out.arrays(rows, contact.nx)
     raw = _core.run(k, METHODS.index(method), x, p, f0[0], f0[1], dt, n_steps, int(record_every),
                     bool(record_forces), hip, depth, max_speed, rtol, atol, h_max,
                     event_tol=event_tol, record_events=bool(record_events), stop_steps=stop_steps,
