@@ -267,8 +267,9 @@ def contact_forces(x: ArrayLike, params: Params | None = None, flags: ArrayLike 
 
     Parameters
     ----------
-    x : array_like, shape (8,) or (N, 8)
-        State [q, qd] [m, rad, m/s, rad/s].
+    x : array_like, shape (nx,) or (N, nx)
+        State [q, qd] [m, rad, m/s, rad/s]: nx = 8, or ``contact.nx`` (10 with LuGre friction:
+        then the bristle states z1, z2 [m] after it).
     params : Params, optional
         Default `Params.paper()`.
     flags : (int, int) or array_like (N, 2)
@@ -282,7 +283,9 @@ def contact_forces(x: ArrayLike, params: Params | None = None, flags: ArrayLike 
     features : iterable of str, optional
         Force elements present (`pdw.core._layout.FEATURES`; default all).
     contact : pdw.Contact, optional
-        Another normal law (with the smooth Coulomb friction); default the paper's.
+        Another normal law, or LuGre friction (its kernel, its state width); default the
+        paper's. With ``features`` without ``friction``, LuGre's run contact
+        (`pdw.Contact.for_features`: no bristles).
 
     Returns
     -------

@@ -10,8 +10,17 @@ recorded end points and their derivatives under the interval's discrete state:
   x'' = (df/dx) f at both ends, interpolation error O(h^6) per step, above the methods' order;
 - methods of order <= 2 (``cdm``, ``verlet``): cubic Hermite from x and f(x), O(h^4).
 
+The state is the run's, nx entries (8; 10 with LuGre's bristle states z1, z2, whose f is the
+LuGre kernel's). x'' comes from the symbolic Jacobian where the kernel has one (the Coulomb
+law's kernels); LuGre's kernels have a fixed-step finite-difference Jacobian, which would make
+the quintic second order, so there x'' is a fourth-order difference of f along f with a step
+proportional to h (`DenseOutput._along`): still O(h^6). The loops reset a foot's z to 0 at its
+touch-down before recording that step, so the recorded sample starts the next interval; the
+interval before it ends at the swing value of z (`_left_limits`).
+
 The interpolant passes through the recorded states exactly, is C^1 inside each smooth stretch,
-and its error between steps converges with the method's order (tests/test_dense_output.py).
+and its error between steps converges with the method's order (tests/test_dense_output.py,
+tests/test_lugre_dense.py).
 The anchors (docs/model.md section 6, `pdw.core._layout.ANCHORS`) are not recorded; they are
 rebuilt from the touch-downs as the loops set them: the rolling coordinate s_i and the approach
 speed max(-v_y, 0) of foot i at the step where flag i became 1 (or at the start, for a foot
