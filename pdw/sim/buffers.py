@@ -42,10 +42,10 @@ class RecordBuffer:
                                     "fits in memory" % (n, n * 8 * (1 + _core.NX_MAX + 2 + 4) / 1e9)
                                     ) from None
 
-    def _make(self, n, nx=_core.NX):
+    def _make(self, n):
         self.t = np.zeros(n)
-        self._states = np.zeros(n * _core.NX_MAX)
-        self.x = self._states[:n * nx].reshape(n, nx)
+        self._states = np.zeros(n * _core.NX_MAX)        # x: a view at the run's width
+        self.x = self._states[:n * _core.NX].reshape(n, _core.NX)
         self.flags = np.zeros((n, 2), dtype=np.intc)
         self.contact = np.zeros((n, len(_layout.RECORD_CONTACT)))
 

@@ -40,8 +40,8 @@ from ..core.model import contact_forces, kernel_index, parameter_vector
 def _anchors(x, flags, params, variant):
     """Anchors in force at each recorded step, shape (N, 4): s0_1, s0_2 [m], v_in1, v_in2 [m/s]
     (`pdw.core._layout.ANCHORS`)."""
-    cs = contact_forces(x[:, :_core.NX], params, flags=(0, 0), variant=variant)  # s, v_y: no
-    # anchors, no bristle states
+    # s and v_y use no anchors and no bristle states
+    cs = contact_forces(x[:, :_core.NX], params, flags=(0, 0), variant=variant)
     s, vin = np.atleast_2d(cs.s), np.maximum(-np.atleast_2d(cs.v_y), 0.0)
     a = np.zeros((len(x), len(_layout.ANCHORS)))
     for i in range(2):
