@@ -212,8 +212,6 @@ def test_x0_mechanical_or_full():
     (dict(contact=dict(friction="lugre", sigma1=-1.0)), r"contact.sigma1 .* >= 0"),
     (dict(contact=dict(friction="lugre", v_s=float("nan"))), "contact.v_s"),
     (dict(contact=dict(friction="lugre", mu_c=0.0)), "contact.mu_c"),
-    (dict(contact=dict(friction="lugre"), t_eval=[0.005]), "t_eval and dense_output"),
-    (dict(contact=dict(friction="lugre"), features=("friction", "tangential")), "features"),
     (dict(approach_speeds0=(-1.0, 0.0)), r"approach_speeds0\[0\] must be >= 0"),
     (dict(approach_speeds0=(0.1,)), "approach_speeds0 must have shape"),
 ])

@@ -224,31 +224,37 @@ class Contact:
         """Names of the state components under this friction law."""
         return _layout.STATE_LAYOUTS[self.friction]
 
-    def run_state(self, x, all_features=True, interpolate=False, buffer=False) -> np.ndarray:
-        """The initial state of a run under this friction law from a checked x0: a mechanical
-        x0 (`pdw.STATE`) gets bristle states 0 (relaxed). Refuses, saying why, what a run
-        with bristle states cannot do yet: a kernel without every force element
-        (``all_features=False``), interpolation (t_eval, dense_output), a `RecordBuffer`."""
+    def for_features(self, features) -> "Contact":
+        """The contact a run with only these force elements (`pdw.core._layout.FEATURES`)
+        simulates. Each element means under LuGre what it means under the default law:
+        ``hip_spring``, ``hip_damper``, ``normal_damping`` and ``tangential`` (the spring-damper
+        of Eqs. 7, 11, which LuGre keeps) are switched off by zeroing their parameters on the
+        law's kernel (`Params.without`), the friction law untouched. ``friction`` is the
+        friction law's force itself: a LuGre contact without it has no friction force, so no
+        bristles; the run is then its normal law with the default friction law, switched off
+        the same way (mu_s = mu_d = 0), and an 8-entry state. Returns this contact, or that
+        one (LuGre's parameters dropped)."""
+        if self.friction == "coulomb" or "friction" in features:
+            return self
+        return Contact(**{n: v for n, v in self.as_dict().items()
+                          if n != "friction" and n not in LUGRE_PARAMETERS})
+
+    def run_state(self, x, features=None) -> np.ndarray:
+        """The initial state of a run under this friction law from a checked x0, shape (nx,):
+        a mechanical x0 (`pdw.STATE`) gets bristle states 0 (relaxed). With ``features``
+        (`for_features`), the state of the contact that run simulates: a LuGre x0 of a run
+        without friction loses its bristle states (they act through the friction force
+        only)."""
         x = np.asarray(x, dtype=float)
-        if self.friction == "coulomb":
+        run = self if features is None else self.for_features(features)
+        if run.friction == "coulomb":
+            if len(x) == self.nx and run is not self:
+                x = x[:run.nx]
             if len(x) != len(_layout.STATE):
                 raise InvalidInputError("x0 has %d entries: the state of the %s friction law has "
                                         "%d (%s)" % (len(x), self.friction, self.nx,
                                                      ", ".join(self.state_names)))
             return x
-        if not all_features:
-            raise InvalidInputError("features: the %s friction law has a kernel with every force "
-                                    "element only; leave features unset (or set the parameters "
-                                    "of the elements to 0)" % self.friction)
-        if interpolate:
-            raise InvalidInputError("t_eval and dense_output interpolate the mechanical state "
-                                    "[q, qd] only; with contact.friction = %r (state %s) record "
-                                    "every step (record_every=1) instead"
-                                    % (self.friction, ", ".join(self.state_names)))
-        if buffer:
-            raise InvalidInputError("out: a pdw.RecordBuffer holds %d-wide states; the %s "
-                                    "friction law's state has %d entries: leave out unset"
-                                    % (len(_layout.STATE), self.friction, self.nx))
         return np.concatenate([x, np.zeros(self.nx - len(x))]) if len(x) < self.nx else x
 
     def for_section(self, section) -> "Contact":

@@ -90,14 +90,16 @@ def _folded(params, features):
 
 
 def _evaluate(x, params, flags, anchors, variant, features=None, contact=None):
-    X, single = _states(x)
+    if contact is not None and features is not None:
+        contact = contact.for_features(checks.features(features, _layout.FEATURES))
+    X, single = _states(x, width=_core.NX if contact is None else contact.nx)
     f, a = _discrete(flags, anchors, len(X))
     if contact is None or contact.is_default:
         k = kernel_index(variant, features)
         p = parameter_vector(_folded(params, features))
-    else:                                       # a normal law beyond the paper's (Coulomb friction)
+    else:                                       # another normal law, or LuGre friction
         params = contact.parameters(_folded(params, features))
-        k = kernel_index(variant, features, contact.normal)
+        k = kernel_index(variant, features, contact.normal, contact.friction)
         p = contact.vector(parameter_vector(params), features, params)
     xdot = np.empty_like(X)
     work = np.empty((len(X), _core.NWORK))
@@ -265,8 +267,9 @@ def contact_forces(x: ArrayLike, params: Params | None = None, flags: ArrayLike 
 
     Parameters
     ----------
-    x : array_like, shape (8,) or (N, 8)
-        State [q, qd] [m, rad, m/s, rad/s].
+    x : array_like, shape (nx,) or (N, nx)
+        State [q, qd] [m, rad, m/s, rad/s]: nx = 8, or ``contact.nx`` (10 with LuGre friction:
+        then the bristle states z1, z2 [m] after it).
     params : Params, optional
         Default `Params.paper()`.
     flags : (int, int) or array_like (N, 2)
@@ -280,7 +283,9 @@ def contact_forces(x: ArrayLike, params: Params | None = None, flags: ArrayLike 
     features : iterable of str, optional
         Force elements present (`pdw.core._layout.FEATURES`; default all).
     contact : pdw.Contact, optional
-        Another normal law (with the smooth Coulomb friction); default the paper's.
+        Another normal law, or LuGre friction (its kernel, its state width); default the
+        paper's. With ``features`` without ``friction``, LuGre's run contact
+        (`pdw.Contact.for_features`: no bristles).
 
     Returns
     -------

@@ -272,9 +272,10 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
 
     Parameters
     ----------
-    x0 : array_like (8,) or Scene
+    x0 : array_like (8,) or (nx,), or Scene
         Initial state [x_o, y_o, theta1, theta2, xd_o, yd_o, thetad1, thetad2] (m, rad, m/s,
-        rad/s). Default: the paper's typical gait (`X0_PAPER`).
+        rad/s), with LuGre friction optionally followed by the bristle states z1, z2 [m]
+        (default 0; nx = 10). Default: the paper's typical gait (`X0_PAPER`).
     t_end : float
         Duration [s].
     dt : float
@@ -314,7 +315,9 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
     features : iterable of str, optional
         Force elements present (`pdw.core._layout.FEATURES`; default all). The absent ones are
         switched off: a specialized generated kernel if there is one, else the general kernel
-        with their parameters zeroed (`Params.without`).
+        with their parameters zeroed (`Params.without`). Under LuGre friction the same, except
+        that a run without ``friction`` has no bristles: it runs the normal law with the
+        default friction law switched off (8-entry state; `pdw.Contact.for_features`).
     record_events : bool
         Keep the list of events (False: only their counts and the online gait analysis, O(1)
         memory however long the run).
@@ -338,14 +341,14 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
         ``solve_ivp``: ``Result.t`` is then t_eval (up to the run's end) and ``x``, ``flags``,
         ``Fn``, ``Ft`` (and ``energies``) are their values there, from the method's dense
         output (`pdw.sim.dense`: quintic Hermite for methods of order >= 4, cubic for cdm and
-        verlet). Needs ``record_every=1``.
+        verlet), every state entry (LuGre's bristle states too). Needs ``record_every=1``.
     dense_output : bool
-        Also return the interpolant: ``Result.sol(t)`` -> (8,) or (len(t), 8), exact at every
-        accepted step (``Result.sol.t``).
+        Also return the interpolant: ``Result.sol(t)`` -> (nx,) or (len(t), nx), exact at
+        every accepted step (``Result.sol.t``); nx = 8, or 10 with LuGre (`pdw.Contact.nx`).
     out : RecordBuffer, optional
         Record into these reusable arrays (`pdw.sim.buffers.RecordBuffer`) instead of fresh
-        ones: no page faults on a repeated run. The Result's t, x, flags, Fn, Ft are then views
-        into ``out``, overwritten by the next run that uses it.
+        ones: no page faults on a repeated run, of any contact law. The Result's t, x, flags,
+        Fn, Ft are then views into ``out``, overwritten by the next run that uses it.
     max_steps : int, optional
         Budget of integration steps of the adaptive methods (default 10^6 + 2 10^6 t_end/s);
         a run that uses it up stops early, saying so. Fixed-step methods take t_end/dt steps
@@ -429,8 +432,8 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
                                 "record_every must be 1, got %r" % (record_every,))
 
     contact = _contact.Contact.coerce(contact)
-    x = contact.run_state(x, feats == _layout.FEATURES, t_eval is not None or dense_output,
-                          out is not None)
+    x = contact.run_state(x, feats)
+    contact = contact.for_features(feats)       # LuGre without friction: no bristle states
     params = contact.parameters(params)
     k = kernel_index(variant, feats, contact.normal, contact.friction)
     if feats != _layout.FEATURES:
@@ -450,7 +453,7 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
         rows = n_steps // int(record_every) + 2
         if _integrators.get(method).adaptive:     # unknown step count: what the buffer has
             rows = max(min(rows, 4096), out.capacity)
-        buffers = out.arrays(rows)
+        buffers = out.arrays(rows, contact.nx)
     raw = _core.run(k, METHODS.index(method), x, p, f0[0], f0[1], dt, n_steps, int(record_every),
                     bool(record_forces), hip, depth, max_speed, rtol, atol, h_max,
                     event_tol=event_tol, record_events=bool(record_events), stop_steps=stop_steps,
