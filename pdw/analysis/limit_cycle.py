@@ -120,6 +120,9 @@ from .section import (  # noqa: F401
 #: Defaults of the step map used by `find_gait` (accurate) ...
 TIGHT = dict(rtol=1e-10, atol=1e-12, event_tol=1e-12)
 #: ... and for cheap uses (settling walks, cell mapping): errors ~1e-6 (`section.LOOSE`).
+#: With LuGre friction, `detect_period`'s: at `LOOSE` its map jitters by ~3e-6 in z1_um [um];
+#: here by ~6e-8 (0.3 s a step at `Params.paper_steady()`, 25 x the default law's).
+LOOSE_LUGRE = dict(rtol=1e-8, atol=1e-10, event_tol=1e-12)
 
 STEP_STATUS = ("ok", "fell", "diverged", "no_touch_down", "flight", "bad_state")
 
@@ -454,10 +457,13 @@ def detect_period(params=None, z0=None, variant="paper", method="rodas4", *, n_t
     Returns a dict: ``kind`` ("period", "fell" (or another failed step: ``status``), or
     "aperiodic": no period up to n_max within tol), ``n`` (the period, or None), ``Z`` (the
     iterates), ``distance`` (max|z_{k+n} - z_k| over the last n_max iterates for n = 1..n_max).
+    Step-map ``options`` default to `LOOSE`; with LuGre friction to `LOOSE_LUGRE` (at `LOOSE`
+    the bristle coordinate z1_um jitters by ~3e-6 um from step to step, above ``tol``).
     """
     p = _params(params)
-    opts = {**LOOSE, **options}
-    contact = opts.get("contact")
+    contact = options.get("contact")
+    loose = LOOSE_LUGRE if "z1_um" in section_names(contact) else LOOSE
+    opts = {**loose, **options}
     if z0 is None:
         z0 = settle(X0_PAPER, p, variant, method, flags0=(0, 1), t_end=4.0,
                     **({} if contact is None else dict(contact=contact)))

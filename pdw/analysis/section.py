@@ -95,9 +95,6 @@ def check_z(z, name="z", contact=None) -> np.ndarray:
                                 % (name, len(names), names, np.shape(z)))
     if not np.isfinite(a).all():
         raise InvalidInputError("%s must be finite, got %r" % (name, a))
-    if "v_in1" in names and a[names.index("v_in1")] < 0:
-        raise InvalidInputError("%s: the approach speed v_in1 must be >= 0 [m/s], got %r"
-                                % (name, a[names.index("v_in1")]))
     return a
 
 
@@ -127,12 +124,13 @@ def leading_speed(x, params, variant="paper") -> float:
 def start(z, params=None, contact=None, variant="paper"):
     """(x0, approach_speeds0) of a `simulate` run from section point z (flags (1, 1)):
     `embed`, and for the laws that use them the approach speeds (v_in1 of z, `leading_speed`),
-    else None."""
+    else None. A negative v_in1 (a Newton or finite-difference iterate) starts as 0: the laws
+    take max(v_in, v_in_min), so the map is flat there."""
     p = _params(params)
     x0 = embed(z, p, contact)
     if not uses_approach_speeds(contact):
         return x0, None
-    return x0, (float(np.asarray(z, dtype=float)[-1]), leading_speed(x0, p, variant))
+    return x0, (max(float(np.asarray(z, dtype=float)[-1]), 0.0), leading_speed(x0, p, variant))
 
 
 def section_coordinates(x, leg=2, contact=None, approach_speeds=None) -> np.ndarray:
@@ -165,22 +163,32 @@ def section_coordinates(x, leg=2, contact=None, approach_speeds=None) -> np.ndar
     return z
 
 
-def extend(z, params=None, contact=None, variant="paper") -> np.ndarray:
-    """A section point of ``contact`` from a mechanical one (6 entries; a point already of the
-    law's size is returned checked): the extras at their defaults, the trailing foot's bristle
-    0 (relaxed) and its approach speed the leading foot's (`leading_speed`: exact on a period-1
-    gait). For guesses, e.g. a gait of the default law or of the hybrid model."""
-    names = section_names(contact)
+def extend(z, params=None, contact=None, variant="paper", names=None) -> np.ndarray:
+    """A section point of ``contact`` from another one: the mechanical six, and the extras of
+    ``contact`` from z where z has them (``names``: z's coordinates, default `SECTION` or those
+    of ``contact``), else at their defaults: the trailing foot's bristle 0 (relaxed), its
+    approach speed the leading foot's (`leading_speed`: exact on a period-1 gait). For
+    guesses: a gait of another law, of the hybrid model."""
+    want = section_names(contact)
     a = np.array(z, dtype=float).reshape(-1)
-    if a.shape == (len(names),):
-        return check_z(a, contact=contact)
-    a = check_z(a, "z", None)
-    if "z1_um" in names:
-        a = np.append(a, 0.0)
-    if "v_in1" in names:
-        p = _params(params)
-        a = np.append(a, leading_speed(embed(a[:6], p), p, variant))
-    return a
+    if names is None:
+        if a.shape == (len(want),):
+            return check_z(a, contact=contact)
+        names = SECTION
+    names = tuple(names)
+    if a.shape != (len(names),) or names[:6] != SECTION:
+        raise InvalidInputError("z must have %d components %s, got shape %s"
+                                % (len(names), names, np.shape(z)))
+    out = list(check_z(a[:6], "z", None))
+    for n in want[6:]:
+        if n in names:
+            out.append(a[names.index(n)])
+        elif n == "z1_um":
+            out.append(0.0)
+        else:
+            p = _params(params)
+            out.append(leading_speed(embed(out[:6], p), p, variant))
+    return check_z(out, "z", contact)
 
 
 def held_speeds(result, t, initial, params, variant="paper"):
@@ -278,13 +286,17 @@ def _guess_z(guess, params, contact=None, variant="paper"):
     """A section point of ``contact`` from a guess (a `Gait`, a section point, a full state);
     the extras a guess lacks at their defaults (`extend`)."""
     if isinstance(guess, Gait):
+        names = SECTION
         if guess.model == "continuous":
             z = np.asarray(guess.details["z"], dtype=float)
+            names = guess.details.get("section_names", SECTION)
         else:
             from . import hybrid
             x = hybrid.full_state(guess.details["y_minus"], params)
             z = section_coordinates(x, 2)
-        return z if contact is None else extend(z, params, contact, variant)
+        if contact is None and names == SECTION:
+            return z
+        return extend(z, params, contact, variant, names)
     g = np.asarray(guess, dtype=float).reshape(-1)
     if contact is None:
         if g.shape == (len(_layout.STATE),):
