@@ -147,7 +147,9 @@ def _foot_height(x, leg, p):
 def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max=2.5,
          dt=1e-4, rtol=TIGHT["rtol"], atol=TIGHT["atol"], event_tol=TIGHT["event_tol"],
          record=False, contact=None) -> dict:
-    """One step of the Poincaré map from section point z; never raises on a failed step.
+    """One step of the Poincaré map from section point z (``len(section_names(contact))``
+    entries: a z of another size raises `InvalidInputError` naming the coordinates); never raises
+    on a failed step.
 
     Returns a dict: ``status`` (one of `STEP_STATUS`: "ok"; "fell"/"diverged" as `simulate`;
     "no_touch_down" by ``t_max``; "flight": the stance foot was off the ground at the

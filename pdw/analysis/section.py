@@ -295,7 +295,7 @@ def _guess_z(guess, params, contact=None, variant="paper"):
             x = hybrid.full_state(guess.details["y_minus"], params)
             z = section_coordinates(x, 2)
         if contact is None and names == SECTION:
-            return z
+            return check_z(z)
         return extend(z, params, contact, variant, names)
     g = np.asarray(guess, dtype=float).reshape(-1)
     if contact is None:
