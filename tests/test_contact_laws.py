@@ -210,21 +210,23 @@ def test_approach_speed_is_captured_at_touch_down():
 
 
 def test_flores_fixed_point_reproduces_itself_under_simulate():
-    """find_gait with Flores carries the approach speeds through the section: its fixed point is
-    the continuous run's periodic orbit. From the fixed point's state (the trailing foot's
-    approach speed = the landing one, as on the orbit), a continuous run returns to the same
-    section point at every touch-down; with both feet re-initialised (the section's old
-    behaviour) it does not."""
+    """find_gait with Flores carries the approach speeds through the section (the trailing
+    foot's is its 7th coordinate, v_in1): its fixed point is the continuous run's periodic
+    orbit. From the fixed point's state (on a period-1 orbit the trailing foot's approach speed
+    is the landing one), a continuous run returns to the same section point at every
+    touch-down; with both feet re-initialised it does not."""
     from pdw.analysis import limit_cycle as LC
     from pdw.core.model import contact_forces
     c = Contact("flores", e=0.18)
     P = pdw.Params.paper_steady()
     g = LC.find_gait(P, contact=c, workers=2)
     z, tol = g.details["z"], 1e-9
-    assert g.details["residual"] < tol
-    x0 = LC.embed(z, P)
+    assert g.details["residual"] < tol and len(z) == 7
+    x0 = LC.embed(z, P, c)
     v2 = -float(contact_forces(x0, P, flags=(1, 1)).v_y[1])
     assert v2 > 0.5                                  # a landing, not a resting foot
+    assert z[6] == pytest.approx(v2, abs=1e-8)
+    z = z[:6]
 
     def returns(a0):
         r = pdw.simulate(x0, t_end=3.0, params=P, method="rodas4", flags0=(1, 1), contact=c,

@@ -229,10 +229,16 @@ def test_a_frictionless_preset_needs_lugre_coefficients():
     assert np.isfinite(r.x).all()
 
 
-def test_find_gait_refuses_lugre_saying_why():
+def test_the_section_carries_the_trailing_bristle():
+    """find_gait's section under LuGre has a 7th coordinate, the trailing foot's bristle [um]
+    (tests/test_section_laws.py finds the gait); a 6-coordinate point is refused, naming it."""
     from pdw.analysis import limit_cycle
-    with pytest.raises(pdw.InvalidInputError, match="bristle state would be re-initialised"):
-        limit_cycle.step(np.zeros(6), contact=Contact(friction="lugre"))
+    c = Contact(friction="lugre")
+    assert limit_cycle.section_names(c) == limit_cycle.SECTION + ("z1_um",)
+    with pytest.raises(pdw.InvalidInputError, match=r"7 components .*z1_um"):
+        limit_cycle.step(np.zeros(6), contact=c)
+    x = limit_cycle.embed([-0.36, 0.38, 0.86, -0.19, -1.8, -1.67, 2.5], pdw.Params.paper(), c)
+    assert x[8] == 2.5e-6 and x[9] == 0.0
 
 
 def test_simulate_many_runs_lugre_on_the_scalar_path():

@@ -46,6 +46,18 @@ SINK = -1
 GRID = ("phi", "thetad2")
 
 
+def _default_section(options, what):
+    """Refuse a contact law whose section has more than the 6 mechanical coordinates: the grid,
+    `cell_state` and `rest_of` are of those six only."""
+    names = lc.section_names(options.get("contact"))
+    if names != lc.SECTION:
+        raise InvalidInputError(
+            "%s: contact %r has the section coordinates %s; cell mapping's grid fixes the six "
+            "mechanical ones %s only (its extras %s would have no value): not supported, use "
+            "find_gait / detect_period with that law" % (
+                what, options.get("contact"), names, lc.SECTION, names[len(lc.SECTION):]))
+
+
 def reference_point(params=None, variant="paper", method="rodas4"):
     """The section point of the first touch-down of the paper's initial condition (X0_PAPER,
     flags (0, 1)); None if the walker does not get there."""
@@ -225,13 +237,15 @@ def cell_map(params=None, variant="paper", phi=(0.69, 0.81, 80), thetad2=(-3.2, 
     progress : bool or pdw.Progress
         A bar over the cells on stderr when it is a terminal (`pdw.core.progress`).
     options
-        Step-map options (default `pdw.limit_cycle.LOOSE`: rtol 1e-7).
+        Step-map options (default `pdw.limit_cycle.LOOSE`: rtol 1e-7); a ``contact`` whose
+        section has extra coordinates (LuGre, lankarani_nikravesh, flores) is refused.
 
     Returns
     -------
     CellMap
     """
     p = Params.paper_steady() if params is None else params
+    _default_section(options, "cell_map")
     opts = {**lc.LOOSE, **options}
     (a0, a1, na), (b0, b1, nb) = phi, thetad2
     if not (a1 > a0 and b1 > b0 and int(na) >= 1 and int(nb) >= 1):
@@ -308,6 +322,7 @@ def point_mapping_basin(cm: CellMap, z_star, *, n_steps=12, tol=1e-4, workers=No
     """
     p = cm.params
     opts = {**cm.info.get("options", lc.LOOSE), **options}
+    _default_section(opts, "point_mapping_basin")
     A, B = cm.centers()
     Z = np.array([cell_state(A[c], B[c], cm.rest[c], p) for c in range(len(A))])
     z_star = np.asarray(z_star, dtype=float)

@@ -68,7 +68,7 @@ def _problem(params, parameter, model, variant, period, params_of, log, options,
 def _start_z(prob, params, start, variant, period):
     if isinstance(start, Gait):
         z = start.details.get("z") if start.details else None
-        return prob.section(start.state) if z is None else np.asarray(z, dtype=float)
+        return prob.section(start.state) if z is None else prob.section(z)
     if start is not None:
         return prob.section(start)
     if prob.model == "hybrid":
@@ -77,7 +77,9 @@ def _start_z(prob, params, start, variant, period):
             raise InvalidInputError("a hybrid period-%d start needs start= (Branch.switch)"
                                     % period)
         return prob.section(g.state)
-    g = LC.find_gait(params, variant, period=period)
+    contact = prob.opts.get("contact")
+    g = LC.find_gait(params, variant, period=period,
+                     **({} if contact is None else dict(contact=contact)))
     return np.asarray(g.details["z"], dtype=float)
 
 
@@ -146,7 +148,9 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
         Central-difference step of the continuous model's Jacobian.
     options : dict
         Step-map options (hybrid: `pdw.hybrid.DEFAULT_OPTIONS`; continuous: rtol, atol,
-        event_tol, t_max, dt).
+        event_tol, t_max, dt, contact: with a contact law that has memory (LuGre friction,
+        lankarani_nikravesh, flores) the section and z have its extra coordinates,
+        `pdw.analysis.section.section_names`).
     at : sequence of float
         Parameter values at which the branch gets a point of its own (a natural correction
         there, when the branch passes the value), e.g. to compare with a table.

@@ -10,11 +10,12 @@ eigenvalues are the Floquet multipliers) and ``d P^n / d lambda``. Two models:
   saltation matrix of the heel-strike event times the derivative of the impact map
   (pdw/core/csrc/pdw_hybrid_var.c, emitted pieces from derive/hybrid.py). It agrees with central
   differences to ~1e-9 at rtol = atol = 1e-12 (tests/test_continuation.py).
-* `ContinuousProblem` (`pdw.limit_cycle`, compliant ground): z (6) at the swing foot's
-  touch-down. M by central differences of the rodas4 map (rtol 1e-10, atol 1e-12, event_tol
+* `ContinuousProblem` (`pdw.limit_cycle`, compliant ground): z at the swing foot's
+  touch-down (6 coordinates, or more with a contact law that has memory: ``options["contact"]``,
+  `pdw.analysis.section.section_names`). M by central differences of the rodas4 map (rtol 1e-10, atol 1e-12, event_tol
   1e-12, step ``fd_step`` = 1e-5): the map is reproducible to ~1e-10, so M is good to ~1e-5
   (multipliers below ~1e-4 in modulus are not resolved). The 12 + 2 evaluations run on an
-  executor (threads by default; the compiled loop releases the GIL).
+  executor (threads by default; the compiled loop releases the GIL); 2 dim + 2 with dim = len(z).
 
 ``d P^n / d lambda`` is a central difference in the (internal) parameter coordinate for both, of
 relative step ``lam_rel`` (1e-6 hybrid, 1e-4 continuous) of the continuation's scale.
@@ -196,7 +197,8 @@ class HybridProblem(_Problem):
 
 
 class ContinuousProblem(_Problem):
-    """Period-n map of the continuous walker (`pdw.limit_cycle`) on its 6-D section."""
+    """Period-n map of the continuous walker (`pdw.limit_cycle`) on its section: ``dim`` = 6,
+    or more with a contact law that has memory (``options["contact"]``, `LC.section_names`)."""
 
     dim = 6
     model = "continuous"
@@ -213,6 +215,8 @@ class ContinuousProblem(_Problem):
         super().__init__(params, parameter, params_of, period, log, **kw)
         self.variant, self.method = variant, method
         self.opts = {**LC.TIGHT, **(options or {})}
+        self.contact = self.opts.get("contact")
+        self.dim = len(LC.section_names(self.contact))
         self.fd_step = float(fd_step)
         self.executor = executor
         self.workers = max(1, int(workers or os.cpu_count() or 1))
@@ -221,7 +225,9 @@ class ContinuousProblem(_Problem):
 
     def section(self, state):
         s = np.asarray(state, dtype=float).reshape(-1)
-        return LC.section_coordinates(s, 2) if s.size == 8 else s.copy()
+        if self.contact is None:
+            return LC.section_coordinates(s, 2) if s.size == 8 else s.copy()
+        return LC._guess_z(s, self.base, self.contact, self.variant)
 
     def __getstate__(self):
         # the tasks travel to process pools / Dask workers without the executor itself
@@ -245,7 +251,8 @@ class ContinuousProblem(_Problem):
             up, down = self.lam_offsets(mu)
             if up == down:
                 return Evaluation(False, "invalid parameter: no room for a difference")
-            tasks += [(z + e, mu) for e in np.eye(6) * h] + [(z - e, mu) for e in np.eye(6) * h]
+            E = np.eye(self.dim) * h
+            tasks += [(z + e, mu) for e in E] + [(z - e, mu) for e in E]
             tasks += [(z, mu + up), (z, mu + down)]
         outs = self._run(tasks)
         self.n_maps += self.period * len(tasks)
@@ -259,12 +266,13 @@ class ContinuousProblem(_Problem):
             if any(v is None for v in vals):
                 bad = next(o[1][-1]["status"] for o in outs if o[0] is None)
                 return Evaluation(False, "finite-difference neighbour: " + bad)
-            M = np.column_stack([(vals[1 + k] - vals[7 + k]) / (2 * h) for k in range(6)])
-            P_lam = (vals[13] - vals[14]) / (up - down)
+            n = self.dim
+            M = np.column_stack([(vals[1 + k] - vals[1 + n + k]) / (2 * h) for k in range(n)])
+            P_lam = (vals[1 + 2 * n] - vals[2 + 2 * n]) / (up - down)
         info = {"period": float(sum(s["period"] for s in steps)),
                 "step_length": float(np.mean([s["step_length"] for s in steps])),
                 "double_support": float(np.mean([s["double_support"] for s in steps])),
-                "state": LC.embed(z, self.params_at(mu)),
+                "state": LC.embed(z, self.params_at(mu), self.contact),
                 "n_events": int(sum(s["n_events"] for s in steps)),
                 "orbit": np.array([z] + [s["z"] for s in steps[:-1]])}
         if self.ref_events is None:
@@ -280,7 +288,8 @@ class ContinuousProblem(_Problem):
                     multipliers=multipliers, model="continuous", params=self.params_at(mu),
                     details={"z": np.array(z), "period_n": self.period, "jacobian": ev.M,
                              "jacobian_kind": "central differences, fd_step %g" % self.fd_step,
-                             "variant": self.variant, "options": dict(self.opts)})
+                             "variant": self.variant, "options": dict(self.opts),
+                             "section_names": LC.section_names(self.contact)})
 
 
 class _ContinuousTask:

@@ -17,23 +17,34 @@ from theta2:
 
     x_o = -(l - r) sin(theta2),   y_o = r + (l - r) cos(theta2)
 
-so the section is 6-dimensional, with coordinates (`SECTION`)
+so the mechanical section is 6-dimensional, with coordinates (`SECTION`)
 
     z = (theta1, theta2, xd_o, yd_o, thetad1, thetad2)
       = (trailing angle, leading angle, hip velocity along / normal to the slope,
          trailing leg's rate, leading (swing) leg's rate)        [rad, rad, m/s, m/s, rad/s, rad/s]
 
-`embed(z)` is the full state (flags (1, 1)); `section_coordinates(x, leg)` goes back (relabelling
-when leg 1 touched down). The discarded coordinates are x_o (translation along the slope: the
-map is invariant under it) and y_o (y_D2 = 0 on the section).
+A contact law with memory adds the trailing foot's share of it (`section_names(contact)`,
+`pdw.analysis.section`): with LuGre friction its bristle deflection ``z1_um`` [um] (the leading
+foot's is 0: reset at its touch-down), with the lankarani_nikravesh and flores normal laws its
+approach speed ``v_in1`` [m/s] captured at its own touch-down (the leading foot's is -v_y of the
+section state). The map then is the continuous run's, on and off a fixed point, for period-n
+gaits too; with the default laws (Coulomb friction, Hunt-Crossley / Hertz / Kelvin-Voigt) there
+is no extra coordinate and z has 6 entries.
+
+`embed(z, params, contact)` is the full state (flags (1, 1)); `section_coordinates(x, leg,
+contact, approach_speeds)` goes back (relabelling when leg 1 touched down). The discarded
+coordinates are x_o (translation along the slope: the map is invariant under it) and y_o
+(y_D2 = 0 on the section).
 
 The step map
 ------------
-`step(z)`: ``pdw.simulate(embed(z), flags0=(1, 1), record_every=1, ...)`` until past the
-trailing leg's next touch-down; the sample recorded at that event's time (adaptive methods end
-an accepted step exactly there and record it after the flag update) is relabelled and mapped
-to z'. Nothing in the compiled code is changed: the loop records every accepted step (a few
-thousand samples) and Python picks the one at the event. The simulation runs to
+`step(z)`: ``pdw.simulate(embed(z), flags0=(1, 1), record_every=1, approach_speeds0=...)``
+until past the trailing leg's next touch-down; the sample recorded at that event's time
+(adaptive methods end an accepted step exactly there and record it after the flag update) is
+relabelled and mapped to z'. The new trailing foot is the old leading one: its bristle is the
+run's, its approach speed the one it got at the start (or at a later touch-down of its own).
+Nothing in the compiled code is changed: the loop records every accepted step (a few thousand
+samples) and Python picks the one at the event. The simulation runs to
 ``1.3 * t_hint + 0.05`` s (``t_hint``: the previous period, default 0.75 s) and, if the touch-down
 has not happened by then, again to ``t_max``.
 
@@ -53,13 +64,14 @@ Newton shooting and Floquet multipliers
 ---------------------------------------
 `find_gait` solves P^n(z) = z (n = ``period``, default 1) by Newton's method with a damped step
 (halved until the residual decreases). The Jacobian DP is taken by **central differences** with
-an absolute step ``fd_step`` (default 1e-5 in every coordinate: rad, m/s, rad/s), each column
-from two step-map evaluations (12 per Jacobian, run in parallel threads: the compiled loop
+an absolute step ``fd_step`` (default 1e-5 in every coordinate: rad, m/s, rad/s, um), each column
+from two step-map evaluations (2 len(z) per Jacobian, run in parallel threads: the compiled loop
 releases the GIL). With the default tolerances (rtol 1e-10, atol 1e-12, event_tol 1e-12) one map
 evaluation is reproducible to ~1e-10, so the Jacobian is good to ~1e-5 and Newton converges to a
 residual max|P(z) - z| < ``tol`` = 1e-9 (the floor is ~3e-10). The Floquet multipliers are the
-eigenvalues of the 6x6 Jacobian of P^n at the fixed point (the full 8x8 map would add the
-neutral translation and the section's constraint); multipliers far below the Jacobian's noise
+eigenvalues of the len(z) x len(z) Jacobian of P^n at the fixed point (6 x 6 for the default
+laws, 7 x 7 with LuGre or Flores; the full 8x8 map would add the neutral translation and the
+section's constraint); multipliers far below the Jacobian's noise
 (~1e-4 in modulus) are not resolved. ``details["multipliers_check"]`` repeats them with
 10 x ``fd_step``.
 
@@ -81,63 +93,48 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..core import _layout, interrupt
+from ..core import interrupt
 from ..core.contact import Contact
 from ..core.errors import FellError, InvalidInputError, SimulationError
 from ..core.integrators import INTEGRATORS, METHODS
-from ..core.params import X0_DISTURBED, X0_PAPER, Params
+from ..core.params import X0_PAPER, Params
 from ..core.progress import progress_bar
 from ..sim.simulation import simulate
+from . import section as _section
 from .gait_types import Gait, GaitNotFoundError
-
-#: Section coordinates z (legs relabelled: leg 2 has just touched down, leg 1 trails).
-SECTION = ("theta1", "theta2", "xd_o", "yd_o", "thetad1", "thetad2")
+from .section import (  # noqa: F401
+    LOOSE,
+    SECTION,
+    UNITS,
+    _guess_z,
+    default_guesses,
+    embed,
+    extend,
+    hybrid_guess,
+    section_coordinates,
+    section_names,
+    section_units,
+    settle,
+)
 
 #: Defaults of the step map used by `find_gait` (accurate) ...
 TIGHT = dict(rtol=1e-10, atol=1e-12, event_tol=1e-12)
-#: ... and for cheap uses (settling walks, cell mapping): errors ~1e-6.
-LOOSE = dict(rtol=1e-7, atol=1e-9, event_tol=1e-10)
+#: ... and for cheap uses (settling walks, cell mapping): errors ~1e-6 (`section.LOOSE`).
+#: With LuGre friction, `detect_period`'s: at `LOOSE` its map jitters by ~3e-6 in z1_um [um];
+#: here by ~6e-8 (0.3 s a step at `Params.paper_steady()`, 25 x the default law's).
+LOOSE_LUGRE = dict(rtol=1e-8, atol=1e-10, event_tol=1e-12)
 
 STEP_STATUS = ("ok", "fell", "diverged", "no_touch_down", "flight", "bad_state")
 
 
-# --- the section ------------------------------------------------------------------------------
+# --- the section (pdw.analysis.section) ---------------------------------------------------------
 
 def _params(params):
-    params = Params.paper_steady() if params is None else params
-    if not isinstance(params, Params):
-        raise InvalidInputError("params must be a pdw.Params, got %s" % type(params).__name__)
-    return params
+    return _section._params(params)
 
 
-def _z(z, name="z"):
-    a = np.array(z, dtype=float).reshape(-1)
-    if a.shape != (6,):
-        raise InvalidInputError("%s must have 6 components %s, got shape %s"
-                                % (name, SECTION, np.shape(z)))
-    if not np.isfinite(a).all():
-        raise InvalidInputError("%s must be finite, got %r" % (name, a))
-    return a
-
-
-def embed(z, params=None) -> np.ndarray:
-    """The full state (`pdw.STATE`) of section point z: leg 2's contact point at the origin
-    (x_D2 = y_D2 = 0), to be simulated with flags (1, 1)."""
-    p = _params(params)
-    th1, th2, xd, yd, w1, w2 = _z(z)
-    return np.array([-(p.l - p.r) * math.sin(th2), p.r + (p.l - p.r) * math.cos(th2),
-                     th1, th2, xd, yd, w1, w2])
-
-
-def section_coordinates(x, leg=2) -> np.ndarray:
-    """z of a full state x recorded at the touch-down of ``leg`` (1 or 2): relabels the legs
-    when leg 1 touched down, drops x_o and y_o."""
-    x = np.asarray(x, dtype=float)
-    if leg == 2:
-        return x[[2, 3, 4, 5, 6, 7]].copy()
-    if leg == 1:
-        return x[[3, 2, 4, 5, 7, 6]].copy()
-    raise InvalidInputError("leg must be 1 or 2, got %r" % (leg,))
+def _z(z, name="z", contact=None):
+    return _section.check_z(z, name, contact)
 
 
 def _foot_height(x, leg, p):
@@ -150,7 +147,9 @@ def _foot_height(x, leg, p):
 def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max=2.5,
          dt=1e-4, rtol=TIGHT["rtol"], atol=TIGHT["atol"], event_tol=TIGHT["event_tol"],
          record=False, contact=None) -> dict:
-    """One step of the Poincaré map from section point z; never raises on a failed step.
+    """One step of the Poincaré map from section point z (``len(section_names(contact))``
+    entries: a z of another size raises `InvalidInputError` naming the coordinates); never raises
+    on a failed step.
 
     Returns a dict: ``status`` (one of `STEP_STATUS`: "ok"; "fell"/"diverged" as `simulate`;
     "no_touch_down" by ``t_max``; "flight": the stance foot was off the ground at the
@@ -163,20 +162,21 @@ def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max
     ``result`` (the `Result`, legs not relabelled, time from the section).
     """
     p = _params(params)
-    law = Contact.coerce(contact).for_section(SECTION)
-    nan6 = np.full(6, np.nan)
-    out = dict(status="ok", z=nan6, x_touch=np.full(len(_layout.STATE), np.nan), period=np.nan,
-               double_support=np.nan, swing_period=np.nan, step_length=np.nan, travel=np.nan,
-               n_events=0, stats={})
+    law = Contact.coerce(contact)
+    nz = len(section_names(law))
+    if np.size(z) != nz:
+        _z(z, contact=law)                  # the wrong size for the law: say so
+    out = dict(status="ok", z=np.full(nz, np.nan), x_touch=np.full(law.nx, np.nan),
+               period=np.nan, double_support=np.nan, swing_period=np.nan, step_length=np.nan,
+               travel=np.nan, n_events=0, stats={})
     try:
-        x0 = embed(z, p)
+        x0, v_in0 = _section.start(z, p, law, variant)
     except InvalidInputError:
         out["status"] = "bad_state"
         return out
     if method not in METHODS:
         raise InvalidInputError("method must be one of %s, got %r" % (", ".join(METHODS), method))
     adaptive = INTEGRATORS[method].adaptive
-    v_in0 = law.section_approach_speeds(x0, p, variant)
     t_first = 1.3 * (0.75 if t_hint is None or not np.isfinite(t_hint) else float(t_hint)) + 0.05
     ends = [min(t_first, t_max), t_max] if t_first < t_max else [t_max]
     for t_end in ends:
@@ -207,7 +207,9 @@ def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max
             s = y0 / (y0 - y1)
             x = res.x[i - 1] + s * (x - res.x[i - 1])
             t = float(res.t[i - 1] + s * (res.t[i] - res.t[i - 1]))
-    out.update(status="ok", z=section_coordinates(x, 1), x_touch=x, period=t,
+    speeds = None if v_in0 is None else _section.held_speeds(res, td.t, v_in0, p, variant)
+    out.update(status="ok", z=section_coordinates(x, 1, law, speeds), x_touch=x,
+               period=t,
                double_support=lo.t, swing_period=t - lo.t,
                step_length=x[0] + (p.l - p.r) * math.sin(x[2]),
                travel=x[0] + (p.l - p.r) * math.sin(x[2]) - lo.x_D,
@@ -229,9 +231,9 @@ def step_map(z, params=None, variant="paper", method="rodas4", **options) -> np.
 
 
 def orbit(z, n, params=None, variant="paper", method="rodas4", **options):
-    """n iterates of the map from z: (Z of shape (k+1, 6), list of step dicts); stops early
+    """n iterates of the map from z: (Z of shape (k+1, len(z)), list of step dicts); stops early
     (k < n) at a failed step."""
-    Z, info = [_z(z)], []
+    Z, info = [_z(z, contact=options.get("contact"))], []
     t_hint = options.pop("t_hint", None)
     for _ in range(int(n)):
         s = step(Z[-1], params, variant, method, t_hint=t_hint, **options)
@@ -251,7 +253,7 @@ def _workers(workers):
 
 def map_batch(Z, params=None, variant="paper", method="rodas4", *, workers=None,
               progress=False, **options):
-    """Steps from every row of Z (N, 6), in ``workers`` threads: list of step dicts
+    """Steps from every row of Z (N, len(z)), in ``workers`` threads: list of step dicts
     (``progress``: False, True or a `pdw.Progress`, one unit per row)."""
     Z = np.atleast_2d(np.asarray(Z, dtype=float))
     bar = progress_bar(progress, len(Z), "step map")
@@ -273,17 +275,18 @@ def _compose(z, n, params, variant, method, options):
 
 def jacobian(z, params=None, variant="paper", method="rodas4", *, fd_step=1e-5, period=1,
              workers=None, **options):
-    """(J, P^n(z), steps at z): central-difference Jacobian of P^n at z, step ``fd_step`` (absolute,
-    every coordinate); the 13 evaluations run in ``workers`` threads. J is NaN where a
-    perturbed step failed."""
-    z = _z(z)
-    E = np.eye(6) * fd_step
+    """(J, P^n(z), steps at z): central-difference Jacobian of P^n at z (n = len(z) square,
+    `section_names`), step ``fd_step`` (absolute, every coordinate in its unit of `UNITS`); the
+    2 n + 1 evaluations run in ``workers`` threads. J is NaN where a perturbed step failed."""
+    z = _z(z, contact=options.get("contact"))
+    n = len(z)
+    E = np.eye(n) * fd_step
     pts = [z] + [z + e for e in E] + [z - e for e in E]
     fn = lambda zz: _compose(zz, period, params, variant, method, options)  # noqa: E731
     # Ctrl-C stops every thread at its next poll (pdw.core.interrupt)
     outs = interrupt.thread_map(fn, pts, min(_workers(workers), len(pts)))
-    val = [o[0] if o[0] is not None else np.full(6, np.nan) for o in outs]
-    J = np.column_stack([(val[1 + k] - val[7 + k]) / (2 * fd_step) for k in range(6)])
+    val = [o[0] if o[0] is not None else np.full(n, np.nan) for o in outs]
+    J = np.column_stack([(val[1 + k] - val[1 + n + k]) / (2 * fd_step) for k in range(n)])
     return J, val[0], outs[0][1]
 
 
@@ -295,69 +298,6 @@ def floquet(z, params=None, variant="paper", method="rodas4", *, fd_step=1e-5, p
                        workers=workers, **opts)
     mult = np.linalg.eigvals(J)
     return mult[np.argsort(-np.abs(mult))], J
-
-
-# --- settling walks and guesses ---------------------------------------------------------------
-
-def settle(x0, params=None, variant="paper", method="rodas4", *, flags0=(0, 1), t_end=8.0,
-           rtol=LOOSE["rtol"], atol=LOOSE["atol"], event_tol=LOOSE["event_tol"]):
-    """Walk from full state x0 for ``t_end`` s (one simulation) and return the section point
-    of the last touch-down with both feet on the ground, or None if there was none."""
-    p = _params(params)
-    res = simulate(x0, t_end=t_end, dt=1e-4, params=p, variant=variant, method=method,
-                   flags0=flags0, record_every=1, record_forces=False, on_failure="return",
-                   rtol=rtol, atol=atol, event_tol=event_tol)
-    for e in reversed(res.events):
-        if e.kind != "touch_down":
-            continue
-        i = int(np.argmin(np.abs(res.t - e.t)))
-        if abs(res.t[i] - e.t) < 1e-12 + 1e-9 * e.t and res.flags[i].all():
-            return section_coordinates(res.x[i], e.leg)
-    return None
-
-
-def hybrid_guess(params=None):
-    """A section point from the hybrid (rigid-ground) model's gait: its pre-impact state with
-    the hip velocity of the rolling stance foot, legs relabelled (None if it has no gait)."""
-    from . import hybrid
-    p = _params(params)
-    try:
-        g = hybrid.find_gait(p)
-    except Exception:      # noqa: BLE001 - no hybrid gait: no guess
-        return None
-    x = hybrid.full_state(g.details["y_minus"], p)        # leg 1 stance (trailing), 2 leading
-    return section_coordinates(x, 2)
-
-
-def default_guesses(params=None, variant="paper", method="rodas4", settle_time=8.0):
-    """Starting points for Newton (list of (name, z)): the paper's initial condition, its
-    disturbed start (Fig. 9) and the hybrid gait, each walked for ``settle_time`` s."""
-    p = _params(params)
-    out = []
-    for name, x0, f0 in (("paper x0", X0_PAPER, (0, 1)), ("disturbed x0", X0_DISTURBED, (1, 0))):
-        z = settle(x0, p, variant, method, flags0=f0, t_end=settle_time)
-        if z is not None:
-            out.append((name + " settled", z))
-    zh = hybrid_guess(p)
-    if zh is not None:
-        z = settle(embed(zh, p), p, variant, method, flags0=(1, 1), t_end=settle_time)
-        out.append(("hybrid gait settled", z if z is not None else zh))
-        if z is not None:
-            out.append(("hybrid gait", zh))
-    return out
-
-
-def _guess_z(guess, params):
-    if isinstance(guess, Gait):
-        if guess.model == "continuous":
-            return _z(guess.details["z"])
-        from . import hybrid
-        x = hybrid.full_state(guess.details["y_minus"], params)
-        return section_coordinates(x, 2)
-    g = np.asarray(guess, dtype=float).reshape(-1)
-    if g.shape == (len(_layout.STATE),):
-        return section_coordinates(g, 2 if g[3] >= g[2] else 1)
-    return _z(g, "guess")
 
 
 # --- Newton shooting ----------------------------------------------------------------------------
@@ -376,7 +316,7 @@ def _newton(z, period, params, variant, method, opts, tol, max_iter, fd_step, wo
         if rn < tol:
             return z, dict(reason="converged", iterations=it, residual=rn, jacobian=J,
                            steps=steps)
-        A = J - np.eye(6)
+        A = J - np.eye(len(z))
         if not np.isfinite(A).all():
             return None, dict(reason="Jacobian not finite at iterate %d" % it, iterations=it)
         try:
@@ -409,29 +349,32 @@ def find_gait(params: Params | None = None, variant: str = "paper",
         Default `Params.paper_steady()`.
     variant : {"paper", "consistent"}
         Contact reading (docs/model.md section 6).
-    guess : array_like (6,) section point, (8,) full state at a touch-down, or a `Gait`
-        (hybrid or continuous), optional. Default: `default_guesses` in turn. A guess is used
-        as it is (no settling walk).
+    guess : array_like, or a `Gait` (hybrid or continuous), optional
+        A section point (``len(section_names(contact))`` entries, or the 6 mechanical ones: the
+        law's extras then get `extend`'s defaults), a full state at a touch-down (8 entries, or
+        LuGre's 10), or a gait. Default: `default_guesses` in turn. A guess is used as it is
+        (no settling walk).
     method : str
         Integrator of the step map; ``rodas4`` (default) locates the touch-down to ``event_tol``.
     period : int
         Solve P^period(z) = z (2 for a period-two gait, ...).
     tol : float
-        Newton converges when max|P^n(z) - z| < tol.
+        Newton converges when max|P^n(z) - z| < tol (every coordinate in its unit of `UNITS`:
+        rad, m/s, rad/s, um for the bristle).
     max_iter : int
         Newton iterations per guess.
     fd_step : float
-        Absolute step of the central-difference Jacobian.
+        Absolute step of the central-difference Jacobian (in each coordinate's unit).
     settle_time : float
         Length of the settling walk of the default guesses [s].
     workers : int
-        Threads for the Jacobian's 13 map evaluations (default: all cores).
+        Threads for the Jacobian's 2 len(z) + 1 map evaluations (default: all cores).
     options
         Step-map options: rtol, atol, event_tol (default `TIGHT`), t_max, dt, and
-        ``contact`` (`pdw.Contact`: the normal law; with lankarani_nikravesh or flores both feet
-        get the section's landing speed as their approach speed
-        (`Contact.section_approach_speeds`: exact at a period-1 fixed point). LuGre friction is
-        refused).
+        ``contact`` (`pdw.Contact`: the normal and friction laws). The section follows the law
+        (`section_names`, `pdw.analysis.section`): with LuGre friction it carries the trailing
+        foot's bristle ``z1_um`` [um], with lankarani_nikravesh or flores the trailing foot's
+        approach speed ``v_in1`` [m/s], so the map is the continuous run's for every law.
 
     Returns
     -------
@@ -440,7 +383,8 @@ def find_gait(params: Params | None = None, variant: str = "paper",
         just touched down, its contact point at the origin); ``period``: touch-down to
         touch-down [s] (for period n > 1: the whole n-step cycle); ``step_length``: footprint
         spacing (n > 1: the mean); ``double_support`` [s] (n > 1: the mean); ``multipliers``: the
-        6 eigenvalues of DP^n. ``details``: ``z``, ``jacobian``, ``fd_step``, ``residual``,
+        len(z) eigenvalues of DP^n (6 for the default laws). ``details``: ``z``,
+        ``section_names``, ``section_units``, ``jacobian``, ``fd_step``, ``residual``,
         ``newton_iterations``, ``swing_period``, ``travel``, ``orbit`` (n section points),
         ``steps``, ``multipliers_check`` (with 10 x fd_step), the guess used.
 
@@ -454,10 +398,12 @@ def find_gait(params: Params | None = None, variant: str = "paper",
     if period < 1:
         raise InvalidInputError("period must be >= 1, got %r" % (period,))
     opts = {**TIGHT, **options}
+    contact = opts.get("contact")
     if guess is not None:
-        guesses = [("given", _guess_z(guess, p))]
+        guesses = [("given", _guess_z(guess, p, contact, variant))]
     else:
-        guesses = default_guesses(p, variant, method, settle_time)
+        guesses = default_guesses(p, variant, method, settle_time,
+                                  **({} if contact is None else dict(contact=contact)))
     attempts = []
     for name, z0 in guesses:
         z, info = _newton(z0, period, p, variant, method, opts, tol, max_iter, fd_step, workers)
@@ -482,9 +428,12 @@ def _gait(p, variant, method, z, period, info, fd_step, opts, workers, guess_nam
     steps = info["steps"]
     orbit_z = [z] + [s["z"] for s in steps[:-1]]
     T = float(sum(s["period"] for s in steps))
+    contact = opts.get("contact")
+    names = section_names(contact)
     details = {
         "section": "touch-down of the swing foot (flags (1, 1)); legs relabelled so that leg 2 "
-                   "has just touched down; z = %s; x_D2 = y_D2 = 0" % (SECTION,),
+                   "has just touched down; z = %s; x_D2 = y_D2 = 0" % (names,),
+        "section_names": names, "section_units": section_units(contact),
         "z": z, "variant": variant, "method": method, "options": dict(opts), "fd_step": fd_step,
         "jacobian": J, "multipliers_check": m10, "residual": info["residual"],
         "newton_iterations": info["iterations"], "guess": guess_name, "period_n": period,
@@ -494,7 +443,7 @@ def _gait(p, variant, method, z, period, info, fd_step, opts, workers, guess_nam
         "travel": float(np.mean([s["travel"] for s in steps])),
         "cycle": float(np.mean([s["period"] for s in steps])),
     }
-    return Gait(state=embed(z, p), period=T,
+    return Gait(state=embed(z, p, contact), period=T,
                 step_length=float(np.mean([s["step_length"] for s in steps])),
                 double_support=float(np.mean([s["double_support"] for s in steps])),
                 multipliers=mult, model="continuous", params=p, details=details)
@@ -510,13 +459,19 @@ def detect_period(params=None, z0=None, variant="paper", method="rodas4", *, n_t
     Returns a dict: ``kind`` ("period", "fell" (or another failed step: ``status``), or
     "aperiodic": no period up to n_max within tol), ``n`` (the period, or None), ``Z`` (the
     iterates), ``distance`` (max|z_{k+n} - z_k| over the last n_max iterates for n = 1..n_max).
+    Step-map ``options`` default to `LOOSE`; with LuGre friction to `LOOSE_LUGRE` (at `LOOSE`
+    the bristle coordinate z1_um jitters by ~3e-6 um from step to step, above ``tol``).
     """
     p = _params(params)
-    opts = {**LOOSE, **options}
+    contact = options.get("contact")
+    loose = LOOSE_LUGRE if "z1_um" in section_names(contact) else LOOSE
+    opts = {**loose, **options}
     if z0 is None:
-        z0 = settle(X0_PAPER, p, variant, method, flags0=(0, 1), t_end=4.0)
+        z0 = settle(X0_PAPER, p, variant, method, flags0=(0, 1), t_end=4.0,
+                    **({} if contact is None else dict(contact=contact)))
         if z0 is None:
-            return dict(kind="fell", status="fell", n=None, Z=np.empty((0, 6)), distance={})
+            return dict(kind="fell", status="fell", n=None,
+                        Z=np.empty((0, len(section_names(contact)))), distance={})
     N = n_transient + 2 * n_max
     Z, info = orbit(z0, N, p, variant, method, **opts)
     if len(Z) < N + 1:

@@ -257,32 +257,6 @@ class Contact:
             return x
         return np.concatenate([x, np.zeros(self.nx - len(x))]) if len(x) < self.nx else x
 
-    def for_section(self, section) -> "Contact":
-        """This contact, for a Poincare map on ``section`` (names of the mechanical coordinates
-        it carries): refuses a friction law with more state (LuGre), saying why."""
-        if self.friction != "coulomb":
-            raise InvalidInputError(
-                "contact.friction = %r: the Poincare section (%s) carries the mechanical state "
-                "only; the trailing foot's bristle state would be re-initialised at every "
-                "section, so the map would not be the continuous run's. Use simulate(..., "
-                "contact=...) with periodic_steps to settle a LuGre gait instead"
-                % (self.friction, ", ".join(section)))
-        return self
-
-    def section_approach_speeds(self, x0, params: Params, variant: str):
-        """Approach speeds of both feet at a touch-down section (for the laws that use them;
-        else None). The foot that has just landed (leg 2) gets max(-v_y, 0), as the loop
-        captures it; the trailing leg 1 landed one step earlier, on a period-1 gait with the
-        same speed, which the section point does not otherwise hold. So a period-1 fixed point
-        of the map is the continuous run's periodic orbit (tests/test_contact_laws.py); off it,
-        the trailing foot's damping during the double support uses this step's landing speed
-        instead of the previous step's."""
-        if "e" not in LAW_PARAMETERS[self.normal]:
-            return None
-        from .model import contact_forces
-        v2 = max(-float(contact_forces(x0, params, flags=(1, 1), variant=variant).v_y[1]), 0.0)
-        return (v2, v2)
-
     def lugre_parameters(self, params: Params) -> dict:
         """LuGre's six parameters with the defaults filled in (sigma0, sigma1, sigma2, mu_s,
         mu_c, v_s)."""

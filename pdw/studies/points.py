@@ -171,12 +171,15 @@ def run_point(task) -> dict:
 
 
 def _newton_point(row, params, scene):
-    """Fill ``row`` from `pdw.find_gait` (default guesses); keeps ``row`` if none is found."""
+    """Fill ``row`` from `pdw.find_gait` (default guesses, the scene's contact laws); keeps
+    ``row`` if none is found."""
     from ..analysis.gait_types import GaitNotFoundError
     from ..analysis.limit_cycle import find_gait
+    c = scene.contact.to_contact()
+    law = {} if c.is_default else dict(contact=c)
     try:
         g = find_gait(params, variant=scene.variant, method=scene.integrator.method, workers=1,
-                      max_iter=12)
+                      max_iter=12, **law)
     except GaitNotFoundError as e:
         if row["status"] == "":
             row.update(status="no_gait", source="newton", error=str(e)[:200])
