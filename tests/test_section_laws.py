@@ -81,10 +81,31 @@ def test_default_section_and_gait_are_bitwise_main(default_gait):
     np.testing.assert_array_equal(g2.details["z"], z)
 
 
-def test_cell_mapping_refuses_a_section_with_extras(lugre):
-    for c in (lugre, FLORES):
-        with pytest.raises(pdw.InvalidInputError, match="not supported"):
-            CM.cell_map(P, phi=(0.7, 0.8, 2), thetad2=(-2, -1, 2), contact=c)
+def test_cell_mapping_with_section_extras(lugre, flores_gait):
+    """Cell mapping runs every law: a cell's extra section coordinates (LuGre's trailing
+    bristle, Flores's trailing approach speed) are the reference point's, as its four
+    non-grid mechanical ones; each image is the law's own step map from the cell's centre."""
+    zf = flores_gait.details["z"]
+    for c, n in ((FLORES, 7), (lugre, 7)):
+        cm = CM.cell_map(P, phi=(0.74, 0.78, 2), thetad2=(-1.9, -1.5, 1), contact=c, workers=2)
+        ref = cm.info["reference"]
+        assert len(ref) == n and cm.rest.shape == (2, n - 2) and cm.image_point.shape == (2, n)
+        np.testing.assert_array_equal(cm.rest[:, 4:], np.tile(ref[6:], (2, 1)))
+        A, B = cm.centers()
+        for k in range(2):
+            z = CM.cell_state(A[k], B[k], cm.rest[k], P)
+            assert len(z) == n and z[6] == ref[6]
+            s = LC.step(z, P, contact=c, t_hint=0.6, **LC.LOOSE)
+            assert s["status"] == "ok" and cm.status[k] in ("ok", "left")   # left: off the grid
+            np.testing.assert_array_equal(s["z"], cm.image_point[k])
+        if c is FLORES:
+            # the extras are not the default law's: the images move with the law
+            assert abs(ref[6] - 0.0) > 0.1                       # an approach speed [m/s]
+            conv, steps = CM.point_mapping_basin(cm, zf, n_steps=3, tol=10.0, workers=2)
+            assert conv.all() and (steps == 1).all()
+    with pytest.raises(pdw.InvalidInputError, match="reference"):
+        CM.cell_map(P, phi=(0.7, 0.8, 2), thetad2=(-2, -1, 2), contact=FLORES,
+                    reference=np.zeros(6))
 
 
 def test_section_sizes_embedding_and_names(lugre):

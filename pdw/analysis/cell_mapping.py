@@ -18,7 +18,10 @@ material-point velocity (v_x1, v_y1) are those of a reference section point (def
 touch-down of the paper's initial condition, `reference_point`, which does not use the fixed
 point); the hip velocity is derived from them (`cell_state`), so that changing phi does not
 kick the stance foot. (Keeping the hip velocity itself fixed would change the stance foot's
-velocity by ~1 cm/s per 0.025 rad of phi.)
+velocity by ~1 cm/s per 0.025 rad of phi.) A contact law with extra section coordinates
+(`pdw.limit_cycle.section_names`: LuGre's trailing bristle, the trailing approach speed of
+lankarani_nikravesh and flores) has them fixed at the reference point's values too, and
+``contact=`` goes with the step-map options.
 
 The slice map is very steep in phi: at `Params.paper_steady()` the image's thetad2 changes by
 about -25 rad/s per rad of phi (the next touch-down's timing moves the swing leg along its
@@ -46,45 +49,38 @@ SINK = -1
 GRID = ("phi", "thetad2")
 
 
-def _default_section(options, what):
-    """Refuse a contact law whose section has more than the 6 mechanical coordinates: the grid,
-    `cell_state` and `rest_of` are of those six only."""
-    names = lc.section_names(options.get("contact"))
-    if names != lc.SECTION:
-        raise InvalidInputError(
-            "%s: contact %r has the section coordinates %s; cell mapping's grid fixes the six "
-            "mechanical ones %s only (its extras %s would have no value): not supported, use "
-            "find_gait / detect_period with that law" % (
-                what, options.get("contact"), names, lc.SECTION, names[len(lc.SECTION):]))
-
-
-def reference_point(params=None, variant="paper", method="rodas4"):
-    """The section point of the first touch-down of the paper's initial condition (X0_PAPER,
-    flags (0, 1)); None if the walker does not get there."""
-    return lc.settle(X0_PAPER, params, variant, method, flags0=(0, 1), t_end=0.6)
+def reference_point(params=None, variant="paper", method="rodas4", contact=None):
+    """The section point (`pdw.limit_cycle.section_names` (contact)) of the first touch-down of
+    the paper's initial condition (X0_PAPER, flags (0, 1)) under ``contact``; None if the
+    walker does not get there."""
+    return lc.settle(X0_PAPER, params, variant, method, flags0=(0, 1), t_end=0.6,
+                     contact=contact)
 
 
 def cell_state(a, b, rest, params):
-    """Section point z of grid coordinates (phi, thetad2) and the four other coordinates
-    ``rest`` = (mean angle m, trailing foot's velocity v_x1, v_y1, thetad1): theta1 = m - phi/2,
+    """Section point z of grid coordinates (phi, thetad2) and the other coordinates ``rest`` =
+    (mean angle m, trailing foot's velocity v_x1, v_y1, thetad1, then the contact law's extra
+    section coordinates, if any, copied to z's end): theta1 = m - phi/2,
     theta2 = m + phi/2, and the hip velocity follows from the trailing foot's material-point
     velocity (docs/model.md section 2, consistent rate): xd_o = v_x1 - ((l - r) cos theta1 + r)
     thetad1, yd_o = v_y1 - (l - r) sin theta1 thetad1."""
-    m, vx, vy, w1 = rest
+    m, vx, vy, w1 = rest[:4]
     th1, th2 = m - 0.5 * a, m + 0.5 * a
     lr = params.l - params.r
     return np.array([th1, th2, vx - (lr * np.cos(th1) + params.r) * w1,
-                     vy - lr * np.sin(th1) * w1, w1, b])
+                     vy - lr * np.sin(th1) * w1, w1, b, *rest[4:]])
 
 
 def rest_of(z, params):
-    """The four non-grid coordinates (m, v_x1, v_y1, thetad1) of section point(s) z."""
+    """The non-grid coordinates (m, v_x1, v_y1, thetad1, then z's extras beyond the six
+    mechanical ones: `pdw.limit_cycle.section_names`) of section point(s) z."""
     z = np.asarray(z, dtype=float)
     th1, w1 = z[..., 0], z[..., 4]
     lr = params.l - params.r
     vx = z[..., 2] + (lr * np.cos(th1) + params.r) * w1
     vy = z[..., 3] + lr * np.sin(th1) * w1
-    return np.stack([0.5 * (z[..., 0] + z[..., 1]), vx, vy, w1], axis=-1)
+    return np.concatenate([np.stack([0.5 * (z[..., 0] + z[..., 1]), vx, vy, w1], axis=-1),
+                           z[..., 6:]], axis=-1)
 
 
 def grid_of(z):
@@ -230,22 +226,23 @@ def cell_map(params=None, variant="paper", phi=(0.69, 0.81, 80), thetad2=(-3.2, 
         Default `Params.paper_steady()`.
     phi, thetad2 : (lo, hi, n)
         The grid: n cells between lo and hi in each coordinate.
-    reference : array_like (6,), optional
-        Section point whose four non-grid coordinates the cells use (default `reference_point`).
+    reference : array_like (len(section_names(contact)),), optional
+        Section point whose non-grid coordinates the cells use (default `reference_point`).
     workers : int
         Threads for the map evaluations (default: all cores).
     progress : bool or pdw.Progress
         A bar over the cells on stderr when it is a terminal (`pdw.core.progress`).
     options
-        Step-map options (default `pdw.limit_cycle.LOOSE`: rtol 1e-7); a ``contact`` whose
-        section has extra coordinates (LuGre, lankarani_nikravesh, flores) is refused.
+        Step-map options (default `pdw.limit_cycle.LOOSE`: rtol 1e-7), ``contact`` among them:
+        a law with extra section coordinates (LuGre's trailing bristle, lankarani_nikravesh's
+        and flores's trailing approach speed) takes them from the reference point, as the
+        four non-grid mechanical coordinates.
 
     Returns
     -------
     CellMap
     """
     p = Params.paper_steady() if params is None else params
-    _default_section(options, "cell_map")
     opts = {**lc.LOOSE, **options}
     (a0, a1, na), (b0, b1, nb) = phi, thetad2
     if not (a1 > a0 and b1 > b0 and int(na) >= 1 and int(nb) >= 1):
@@ -253,7 +250,9 @@ def cell_map(params=None, variant="paper", phi=(0.69, 0.81, 80), thetad2=(-3.2, 
                                 % (phi, thetad2))
     a_edges = np.linspace(a0, a1, int(na) + 1)
     b_edges = np.linspace(b0, b1, int(nb) + 1)
-    z_ref = reference_point(p, variant, method) if reference is None else lc._z(reference)
+    contact = options.get("contact")
+    z_ref = (reference_point(p, variant, method, contact) if reference is None
+             else lc._z(reference, "reference", contact))
     if z_ref is None:
         raise InvalidInputError("no reference point: the paper's initial condition does not "
                                 "reach a touch-down with these parameters; pass reference=")
@@ -322,7 +321,6 @@ def point_mapping_basin(cm: CellMap, z_star, *, n_steps=12, tol=1e-4, workers=No
     """
     p = cm.params
     opts = {**cm.info.get("options", lc.LOOSE), **options}
-    _default_section(opts, "point_mapping_basin")
     A, B = cm.centers()
     Z = np.array([cell_state(A[c], B[c], cm.rest[c], p) for c in range(len(A))])
     z_star = np.asarray(z_star, dtype=float)
