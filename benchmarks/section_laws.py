@@ -5,7 +5,7 @@ friction, Flores (e = 0.18) and Lankarani-Nikravesh (e = 0.9), at the Newton tol
 and the return of a continuous run from the fixed point. Writes
 benchmarks/results/section_laws.txt (with --update-docs).
 
-Usage: .venv/bin/python benchmarks/section_laws.py   (~3 min on 2 cores, LuGre most of it)
+Usage: .venv/bin/python benchmarks/section_laws.py   (~11 s on 2 cores)
 """
 import pathlib
 import sys

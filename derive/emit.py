@@ -243,15 +243,20 @@ void @K@_rhs(const double *restrict x, const double *restrict p, const int *rest
     for (int i = 0; i < 2; ++i) xdot[PDW_X_Z1 + i] = contact[i*PDW_NCONTACT + PDW_CONTACT_ZDOT];
 }
 
-/* df/dx by central differences of @K@_rhs, step cbrt(eps) max(1, |x_j|) (relative error about
- * 1e-10 where f is smooth); leaves work at x, as the symbolic Jacobians do. */
+/* df/dx by central differences of @K@_rhs, step sqrt(eps) max(1, |x_j|) = 1.5e-8 max(1, |x_j|)
+ * (rounding error about 1e-8 relative); leaves work at x, as the symbolic Jacobians do. Not
+ * cbrt(eps) = 6e-6, the optimum for a smooth f: f has kinks (LuGre's |v|, the friction
+ * branches, the no-pull clamp), and a stuck foot's slip (~1e-6 m/s) lies within a 6e-6 step of
+ * LuGre's kink at v = 0, where a central difference averages the two sides (d|v|/dv -> v/h).
+ * rodas4, which needs the true Jacobian, then took 417 000 steps for 1 s of paper_steady at
+ * rtol 1e-10 (5 400 for dopri5); with the smaller step 5 800 (docs/contact_laws.md). */
 void @K@_jacobian(const double *restrict x, const double *restrict p, const int *restrict flags,
     const double *restrict anchors, double *restrict J, double *restrict work)
 {
     double xp[PDW_NX_LUGRE], fp[PDW_NX_LUGRE], fm[PDW_NX_LUGRE];
     for (int j = 0; j < PDW_NX_LUGRE; ++j) xp[j] = x[j];
     for (int j = 0; j < PDW_NX_LUGRE; ++j) {
-        const double h = 6.0554544523933395e-06 * fmax(1.0, fabs(x[j]));
+        const double h = 1.4901161193847656e-08 * fmax(1.0, fabs(x[j]));
         xp[j] = x[j] + h;
         const double hp = xp[j] - x[j];
         @K@_rhs(xp, p, flags, anchors, fp, work);

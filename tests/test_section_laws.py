@@ -158,9 +158,10 @@ def test_lugre_continuation_points_are_fixed_points(lugre_gait, lugre):
     assert b.stable.all()
 
 
-@pytest.mark.slow
 def test_lugre_find_gait_at_the_newton_tolerances(lugre_gait, lugre):
-    """The accurate search (default guesses, rtol 1e-10): ~2 min on 2 threads."""
+    """The accurate search (default guesses, rtol 1e-10): ~1.4 s on 2 threads (136 s with the
+    LuGre kernels' first finite-difference Jacobian step, cbrt(eps), which made rodas4 take
+    ~70x the steps: docs/contact_laws.md, "Integrators")."""
     g = LC.find_gait(P, contact=lugre, workers=2)
     assert g.details["residual"] < 1e-9 and len(g.multipliers) == 7 and g.stable
     np.testing.assert_allclose(g.details["z"], lugre_gait.details["z"], atol=1e-6)

@@ -12,9 +12,9 @@ recorded end points and their derivatives under the interval's discrete state:
 
 The state is the run's, nx entries (8; 10 with LuGre's bristle states z1, z2, whose f is the
 LuGre kernel's). x'' comes from the symbolic Jacobian where the kernel has one (the Coulomb
-law's kernels); LuGre's kernels have a fixed-step finite-difference Jacobian, which would make
-the quintic second order, so there x'' is a fourth-order difference of f along f with a step
-proportional to h (`DenseOutput._along`): still O(h^6). The loops reset a foot's z to 0 at its
+law's kernels); with LuGre's kernels (a finite-difference Jacobian, 21 right-hand sides) x'' is
+a fourth-order difference of f along f with a step proportional to h (`DenseOutput._along`,
+4 right-hand sides, independent of a Jacobian's step across |v|'s kink): still O(h^6). The loops reset a foot's z to 0 at its
 touch-down before recording that step, so the recorded sample starts the next interval; the
 interval before it ends at the swing value of z (`_left_limits`).
 
