@@ -292,6 +292,37 @@ def test_cli_continue_writes_csv_json_and_diagram(tmp_path, capsys):
     assert "period_doubling" in capsys.readouterr().out
 
 
+def test_cli_continue_with_a_contact_section(tmp_path):
+    """A continuation spec's [contact] selects the laws (continuous model): the branch's
+    points are fixed points of that law's map (7 section coordinates for Flores: its trailing
+    approach speed), not of the default law's; a bad law or a rigid model is refused."""
+    import json
+
+    from pdw.analysis import limit_cycle as LC
+    from pdw.present.cli_continue import load_spec, run_spec
+    spec_file = tmp_path / "flores.toml"
+    spec_file.write_text('name = "flores_k_hip"\nmodel = "continuous"\npreset = "paper_steady"\n'
+                         'parameter = "k_hip"\nstop = 1.0\nstart = 0.95\n'
+                         '[continuation]\nstep = 0.01\nmax_points = 2\nworkers = 2\n'
+                         'detect = []\n[contact]\nnormal = "flores"\ne = 0.18\n')
+    spec = load_spec(spec_file)
+    (b,), paths = run_spec(spec, out=tmp_path)
+    assert len(b) == 2 and b.z.shape == (2, 7)
+    flores = pdw.Contact("flores", e=0.18)
+    P = pdw.Params.paper_steady()
+    for k in range(2):
+        Pk = P.replace(k_hip=b.values[k])
+        assert np.max(np.abs(LC.step_map(b.z[k], Pk, contact=flores) - b.z[k])) < 1e-8
+    with open(paths["json"], encoding="utf-8") as fh:
+        assert "flores" in json.load(fh)["spec"]["toml"]
+    for bad, match in (('[contact]\nnormal = "rubber"\n', r"\[contact\].*normal"),
+                       ('model = "hybrid"\n[contact]\nnormal = "flores"\n', "rigid ground")):
+        f = tmp_path / "bad.toml"
+        f.write_text('name = "x"\nparameter = "k_hip"\nstop = 1.0\n' + bad)
+        with pytest.raises(pdw.InvalidInputError, match=match):
+            load_spec(f)
+
+
 def test_diagram_draws_stable_solid_and_unstable_dashed(cascade):
     import matplotlib
     matplotlib.use("Agg")

@@ -22,6 +22,10 @@ The spec (docs/continuation.md; examples in pdw/examples/continuations/, run by
     step = 0.001                      # cascade = 2: switch at the period doublings twice
     cascade = 2
 
+    [contact]                         # optional (continuous model): the contact laws, as a
+    normal = "flores"                 # scene's [contact] / pdw.Contact (docs/contact_laws.md)
+    e = 0.18
+
     [plot]
     y = "step_length"                 # pdw.present.plots_continuation.QUANTITIES
     x_scale = 57.29577951308232       # e.g. radians -> degrees
@@ -47,6 +51,7 @@ import numpy as np
 from .. import examples
 from ..analysis.branch import _jsonable
 from ..analysis.continuation import continue_gait, follow_cascade
+from ..core.contact import Contact
 from ..core.errors import InvalidInputError
 from ..core.params import Params
 
@@ -56,7 +61,7 @@ except ImportError:                                    # pragma: no cover - Pyth
     import tomli as tomllib
 
 KEYS = {"name", "title", "model", "preset", "variant", "parameter", "stop", "start", "params",
-        "couple", "continuation", "plot"}
+        "couple", "continuation", "contact", "plot"}
 CONTINUATION_KEYS = {"step", "method", "max_points", "step_min", "step_max", "tol",
                      "locate_tol", "log", "detect", "max_newton", "fd_step", "options",
                      "cascade", "period", "workers"}
@@ -94,6 +99,14 @@ def load_spec(path) -> dict:
     if bad:
         raise InvalidInputError("%s: [continuation] unknown key(s) %s; allowed: %s"
                                 % (path, sorted(bad), sorted(CONTINUATION_KEYS)))
+    if "contact" in spec:
+        if spec.get("model", "continuous") != "continuous":
+            raise InvalidInputError("%s: [contact] is a section of the continuous model's specs; "
+                                    "model = %r has rigid ground" % (path, spec.get("model")))
+        try:
+            spec["contact"] = Contact.coerce(dict(spec["contact"])).as_dict()
+        except InvalidInputError as e:
+            raise InvalidInputError("%s: [contact] %s" % (path, e)) from None
     spec["_source"], spec["_path"] = text, str(path)
     return spec
 
@@ -106,6 +119,8 @@ def run_spec(spec, out=None, progress=False):
     couple = dict(spec.get("couple", {}))
     kw = dict(spec.get("continuation", {}))
     depth = int(kw.pop("cascade", 0))
+    if spec.get("contact"):
+        kw["options"] = {**kw.get("options", {}), "contact": Contact.coerce(spec["contact"])}
     start = spec.get("start", getattr(params, par, None))
     params_of = None
     if couple:
