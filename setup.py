@@ -19,6 +19,8 @@ extra = ["-O3", "-std=c99", "-fno-math-errno"] + ([] if DEBUG else ["-g0"]) \
 link = [] if DEBUG or not sys.platform.startswith("linux") else ["-s"]
 hybrid = ["pdw/core/_hybrid.pyx", "generated/pdw_hybrid.c", CSRC + "/pdw_hybrid_sim.c",
           CSRC + "/pdw_hybrid_var.c"]
+# the hybrid integrators read dopri5's coefficients from the one tableau (pdw_dp5.h)
+hybrid_extra = [CSRC + "/pdw_tableaus.c"]
 batch = sorted(glob.glob(CSRC + "/pdw_batch*.c"))
 loops = sorted(set(glob.glob(CSRC + "/*.c")) - set(hybrid) - set(batch))
 sources = ["pdw/core/_core.pyx", "generated/pdw_model.c"] + loops
@@ -46,7 +48,7 @@ setup(
                    depends=depends,
                    extra_compile_args=extra + BATCH_FLAGS, extra_link_args=link,
                    libraries=["mvec", "m"]),
-         Extension("pdw.core._hybrid", sources=hybrid, include_dirs=["generated", CSRC],
+         Extension("pdw.core._hybrid", sources=hybrid + hybrid_extra, include_dirs=["generated", CSRC],
                    extra_compile_args=extra, extra_link_args=link, libraries=["m"],
                    depends=depends)],
         compiler_directives={"language_level": "3", "boundscheck": False, "wraparound": False,

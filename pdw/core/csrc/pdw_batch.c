@@ -42,17 +42,17 @@ static void finish(const pdw_batch_job *job, long i, const pdw_sim *s)
 
 /* Load walker i into lane s and take the start-up of pdw_cdm_advance. Returns 1 if the walker
  * is still running, 0 if it finished at once (a stop condition at t = 0). */
-static int start(const pdw_batch_job *job, long i, pdw_sim *s)
+/* What every lane takes of walker i, whatever the method: its parameters, fall limits, stop
+ * conditions, initial state and discrete state (pdw_discrete_init last, on the loaded x). The
+ * caller sets the method's own fields first (s zeroed here). */
+static void load_walker(const pdw_batch_job *job, long i, pdw_sim *s)
 {
-    const double dt = job->dt;
     int flags0[2];
-    memset(s, 0, sizeof *s);
     s->kernel = job->kernel;
     s->nx = PDW_NX;             /* the smooth Coulomb law only (_batch.pyx checks) */
     memcpy(s->p, job->p + i*job->p_stride, PDW_NP * sizeof(double));
-    s->dt = dt;
+    s->dt = job->dt;
     s->n_steps = job->n_steps;
-    s->t_end = job->n_steps * dt;
     s->fall_hip_height = job->fall_hip_height[i];
     s->fall_depth = job->fall_depth[i];
     s->max_speed = job->max_speed;
@@ -64,6 +64,13 @@ static int start(const pdw_batch_job *job, long i, pdw_sim *s)
     flags0[0] = job->flags0[2*i];
     flags0[1] = job->flags0[2*i + 1];
     pdw_discrete_init(s->kernel, s->p, s->x, flags0, &s->disc, s->work);
+}
+
+static int start(const pdw_batch_job *job, long i, pdw_sim *s)
+{
+    memset(s, 0, sizeof *s);
+    s->t_end = job->n_steps * job->dt;
+    load_walker(job, i, s);
     /* pdw_cdm_advance's start-up (no events stored: the update cannot return -1) */
     s->status = PDW_STATUS_RUNNING;
     if (pdw_update_flags(s, 0.0) > 0) { s->started = 1; return 0; }
@@ -161,35 +168,19 @@ long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *l
  * pdw_sim (nothing recorded, events only counted), polling after every step. */
 static void start_method(const pdw_batch_job *job, long i, pdw_sim *s)
 {
-    int flags0[2];
     const pdw_method *m = &pdw_methods[job->method];
     memset(s, 0, sizeof *s);
-    s->kernel = job->kernel;
-    s->nx = PDW_NX;             /* the smooth Coulomb law only (_batch.pyx checks) */
-    memcpy(s->p, job->p + i*job->p_stride, PDW_NP * sizeof(double));
     s->t_end = job->t_end;
     s->rtol = job->rtol;
     s->atol = job->atol;
     s->h_max = job->h_max > 0 ? job->h_max : job->t_end;
     s->h = job->dt;
     s->event_tol = job->event_tol;
-    s->dt = job->dt;
-    s->n_steps = job->n_steps;
-    s->fall_hip_height = job->fall_hip_height[i];
-    s->fall_depth = job->fall_depth[i];
-    s->max_speed = job->max_speed;
     s->max_steps = m->adaptive ? job->max_steps : 0;
     /* a poll every 2 loop iterations returns after each (accepted) step: the drivers poll at
      * the top of an iteration, where a resumed call continues exactly */
     s->poll_every = 2;
-    s->stop_steps = job->stop_steps;
-    s->periodic_k = job->periodic_k;
-    s->periodic_tol = job->periodic_tol;
-    pdw_gait_init(&s->gait);
-    memcpy(s->x, job->x0 + i*PDW_NX, PDW_NX * sizeof(double));
-    flags0[0] = job->flags0[2*i];
-    flags0[1] = job->flags0[2*i + 1];
-    pdw_discrete_init(s->kernel, s->p, s->x, flags0, &s->disc, s->work);
+    load_walker(job, i, s);
 }
 
 /* Every PDW_BATCH_POLL rounds: job->poll; if it says stop, write the running walkers as they

@@ -14,6 +14,7 @@
 #include <math.h>
 #include <string.h>
 #include "pdw_hybrid_sim.h"
+#include "pdw_dp5.h"
 
 #define NY 4
 
@@ -34,18 +35,6 @@ void pdw_hybrid_default_opts(pdw_hybrid_opts *o)
 }
 
 /* ---- Dormand-Prince 5(4) ---------------------------------------------------------------- */
-static const double C2 = 1.0/5, C3 = 3.0/10, C4 = 4.0/5, C5 = 8.0/9;
-static const double A21 = 1.0/5;
-static const double A31 = 3.0/40, A32 = 9.0/40;
-static const double A41 = 44.0/45, A42 = -56.0/15, A43 = 32.0/9;
-static const double A51 = 19372.0/6561, A52 = -25360.0/2187, A53 = 64448.0/6561,
-                    A54 = -212.0/729;
-static const double A61 = 9017.0/3168, A62 = -355.0/33, A63 = 46732.0/5247, A64 = 49.0/176,
-                    A65 = -5103.0/18656;
-static const double B1 = 35.0/384, B3 = 500.0/1113, B4 = 125.0/192, B5 = -2187.0/6784,
-                    B6 = 11.0/84;
-static const double E1 = 71.0/57600, E3 = -71.0/16695, E4 = 71.0/1920, E5 = -17253.0/339200,
-                    E6 = 22.0/525, E7 = -1.0/40;
 
 typedef struct stepper {
     const double *p;
@@ -68,7 +57,6 @@ static void dopri(stepper *s, const double *y, const double *k1, double h, doubl
                   double *k7, double *err)
 {
     double k2[NY], k3[NY], k4[NY], k5[NY], k6[NY], t[NY];
-    (void)C2; (void)C3; (void)C4; (void)C5;   /* autonomous system: the nodes are not needed */
     for (int i = 0; i < NY; ++i) t[i] = y[i] + h*A21*k1[i];
     f(s, t, k2);
     for (int i = 0; i < NY; ++i) t[i] = y[i] + h*(A31*k1[i] + A32*k2[i]);
