@@ -40,10 +40,12 @@ test: $(STAMP)
 	$(MAKE) --no-print-directory lint
 	$(PY) -m pytest -q
 
-## lint: ruff (rules in pyproject.toml) and the import contract (layers, no cycles: docs/architecture.md)
+## lint: ruff (rules in pyproject.toml), the import contract (layers, no cycles: docs/architecture.md)
+## and mypy on the public modules ([tool.mypy] in pyproject.toml)
 lint: $(STAMP)
 	$(VENV)/bin/ruff check pdw tests benchmarks derive
 	$(VENV)/bin/lint-imports --no-cache
+	$(VENV)/bin/mypy
 
 ## test-all: also the slow studies
 test-all: $(STAMP)

@@ -32,6 +32,7 @@ branch, tangent to (v, 0), does.
 """
 from __future__ import annotations
 
+import copy
 import time
 from concurrent.futures import Executor
 from typing import Callable, Literal, Sequence
@@ -342,8 +343,7 @@ def switch_branch(branch, bifurcation, amplitude=0.005, max_tries=6) -> Gait:
                                 % bifurcation.kind)
     p1 = branch.problem
     s = branch.settings
-    prob = type(p1).__new__(type(p1))
-    prob.__dict__.update(p1.__dict__)
+    prob = copy.copy(p1)
     prob.period = 2 * p1.period
     prob.n_maps = 0
     if hasattr(prob, "ref_events"):

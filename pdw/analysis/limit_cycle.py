@@ -192,7 +192,7 @@ def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max
             break
     if record:
         out["result"] = res
-    if td is None:
+    if td is None or lo is None:      # (leg 1 touches down only after its lift-off)
         out["status"] = res.status if res.status != "walked" else "no_touch_down"
         return out
     i = int(np.argmin(np.abs(res.t - td.t)))

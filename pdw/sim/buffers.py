@@ -62,10 +62,10 @@ class RecordBuffer:
         if rows > self.capacity:
             self._alloc(rows)
         n = self.capacity
-        x = self.x
+        x, states = self.x, self._states
         if (isinstance(x, np.ndarray) and x.ndim == 2 and x.shape != (n, nx)
-                and x.base is self._states and n * nx <= self._states.size):
-            self.x = self._states[:n * nx].reshape(n, nx)     # the same memory, another width
+                and x.base is states and states is not None and n * nx <= states.size):
+            self.x = states[:n * nx].reshape(n, nx)     # the same memory, another width
         for name, a, shape, dtype in (("t", self.t, (n,), np.float64),
                                       ("x", self.x, (n, nx), np.float64),
                                       ("flags", self.flags, (n, 2), np.intc),
