@@ -192,7 +192,9 @@ def _contact_function(fname, exprs, fields, names, ops, key):
         "%s\n        } else {\n%s\n        }\n    }" % (code, zero))
 
 
-COMPOSED = """\
+# The right-hand side of every kernel, composed from its stages; @M@ names the kernel whose
+# mechanical stages (dynamics) it uses, @Z@ is the bristle states' line of LuGre's kernels.
+RHS = """\
 void @K@_rhs(const double *restrict x, const double *restrict p, const int *restrict flags,
     const double *restrict anchors, double *restrict xdot, double *restrict work)
 {
@@ -202,11 +204,16 @@ void @K@_rhs(const double *restrict x, const double *restrict p, const int *rest
     pdw_trig(x, trig);
     @K@_kinematics(x, trig, p, anchors, kin);
     @K@_contact(kin, flags, p, contact);
-    @K@_dynamics(x, trig, p, contact, M, f);
+    @M@_dynamics(x, trig, p, contact, M, f);
     pdw_solve_dblock(M, f, qdd);
     for (int i = 0; i < PDW_NQ; ++i) { xdot[i] = x[PDW_NQ + i]; xdot[PDW_NQ + i] = qdd[i]; }
-}
+@Z@}
+"""
+LUGRE_Z = ("    for (int i = 0; i < 2; ++i) xdot[PDW_X_Z1 + i] = "
+           "contact[i*PDW_NCONTACT + PDW_CONTACT_ZDOT];\n")
 
+
+COMPOSED = RHS.replace("@M@", "@K@").replace("@Z@", "") + """
 void @K@_jacobian(const double *restrict x, const double *restrict p, const int *restrict flags,
     const double *restrict anchors, double *restrict J, double *restrict work)
 {
@@ -227,22 +234,7 @@ void @K@_jacobian(const double *restrict x, const double *restrict p, const int 
 """
 
 
-COMPOSED_LUGRE = """\
-void @K@_rhs(const double *restrict x, const double *restrict p, const int *restrict flags,
-    const double *restrict anchors, double *restrict xdot, double *restrict work)
-{
-    double *trig = work + PDW_WORK_TRIG, *kin = work + PDW_WORK_KIN;
-    double *contact = work + PDW_WORK_CONTACT, *M = work + PDW_WORK_M;
-    double *f = work + PDW_WORK_F, *qdd = work + PDW_WORK_QDD;
-    pdw_trig(x, trig);
-    @K@_kinematics(x, trig, p, anchors, kin);
-    @K@_contact(kin, flags, p, contact);
-    @M@_dynamics(x, trig, p, contact, M, f);
-    pdw_solve_dblock(M, f, qdd);
-    for (int i = 0; i < PDW_NQ; ++i) { xdot[i] = x[PDW_NQ + i]; xdot[PDW_NQ + i] = qdd[i]; }
-    for (int i = 0; i < 2; ++i) xdot[PDW_X_Z1 + i] = contact[i*PDW_NCONTACT + PDW_CONTACT_ZDOT];
-}
-
+COMPOSED_LUGRE = RHS.replace("@Z@", LUGRE_Z) + """
 /* df/dx by central differences of @K@_rhs, step sqrt(eps) max(1, |x_j|) = 1.5e-8 max(1, |x_j|)
  * (rounding error about 1e-8 relative); leaves work at x, as the symbolic Jacobians do. Not
  * cbrt(eps) = 6e-6, the optimum for a smooth f: f has kinks (LuGre's |v|, the friction
