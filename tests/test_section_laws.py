@@ -197,3 +197,16 @@ def test_flores_map_off_the_fixed_point_is_the_continuous_run(flores_gait):
     # the old section: both feet at the leading foot's speed
     old = S.extend(z[:6], P, FLORES)
     assert np.max(np.abs(LC.step_map(old, P, contact=FLORES, **LC.TIGHT)[:6] - Z[1][:6])) > 1e-5
+
+
+def test_kelvin_voigt_period_one_gait_is_unstable_by_a_flip():
+    """Calibrated like the others (same sink, same landing restitution), Kelvin-Voigt's
+    period-1 gait on paper_steady exists but is unstable with a real multiplier near -1.45 (a
+    flip), which is why its walk stays irregular (docs/contact_laws.md)."""
+    from pdw.analysis.calibration import calibrate
+    kv = calibrate(P).contacts["kelvin_voigt"]
+    g = LC.find_gait(P, contact=kv, workers=2)
+    m = g.multipliers[0]
+    assert g.details["residual"] < 1e-9 and not g.stable
+    assert abs(m.imag) < 1e-9 and -1.6 < m.real < -1.3, g.multipliers
+    assert abs(g.step_length - 0.34596) < 1e-4
