@@ -313,8 +313,9 @@ def plot_basin(cm: CellMap, ax=None, fixed_point=None, title=None, max_steps=8):
 def point_mapping_basin(cm: CellMap, z_star, *, n_steps=12, tol=1e-4, workers=None,
                         progress=False, **options):
     """Check of a cell map against the full dynamics: from every cell's centre state, iterate
-    the touch-down map (6-D, no cells) up to ``n_steps`` steps; a cell is in the basin when the
-    orbit comes within ``tol`` (max norm) of the fixed point ``z_star``.
+    the touch-down map (the whole section: 6-D, more with a law's extras; no cells) up to
+    ``n_steps`` steps; a cell is in the basin when the orbit comes within ``tol`` (max norm) of
+    the fixed point ``z_star``.
 
     Returns (converged, steps): boolean mask (N,) and the number of steps taken (N,) (-1 when
     a step failed). ``progress``: False, True or a `pdw.Progress` (one unit per cell).
