@@ -6,7 +6,9 @@ a few of which fall), no recording. Interleaved in one process, round by round: 
 `pdw.simulate_batch` with W lanes: every cdm lane loop this CPU runs (PDW_BATCH_ISA: "scalar" =
 the generated scalar stages per lane, then the structure-of-arrays step compiled for the
 baseline, AVX2, AVX-512F), bitwise (libm sin/cos) and vector (libmvec sin/cos), on 1 thread,
-then on 2 threads; and rodas4 (rtol 1e-6, atol 1e-8) scalar against batch, per accepted step.
+then on 2 threads; and rodas4 (rtol 1e-6, atol 1e-8) scalar against batch, per accepted step,
+on every rodas4 lane loop ("scalar" = the scalar rodas4 per lane, then its structure-of-arrays
+try step per instruction set).
 Medians of ROUNDS rounds; the load average is printed before and after (the machine is shared:
 read the ratios, taken in the same rounds, before the times).
 
@@ -65,9 +67,15 @@ def main():
                                 record_events=False, on_failure="return",
                                 check_step="off").n_steps for xi in x)
 
-    def batch_rodas(threads):
-        return lambda: int(pdw.simulate_batch(x, t_end=T_END, method="rodas4", rtol=RTOL,
-                                              threads=threads).n_steps.sum())
+    def batch_rodas(lanes, threads, isa=best):
+        def run():
+            os.environ[ISA_ENV] = isa
+            try:
+                return int(pdw.simulate_batch(x, t_end=T_END, method="rodas4", rtol=RTOL,
+                                              lanes=lanes, threads=threads).n_steps.sum())
+            finally:
+                os.environ.pop(ISA_ENV)
+        return run
 
     isas = [n for n in ("scalar", "base", "avx2", "avx512") if _batch.isa_supported(n)]
     cases = [("scalar simulate, 1 thread", scalar, 1)]
@@ -76,9 +84,10 @@ def main():
               ("batch W=16 vector %s, 1 thr" % best, batch(16, True, 1), 1),
               ("batch W=8 bitwise %s, 2 thr" % best, batch(8, False, 2), 2),
               ("batch W=8 vector %s, 2 thr" % best, batch(8, True, 2), 2),
-              ("rodas4: scalar simulate, 1 thr", scalar_rodas, 1),
-              ("rodas4: batch W=8, 1 thr", batch_rodas(1), 1),
-              ("rodas4: batch W=8, 2 thr", batch_rodas(2), 2)]
+              ("rodas4: scalar simulate, 1 thr", scalar_rodas, 1)]
+    cases += [("rodas4: batch W=8 %s, 1 thr" % n, batch_rodas(8, 1, n), 1) for n in isas]
+    cases += [("rodas4: batch W=16 %s, 1 thr" % best, batch_rodas(16, 1), 1),
+              ("rodas4: batch W=8 %s, 2 thr" % best, batch_rodas(8, 2), 2)]
     times = {name: [] for name, _, _ in cases}
     cpu = {name: [] for name, _, _ in cases}
     steps = {}
@@ -93,7 +102,7 @@ def main():
              "rodas4 rtol = %g), %d rounds interleaved, medians" % (N, DT, T_END, RTOL, ROUNDS),
              "load average before %.2f %.2f %.2f, after %.2f %.2f %.2f (%d cores); widest "
              "lane loop this CPU runs: %s" % (load0 + load1 + (os.cpu_count(), best)),
-             "%-32s %11s %10s %12s %12s %10s" % ("case", "wall ns/ws", "vs scalar", "CPU ns/ws",
+             "%-36s %11s %10s %12s %12s %10s" % ("case", "wall ns/ws", "vs scalar", "CPU ns/ws",
                                                  "ws/CPU-s", "vs scalar"),
              ]
     for name, _, _ in cases:
@@ -102,7 +111,7 @@ def main():
         ref_cpu = statistics.median(cpu[base]) / steps[base]
         per = statistics.median(times[name]) / steps[name]
         per_cpu = statistics.median(cpu[name]) / steps[name]
-        lines.append("%-32s %11.1f %9.2fx %12.1f %12.3g %9.2fx" % (
+        lines.append("%-36s %11.1f %9.2fx %12.1f %12.3g %9.2fx" % (
             name, per * 1e9, ref / per, per_cpu * 1e9, 1 / per_cpu, ref_cpu / per_cpu))
     lines.append("ws = walker-step (rodas4: accepted step, vs the scalar rodas4 loop). wall: elapsed time / walker-steps (2 threads: both cores); "
                  "CPU: process CPU time / walker-steps, i.e. the cost per core (less sensitive "

@@ -1,4 +1,8 @@
-"""Emit ``generated/pdw_batch_gen.h``: structure-of-arrays (SoA) variants of the cdm stages.
+"""Emit ``generated/pdw_batch_gen.h``: structure-of-arrays (SoA) variants of the stages.
+
+The cdm lane loop (pdw/core/csrc/pdw_batch_soa.inc) takes kinematics, contact and cdm_terms;
+rodas4's (pdw/core/csrc/pdw_batch_ros.inc) kinematics, contact and dynamics for its right-hand
+side, and contact_partials and dynamics_jacobian for its Jacobian.
 
 A batched stage computes one stage of the scalar kernel for W walkers at once, one per lane:
 every array of the scalar stage (``x``, ``p``, ``trig``, ``anchors``, ``kin``, ``contact``,
@@ -49,7 +53,8 @@ def _function(signature, body):
 
 
 def emit_kernel(spec, names, c_block, nforces):
-    """C source of the batched kinematics, contact and cdm_terms stages of one kernel."""
+    """C source of the batched stages of one kernel: kinematics, contact, cdm_terms (the cdm lane
+    loop), contact_partials, dynamics and dynamics_jacobian (the rodas4 lane loop)."""
     k = "pdw_soa_" + spec.name
     soa = {s: _soa(c) for s, c in names.items()}
     out = ["/* ---- kernel %s, batched (SoA) ---- */\n" % spec.name]
@@ -62,9 +67,38 @@ def emit_kernel(spec, names, c_block, nforces):
         "    const double *restrict p, const double *restrict anchors, double *restrict kin)" % k,
         "    (void)anchors;\n" + LOOP % code))
 
-    fields = layout.CONTACT[:nforces]
+    for suffix, nout in (("contact", nforces), ("contact_partials", len(layout.CONTACT))):
+        out.append(_contact_function(k + "_" + suffix, stages.contact(spec)[:nout],
+                                     layout.CONTACT[:nout], soa, c_block))
+    targets = [_soa("M[%d]" % i) for i in range(16)] + [_soa("C[%d]" % i) for i in range(16)] \
+        + [_soa("QmG[%d]" % i) for i in range(4)]
+    code, _ = c_block(stages.cdm_terms(spec), targets, soa, indent="        ")
+    out.append(_function(
+        "static void %s_cdm_terms(int W, const double *restrict x, const double *restrict trig,\n"
+        "    const double *restrict p, const double *restrict contact,\n"
+        "    double *restrict M, double *restrict C, double *restrict QmG)" % k, LOOP % code))
+
+    # the right-hand side's and the Jacobian's stages (the lane loop of rodas4, pdw_batch_ros.inc)
+    targets = [_soa("M[%d]" % i) for i in range(16)] + [_soa("f[%d]" % i) for i in range(4)]
+    code, _ = c_block(stages.dynamics(spec), targets, soa, indent="        ")
+    out.append(_function(
+        "static void %s_dynamics(int W, const double *restrict x, const double *restrict trig,\n"
+        "    const double *restrict p, const double *restrict contact,\n"
+        "    double *restrict M, double *restrict f)" % k, LOOP % code))
+
+    targets = [_soa("A[%d]" % i) for i in range(32)]
+    code, _ = c_block(stages.dynamics_jacobian(spec), targets, soa, indent="        ")
+    out.append(_function(
+        "static void %s_dynamics_jacobian(int W, const double *restrict x,\n"
+        "    const double *restrict trig, const double *restrict p, const double *restrict contact,\n"
+        "    const double *restrict qdd, double *restrict A)" % k, LOOP % code))
+    return "\n".join(out)
+
+
+def _contact_function(fname, exprs, fields, soa, c_block):
+    """A batched contact stage: the scalar stage's branch (a penetrating support foot) as a
+    mask, every lane evaluating the law and keeping it only where its foot is one."""
     outs = ["o_%s" % f.lower() for f in fields]
-    exprs = stages.contact(spec)[:nforces]
     # the parameters as locals loaded up front: the law's branches then hold no loads, and the
     # compiler turns them into selects (a branch with a load would need a masked load)
     used = set().union(*(e.free_symbols for e in exprs))
@@ -75,9 +109,9 @@ def emit_kernel(spec, names, c_block, nforces):
     code = loads + code
     store = "\n".join("            c[PDW_CONTACT_%s*PDW_SOA + l] = on ? %s : 0.0;"
                       % (f.upper(), o) for f, o in zip(fields, outs))
-    out.append(_function(
-        "static void %s_contact(int W, const double *restrict kin, const int *restrict flags,\n"
-        "    const double *restrict p, double *restrict contact)" % k,
+    return _function(
+        "static void %s(int W, const double *restrict kin, const int *restrict flags,\n"
+        "    const double *restrict p, double *restrict contact)" % fname,
         "    for (int i = 0; i < 2; ++i) {\n"
         "        const double *restrict ki = kin + i*PDW_NKIN*PDW_SOA;\n"
         "        double *restrict c = contact + i*PDW_NCONTACT*PDW_SOA;\n"
@@ -94,16 +128,7 @@ def emit_kernel(spec, names, c_block, nforces):
         "            const double v_in = ki[PDW_KIN_V_IN*PDW_SOA + l];\n"
         "            (void)delta; (void)deltad; (void)v_t; (void)xi; (void)v_in;\n"
         "            double %s;\n"
-        "%s\n%s\n        }\n        }\n    }" % (", ".join(outs), code, store)))
-
-    targets = [_soa("M[%d]" % i) for i in range(16)] + [_soa("C[%d]" % i) for i in range(16)] \
-        + [_soa("QmG[%d]" % i) for i in range(4)]
-    code, _ = c_block(stages.cdm_terms(spec), targets, soa, indent="        ")
-    out.append(_function(
-        "static void %s_cdm_terms(int W, const double *restrict x, const double *restrict trig,\n"
-        "    const double *restrict p, const double *restrict contact,\n"
-        "    double *restrict M, double *restrict C, double *restrict QmG)" % k, LOOP % code))
-    return "\n".join(out)
+        "%s\n%s\n        }\n        }\n    }" % (", ".join(outs), code, store))
 
 
 HEADER = """\
@@ -136,6 +161,13 @@ typedef struct pdw_soa_kernel {{
                     double *contact);
     void (*cdm_terms)(int W, const double *x, const double *trig, const double *p,
                       const double *contact, double *M, double *C, double *QmG);
+    /* the right-hand side's and the Jacobian's (rodas4's lane loop) */
+    void (*contact_partials)(int W, const double *kin, const int *flags, const double *p,
+                             double *contact);
+    void (*dynamics)(int W, const double *x, const double *trig, const double *p,
+                     const double *contact, double *M, double *f);
+    void (*dynamics_jacobian)(int W, const double *x, const double *trig, const double *p,
+                              const double *contact, const double *qdd, double *A);
 }} pdw_soa_kernel;
 
 {body}
@@ -153,8 +185,10 @@ def header(banner, h, kernels, names_of, c_block, nforces):
     body, rows = [], []
     for spec in kernels:
         if spec.normal != "hunt_crossley" or getattr(spec, "friction", "coulomb") != "coulomb":
-            rows.append("    {NULL, NULL, NULL},   /* %s */" % spec.name)
+            rows.append("    {NULL, NULL, NULL, NULL, NULL, NULL},   /* %s */" % spec.name)
             continue
         body.append(emit_kernel(spec, names_of(spec), c_block, nforces))
-        rows.append("    {%s_kinematics, %s_contact, %s_cdm_terms}," % (("pdw_soa_" + spec.name,) * 3))
+        rows.append("    {%s_kinematics, %s_contact, %s_cdm_terms,\n"
+                    "     %s_contact_partials, %s_dynamics, %s_dynamics_jacobian},"
+                    % (("pdw_soa_" + spec.name,) * 6))
     return HEADER.format(banner=banner, hash=h, body="\n".join(body), table="\n".join(rows))

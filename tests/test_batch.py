@@ -258,6 +258,46 @@ def test_every_lane_loop_is_bitwise_the_scalar_run(isa, variant, n, lanes, monke
 
 
 @pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("variant, n, lanes, threads", [("paper", 13, 8, 1), ("consistent", 7, 3, 1),
+                                                        ("paper", 70, 64, 1), ("paper", 21, 4, 2)])
+def test_every_rodas4_lane_loop_is_bitwise_the_scalar_run(isa, variant, n, lanes, threads,
+                                                          monkeypatch):
+    """rodas4's structure-of-arrays lanes (pdw_batch_ros.inc), per instruction set: each lane
+    attempts its own step size in lockstep with the others (Jacobian, pivoted factors, six
+    stages, error norm, the checks as masks), and rejects, accepts and adapts its step as the
+    scalar driver; located events, failures, first and last steps go through the scalar rodas4.
+    Every walker is bit for bit `simulate(method="rodas4")`, and the lanes did the work."""
+    monkeypatch.setenv(ISA_ENV, isa)
+    x = _states(n, seed=9)
+    kw = dict(rtol=1e-6, atol=1e-8, variant=variant)
+    _batch.lane_steps(reset=True)
+    b = simulate_batch(x, t_end=T_END, method="rodas4", lanes=lanes, threads=threads, **kw)
+    in_lanes = _batch.lane_steps(reset=True)
+    statuses = set()
+    for i in range(n):
+        r = _scalar(x[i], pdw.Params.paper(), method="rodas4", **kw)
+        _assert_bitwise(b, i, r)
+        statuses.add(r.status)
+    assert statuses >= {"walked", "fell"}, statuses
+    if isa == "scalar":
+        assert in_lanes == 0
+    else:
+        # all but the rare steps (switches of flags or arming, falls, each walker's first and
+        # last) were the lanes'
+        assert in_lanes >= 0.9 * b.n_steps.sum(), (in_lanes, b.n_steps.sum())
+
+
+def test_cdm_lanes_do_the_work():
+    """The bitwise tests above could pass through the scalar fallback alone: the lane loop
+    of the widest instruction set commits all but the event steps."""
+    x = _states(13, seed=8)
+    _batch.lane_steps(reset=True)
+    b = simulate_batch(x, t_end=T_END, lanes=8, threads=1, check_step="off")
+    in_lanes = _batch.lane_steps(reset=True)
+    assert 0.99 * b.n_steps.sum() <= in_lanes < b.n_steps.sum()
+
+
+@pytest.mark.parametrize("isa", ISAS)
 def test_vector_trig_is_lane_independent_per_isa(isa, monkeypatch):
     monkeypatch.setenv(ISA_ENV, isa)
     x = _states(11, seed=9)

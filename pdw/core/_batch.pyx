@@ -9,6 +9,8 @@ from cpython.exc cimport PyErr_CheckSignals
 from libc.math cimport INFINITY
 from libc.stdlib cimport malloc, free
 
+import threading
+
 from pdw.core import interrupt as _interrupt
 
 
@@ -66,6 +68,7 @@ cdef extern from "pdw_batch.h":
         int *fail_leg
         double *fail_t
         double *fail_x
+        long *lane_steps
         int (*poll)(void *ctx) noexcept nogil
         void *poll_ctx
     long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
@@ -77,6 +80,10 @@ cdef extern from "pdw_batch.h":
     int pdw_batch_isa_supported(int isa) noexcept nogil
     long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
                            int vector, int isa, pdw_soa_state *S) noexcept nogil
+    ctypedef struct pdw_ros_soa:
+        int W
+    long pdw_batch_rodas4_soa(const pdw_batch_job *job, long i0, long i1, int W,
+                              pdw_sim *lanes, int isa, pdw_ros_soa *S) noexcept nogil
 
 
 cdef extern from "pdw_sim.h":
@@ -90,6 +97,22 @@ MAX_LANES = PDW_BATCH_MAXW
 ISAS = {"scalar": -1, "base": 0, "avx2": 1, "avx512": 2}
 """The cdm lane loops: "scalar" (every lane through the generated scalar stages), and the
 structure-of-arrays step compiled for the x86-64 baseline (SSE2), AVX2 and AVX-512F."""
+
+
+_lane_lock = threading.Lock()
+_lane_steps = [0]
+
+
+def lane_steps(reset=False):
+    """Walker-steps the structure-of-arrays lane loops (cdm and rodas4) committed in this
+    process since the last reset, over every thread; the other steps (events, failures, the
+    first and last steps) went through the scalar step. A diagnostic: the tests check with it
+    that the lanes, not only the scalar fallback, did the work. reset: zero it (after reading)."""
+    with _lane_lock:
+        n = _lane_steps[0]
+        if reset:
+            _lane_steps[0] = 0
+    return n
 
 
 def isa_supported(name):
@@ -130,8 +153,8 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     the lockstep cdm loop (pdw_batch_cdm, `vector` applies), any other the per-lane rounds of
     pdw_batch_method with t_end (0: n_steps dt), rtol, atol, h_max (0: t_end), event_tol and
     max_steps (0: no budget) as `pdw.core._core.run` takes them; dt is then the first step.
-    isa: the cdm loop, a value of ISAS (-1: per-lane scalar stages; an unsupported one falls
-    back to it).
+    isa: the lane loop of cdm and rodas4, a value of ISAS (-1: per-lane scalar stages; an
+    unsupported one falls back to it).
 
     x0 (N, 8); p (N, NP) or (1, NP) (one vector for all); flags0 (N, 2) intc; hip, depth (N,).
     out: the dict of output arrays made by pdw.sim.batch (status, stop_reason, flags_final,
@@ -250,6 +273,8 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     job.fail_leg = &fail_leg[0]
     job.fail_t = &fail_t[0]
     job.fail_x = &fail_x[0, 0]
+    cdef long lane_steps = 0
+    job.lane_steps = &lane_steps
     cdef list pending = []
     job.poll = _poll
     job.poll_ctx = <void *> pending
@@ -261,6 +286,11 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     if posix_memalign(<void **> &soa, 64, sizeof(pdw_soa_state)) != 0:
         free(sims)
         raise MemoryError()
+    cdef pdw_ros_soa *ros = NULL
+    if method != 0 and isa >= 0 and posix_memalign(<void **> &ros, 64, sizeof(pdw_ros_soa)) != 0:
+        free(sims)
+        free(soa)
+        raise MemoryError()
     cdef long done
     try:
         with nogil:
@@ -268,11 +298,17 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
                 done = pdw_batch_cdm_soa(&job, i0, i1, lanes, sims, vector, isa, soa)
             elif method == 0:
                 done = pdw_batch_cdm(&job, i0, i1, lanes, sims, vector)
+            elif isa >= 0:
+                # rodas4's structure-of-arrays lanes (any other method: pdw_batch_method)
+                done = pdw_batch_rodas4_soa(&job, i0, i1, lanes, sims, isa, ros)
             else:
                 done = pdw_batch_method(&job, i0, i1, lanes, sims)
     finally:
         free(sims)
         free(soa)
+        free(ros)
+    with _lane_lock:
+        _lane_steps[0] += lane_steps
     if pending:             # Ctrl-C (or a cancelled pool): the rows written so far stay
         raise pending[0]
     return done

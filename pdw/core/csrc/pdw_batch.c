@@ -13,7 +13,7 @@
 #include "pdw_linalg.h"
 
 /* Write lane s's walker i outputs. */
-static void finish(const pdw_batch_job *job, long i, const pdw_sim *s)
+void pdw_batch_finish(const pdw_batch_job *job, long i, const pdw_sim *s)
 {
     job->status[i] = s->status;
     job->stop_reason[i] = s->stop_reason;
@@ -113,7 +113,7 @@ long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *l
         while (next < i1) {
             const long i = next++;
             if (start(job, i, &lanes[l])) { walker[l] = i; running++; break; }
-            finish(job, i, &lanes[l]);
+            pdw_batch_finish(job, i, &lanes[l]);
             done++;
         }
     }
@@ -122,7 +122,7 @@ long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *l
             since_poll = 0;
             if (job->poll(job->poll_ctx)) {      /* stopped: write the running walkers as they are */
                 for (int l = 0; l < W; ++l)
-                    if (walker[l] >= 0) finish(job, walker[l], &lanes[l]);
+                    if (walker[l] >= 0) pdw_batch_finish(job, walker[l], &lanes[l]);
                 return done;
             }
         }
@@ -149,14 +149,14 @@ long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *l
         /* (2) the step of every lane; refill the finished ones */
         for (int l = 0; l < W; ++l) {
             if (walker[l] < 0 || step(&lanes[l])) continue;
-            finish(job, walker[l], &lanes[l]);
+            pdw_batch_finish(job, walker[l], &lanes[l]);
             walker[l] = -1;
             running--;
             done++;
             while (next < i1) {
                 const long i = next++;
                 if (start(job, i, &lanes[l])) { walker[l] = i; running++; break; }
-                finish(job, i, &lanes[l]);
+                pdw_batch_finish(job, i, &lanes[l]);
                 done++;
             }
         }
@@ -166,7 +166,7 @@ long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *l
 
 /* Load walker i into lane s with the settings pdw/core/_core.pyx's run gives pdw.simulate's
  * pdw_sim (nothing recorded, events only counted), polling after every step. */
-static void start_method(const pdw_batch_job *job, long i, pdw_sim *s)
+void pdw_batch_start_method(const pdw_batch_job *job, long i, pdw_sim *s)
 {
     const pdw_method *m = &pdw_methods[job->method];
     memset(s, 0, sizeof *s);
@@ -185,14 +185,14 @@ static void start_method(const pdw_batch_job *job, long i, pdw_sim *s)
 
 /* Every PDW_BATCH_POLL rounds: job->poll; if it says stop, write the running walkers as they
  * are (status running) and return 1. */
-static int poll_stop(const pdw_batch_job *job, long *since_poll, const long *walker, int W,
-                     const pdw_sim *lanes)
+int pdw_batch_poll_stop(const pdw_batch_job *job, long *since_poll, const long *walker, int W,
+                        const pdw_sim *lanes)
 {
     if (!job->poll || ++*since_poll < PDW_BATCH_POLL) return 0;
     *since_poll = 0;
     if (!job->poll(job->poll_ctx)) return 0;
     for (int l = 0; l < W; ++l)
-        if (walker[l] >= 0) finish(job, walker[l], &lanes[l]);
+        if (walker[l] >= 0) pdw_batch_finish(job, walker[l], &lanes[l]);
     return 1;
 }
 
@@ -206,10 +206,10 @@ long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim
     if (W > PDW_BATCH_MAXW) W = PDW_BATCH_MAXW;
     for (int l = 0; l < W; ++l) {
         walker[l] = -1;
-        if (next < i1) { walker[l] = next; start_method(job, next++, &lanes[l]); running++; }
+        if (next < i1) { walker[l] = next; pdw_batch_start_method(job, next++, &lanes[l]); running++; }
     }
     while (running > 0) {
-        if (poll_stop(job, &since_poll, walker, W, lanes)) {
+        if (pdw_batch_poll_stop(job, &since_poll, walker, W, lanes)) {
             /* a lane stopped inside its round holds the state of its last accepted step */
             for (int l = 0; l < W; ++l)
                 if (walker[l] >= 0) job->status[walker[l]] = PDW_STATUS_RUNNING;
@@ -220,11 +220,11 @@ long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim
             /* nothing recorded and events not stored: RECORDS_FULL and EVENTS_FULL cannot
              * occur, POLL is the end of this lane's step */
             if (advance(&lanes[l]) == PDW_STATUS_POLL) continue;
-            finish(job, walker[l], &lanes[l]);
+            pdw_batch_finish(job, walker[l], &lanes[l]);
             walker[l] = -1;
             running--;
             done++;
-            if (next < i1) { walker[l] = next; start_method(job, next++, &lanes[l]); running++; }
+            if (next < i1) { walker[l] = next; pdw_batch_start_method(job, next++, &lanes[l]); running++; }
         }
     }
     return done;
@@ -252,12 +252,11 @@ int pdw_batch_isa_supported(int isa)
     return 0;
 }
 
-void pdw_soa_trig_libm(pdw_soa_state *S, int W, int only_first)
+/* pdw_soa_trig_libm's loop; skip: NULL, or lanes to leave alone (nonzero) */
+static void trig_rows(int W, const double *x, double *trig, const int *skip)
 {
-    const double *x = S->x;
-    double *trig = S->trig;
     for (int l = 0; l < W; ++l) {
-        if (only_first && S->upd[l]) continue;
+        if (skip && skip[l]) continue;
         /* both angles first: GCC then fuses each sin/cos pair into one sincos call, as in
          * pdw_trig (the same results: glibc's sincos is its sin and cos) */
         const double a1 = x[PDW_X_THETA1*PDW_SOA_STRIDE + l], a2 = x[PDW_X_THETA2*PDW_SOA_STRIDE + l];
@@ -267,6 +266,17 @@ void pdw_soa_trig_libm(pdw_soa_state *S, int W, int only_first)
         trig[PDW_TRIG_SIN_THETA2*PDW_SOA_STRIDE + l] = s2;
         trig[PDW_TRIG_COS_THETA2*PDW_SOA_STRIDE + l] = c2;
     }
+}
+
+void pdw_soa_trig_libm(pdw_soa_state *S, int W, int only_first)
+{
+    trig_rows(W, S->x, S->trig, only_first ? S->upd : NULL);
+}
+
+void pdw_soa_trig_rows(int W, const double *x, double *trig)
+{
+    /* every computed lane, the padding up to a multiple of 8 included (ordinary numbers) */
+    trig_rows((W + 7) & ~7, x, trig, NULL);
 }
 
 /* Lane l of S from its pdw_sim (after a start or a scalar step). */
@@ -308,7 +318,7 @@ static long soa_refill(const pdw_batch_job *job, long *next, long i1, pdw_sim *s
     while (*next < i1) {
         const long i = (*next)++;
         if (soa_start(job, i, s, S, l)) return i;
-        finish(job, i, s);
+        pdw_batch_finish(job, i, s);
         ++*done;
     }
     return -1;
@@ -327,7 +337,7 @@ long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_si
         return pdw_batch_cdm(job, i0, i1, W, lanes, vector);
     long walker[PDW_BATCH_MAXW], next = i0;
     int running = 0;
-    long since_poll = 0, done = 0;
+    long since_poll = 0, done = 0, lane_steps = 0;
     if (W < 1) W = 1;
     if (W > PDW_BATCH_MAXW) W = PDW_BATCH_MAXW;
     memset(S, 0, sizeof *S);
@@ -352,8 +362,9 @@ long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_si
                 for (int l = 0; l < W; ++l) {
                     if (walker[l] < 0) continue;
                     soa_store(S, l, &lanes[l]);
-                    finish(job, walker[l], &lanes[l]);
+                    pdw_batch_finish(job, walker[l], &lanes[l]);
                 }
+                if (job->lane_steps) *job->lane_steps += lane_steps;
                 return done;
             }
         }
@@ -374,6 +385,7 @@ long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_si
                 s->n++;
                 s->t = s->n * s->dt;
                 s->n_rhs++;
+                lane_steps++;
                 S->upd[l] = 1;
                 more = s->n < s->n_steps;
                 if (!more) {
@@ -383,12 +395,13 @@ long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_si
                 }
             }
             if (more) continue;
-            finish(job, walker[l], s);
+            pdw_batch_finish(job, walker[l], s);
             running--;
             done++;
             walker[l] = soa_refill(job, &next, i1, s, S, l, &done);
             if (walker[l] >= 0) running++;
         }
     }
+    if (job->lane_steps) *job->lane_steps += lane_steps;
     return done;
 }

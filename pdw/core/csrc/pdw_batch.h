@@ -11,6 +11,7 @@
 #define PDW_BATCH_H
 
 #include "pdw_sim.h"
+#include "pdw_tableaus.h"
 
 enum { PDW_BATCH_MAXW = 64 };
 /* the row stride of pdw_soa_state: the generated stages' PDW_SOA (generated/pdw_batch_gen.h) */
@@ -52,6 +53,9 @@ typedef struct pdw_batch_job {
     int *fail_reason, *fail_leg;/* (n,) PDW_REASON_*, leg (-1: none) */
     double *fail_t;             /* (n,) */
     double *fail_x;             /* (n, PDW_NX) */
+    /* --- diagnostics (out, may be NULL): += the steps the structure-of-arrays lane loops
+     * committed (the others went through the scalar step: events, failures, starts, ends) --- */
+    long *lane_steps;
     /* --- interruptibility --- */
     int (*poll)(void *ctx);     /* called every PDW_BATCH_POLL lockstep steps (NULL: never); nonzero
                                  * stops: the running walkers are written with status running */
@@ -80,6 +84,37 @@ typedef struct pdw_soa_state {
 /* The trig of lanes l < W from libm (bitwise pdw_trig): all lanes, or (only_first != 0) only
  * those at their first step (upd[l] == 0). */
 void pdw_soa_trig_libm(pdw_soa_state *S, int W, int only_first);
+
+/* The trig (PDW_NTRIG rows) of the leg angles of the SoA states x (PDW_NX rows), lanes
+ * l < W, from libm: bitwise pdw_trig. */
+void pdw_soa_trig_rows(int W, const double *x, double *trig);
+
+/* rodas4's lanes as structure of arrays (pdw_batch_ros.inc; rows as pdw_soa_state's). A lane
+ * holds its walker right after an accepted step (or its first); one attempt of every lane is
+ * one call of the structure-of-arrays try step. */
+typedef struct pdw_ros_soa {
+    /* in: the lanes' points and attempts */
+    double x[PDW_NX*PDW_SOA_STRIDE], fx[PDW_NX*PDW_SOA_STRIDE];   /* x and f(x) */
+    double p[PDW_NP*PDW_SOA_STRIDE], anchors[PDW_NANCHOR*PDW_SOA_STRIDE];
+    double hip[PDW_SOA_STRIDE], depth[PDW_SOA_STRIDE];
+    double h[PDW_SOA_STRIDE];           /* the attempt's step */
+    int flags[2*PDW_SOA_STRIDE], armed[2*PDW_SOA_STRIDE];
+    int jac[PDW_SOA_STRIDE];            /* 1: a new point, J of x wanted */
+    /* kept: J = d qdd / d x at x (row i*PDW_NX + j), the factors of the attempt */
+    double J[PDW_NQ*PDW_NX*PDW_SOA_STRIDE];
+    double LU[PDW_NQ*PDW_NQ*PDW_SOA_STRIDE], piv[PDW_NQ*PDW_SOA_STRIDE];
+    /* out: the attempt */
+    double xnew[PDW_NX*PDW_SOA_STRIDE], fnew[PDW_NX*PDW_SOA_STRIDE], err[PDW_SOA_STRIDE];
+    int bad[PDW_SOA_STRIDE];    /* 1: singular matrix or non-finite error: the scalar step */
+    double sing[PDW_SOA_STRIDE];/* 1.0: a zero or non-finite pivot */
+    int rare[PDW_SOA_STRIDE];   /* 1: if accepted, a flag switch, a failure or a deep foot */
+    /* scratch */
+    double u[PDW_ROS_MAXSTAGES][PDW_NX*PDW_SOA_STRIDE], xs[PDW_NX*PDW_SOA_STRIDE];
+    double trig[PDW_NTRIG*PDW_SOA_STRIDE], kin[2*PDW_NKIN*PDW_SOA_STRIDE];
+    double contact[2*PDW_NCONTACT*PDW_SOA_STRIDE];
+    double M[PDW_NQ*PDW_NQ*PDW_SOA_STRIDE], f[PDW_NQ*PDW_SOA_STRIDE], qdd[PDW_NQ*PDW_SOA_STRIDE];
+    double A[PDW_NQ*PDW_NX*PDW_SOA_STRIDE], Jn[PDW_NQ*PDW_NX*PDW_SOA_STRIDE];
+} pdw_ros_soa;
 
 /* Instruction sets of the structure-of-arrays step (pdw_batch_soa_*.c); PDW_ISA_SCALAR: no
  * SoA step, every lane through the generated scalar stages (pdw_batch_cdm). */
@@ -110,5 +145,28 @@ long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *l
  * located events and every walker is bitwise its `pdw.simulate` run; a finished lane takes the
  * next walker. Returns the walkers finished (fewer when job->poll stopped the range). */
 long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes);
+
+/* Advance walkers [i0, i1) of job with rodas4 (job->method must name it), as
+ * pdw_batch_method does, the ordinary steps of the lanes through the structure-of-arrays try
+ * step compiled for isa (pdw_batch_ros.inc; S caller-allocated, 64-byte aligned): each lane
+ * keeps its own time, step size, accept/reject and Jacobian; a lane whose accepted step
+ * has a flag switch (located by the scalar step), a failure, or that starts, ends or runs
+ * out of budget takes that step through the scalar rodas4. Bitwise pdw_batch_method (and
+ * `pdw.simulate`). Falls back to pdw_batch_method where the kernel has no batched stages or
+ * isa is PDW_ISA_SCALAR or unsupported. */
+long pdw_batch_rodas4_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
+                          int isa, pdw_ros_soa *S);
+
+/* --- the lane loops' shared pieces (pdw_batch.c) ------------------------------------------ */
+
+/* Write lane s's walker i into job's outputs. */
+void pdw_batch_finish(const pdw_batch_job *job, long i, const pdw_sim *s);
+/* Load walker i into lane s for a method of pdw_methods (job->method) with the settings
+ * pdw.simulate gives its pdw_sim, returning (PDW_STATUS_POLL) after each accepted step. */
+void pdw_batch_start_method(const pdw_batch_job *job, long i, pdw_sim *s);
+/* Every PDW_BATCH_POLL calls: job->poll; if it says stop, write the running walkers (walker[l]
+ * >= 0) as they are and return 1. */
+int pdw_batch_poll_stop(const pdw_batch_job *job, long *since_poll, const long *walker, int W,
+                        const pdw_sim *lanes);
 
 #endif /* PDW_BATCH_H */

@@ -166,7 +166,6 @@ static int fail_step_size(pdw_sim *s)
 int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx)
 {
     double xnew[PDW_NX_MAX], fnew[PDW_NX_MAX];
-    const double alpha = m->err_exponent - 0.75 * m->pi_beta;
     const double t_end = s->t_end;
     int new_point = 1, last_rejected = 0;
 
@@ -212,26 +211,12 @@ int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx)
         const double err = m->step(s, ctx, s->cache, h, new_point, xnew, fnew, &fnew_valid);
         new_point = 0;
         if (!(err <= 1.0)) {                               /* rejected (or NaN / singular) */
-            double fac = m->fac_min;
-            if (isfinite(err)) fac = fmax(m->fac_min, m->safety * pow(err, -m->err_exponent));
-            s->h = h * fmin(1.0, fac);
+            s->h = h * pdw_reject_factor(m, err);
             s->n_rejected++;
             last_rejected = 1;
             continue;
         }
-        double fac = m->safety * pow(fmax(err, 1e-10), -alpha);
-        if (m->pi_beta > 0.0) fac *= pow(s->err_prev, m->pi_beta);
-        fac = fmin(m->fac_max, fmax(m->fac_min, fac));
-        if (m->predictive && s->h_prev > 0.0) {
-            /* Gustafsson (1994): h_new/h = safety (h/h_prev) (err_prev / err^2)^(1/(q+1)),
-             * the smaller of this and the I controller's (Hairer & Wanner II, Eq. IV.8.21) */
-            double g = m->safety * (h / s->h_prev)
-                     * pow(s->err_prev / (fmax(err, 1e-10) * fmax(err, 1e-10)), m->err_exponent);
-            g = fmin(m->fac_max, fmax(m->fac_min, g));
-            fac = fmin(fac, g);
-        }
-        if (last_rejected) fac = fmin(fac, 1.0);
-        const double h_next = h * fac;
+        const double h_next = h * pdw_accept_factor(m, s, err, h, last_rejected);
         if (!fnew_valid) { pdw_ode_f(s, xnew, fnew); fnew_valid = 1; }
 
         /* a flag switch inside the step: locate it on the step's continuous extension, then
@@ -259,9 +244,7 @@ int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx)
         s->cache_valid = 1;
         s->t = last ? t_end : s->t + h_acc;
         s->n++;
-        s->err_prev = m->predictive ? fmax(err, 1e-2) : fmax(err, 1e-4);
-        s->h_prev = h;
-        s->h = h_next;
+        pdw_accept_memory(m, s, err, h, h_next);
         new_point = 1;
         last_rejected = 0;
 

@@ -13,6 +13,7 @@
 #ifndef PDW_ODE_H
 #define PDW_ODE_H
 
+#include <math.h>
 #include "pdw_sim.h"
 #include "pdw_tableaus.h"
 
@@ -57,5 +58,49 @@ typedef struct pdw_adaptive_method {
 } pdw_adaptive_method;
 
 int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx);
+
+/* The step-size control of pdw_adaptive_advance, shared with the ensemble's rodas4 lanes
+ * (pdw_batch_ros.c) so that both take the same steps. */
+
+/* h_new / h after an attempt rejected with error norm err (> 1, inf or NaN). */
+static inline double pdw_reject_factor(const pdw_adaptive_method *m, double err)
+{
+    double fac = m->fac_min;
+    if (isfinite(err)) fac = fmax(m->fac_min, m->safety * pow(err, -m->err_exponent));
+    return fmin(1.0, fac);
+}
+
+/* h_new / h after an attempt accepted with error norm err <= 1, from the controller's memory
+ * (s->err_prev, s->h_prev; before pdw_accept_memory updates it). */
+static inline double pdw_accept_factor(const pdw_adaptive_method *m, const pdw_sim *s,
+                                       double err, double h, int last_rejected)
+{
+    const double alpha = m->err_exponent - 0.75 * m->pi_beta;
+    double fac = m->safety * pow(fmax(err, 1e-10), -alpha);
+    if (m->pi_beta > 0.0) fac *= pow(s->err_prev, m->pi_beta);
+    fac = fmin(m->fac_max, fmax(m->fac_min, fac));
+    if (m->predictive && s->h_prev > 0.0) {
+        /* Gustafsson (1994): h_new/h = safety (h/h_prev) (err_prev / err^2)^(1/(q+1)),
+         * the smaller of this and the I controller's (Hairer & Wanner II, Eq. IV.8.21) */
+        double g = m->safety * (h / s->h_prev)
+                 * pow(s->err_prev / (fmax(err, 1e-10) * fmax(err, 1e-10)), m->err_exponent);
+        g = fmin(m->fac_max, fmax(m->fac_min, g));
+        fac = fmin(fac, g);
+    }
+    if (last_rejected) fac = fmin(fac, 1.0);
+    return fac;
+}
+
+/* The controller's memory after an accepted step of size h with error err; h_next its next. */
+static inline void pdw_accept_memory(const pdw_adaptive_method *m, pdw_sim *s, double err,
+                                     double h, double h_next)
+{
+    s->err_prev = m->predictive ? fmax(err, 1e-2) : fmax(err, 1e-4);
+    s->h_prev = h;
+    s->h = h_next;
+}
+
+/* rodas4's method (pdw_rodas4.c), for the ensemble's rodas4 lanes. */
+extern const pdw_adaptive_method pdw_rodas4_method;
 
 #endif /* PDW_ODE_H */

@@ -115,7 +115,7 @@ static double rodas4_step(pdw_sim *s, void *vctx, const double *fx, double h, in
     return pdw_err_norm(s, s->x, xnew, errv);
 }
 
-static const pdw_adaptive_method rodas4 = {
+const pdw_adaptive_method pdw_rodas4_method = {
     rodas4_step, 1.0/4.0, 0.0, 0.9, 0.2, 6.0, 1,
 };
 
@@ -124,5 +124,5 @@ int pdw_rodas4_advance(pdw_sim *s)
     rodas_ctx c;
     c.lu_h = 0.0;
     c.nx = s->nx;
-    return pdw_adaptive_advance(s, &rodas4, &c);
+    return pdw_adaptive_advance(s, &pdw_rodas4_method, &c);
 }
