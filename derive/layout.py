@@ -99,6 +99,7 @@ STOP = (
     "none",         # none did: the run reached t_end, or failed
     "steps",        # the requested number of complete gait steps was reached
     "periodic",     # the last k steps agreed within the tolerance
+    "touch_down",   # the given leg touched down (the ensemble's Poincare maps)
 )
 
 # Per-step gait descriptors (docs/model.md section 8), computed online in the compiled loop as the

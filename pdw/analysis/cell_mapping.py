@@ -261,9 +261,9 @@ def cell_map(params=None, variant="paper", phi=(0.69, 0.81, 80), thetad2=(-3.2, 
     A = np.repeat(0.5 * (a_edges[1:] + a_edges[:-1]), int(nb))
     B = np.tile(0.5 * (b_edges[1:] + b_edges[:-1]), int(na))
     Z = np.array([cell_state(A[c], B[c], rest[c], p) for c in range(N)])
-    outs = lc.map_batch(Z, p, variant, method, workers=workers, t_hint=0.6, progress=progress, **opts)
-    image_point = np.array([s["z"] for s in outs])
-    status = np.array([s["status"] for s in outs], dtype=object)
+    # through the ensemble engine where it takes the maps (the same numbers as `lc.step`)
+    image_point, status = lc.map_images(Z, p, variant, method, workers=workers, t_hint=0.6,
+                                        progress=progress, **opts)
     g = grid_of(image_point)
     image = _cell_index(a_edges, b_edges, g[:, 0], g[:, 1])
     left = (image == SINK) & (status == "ok")

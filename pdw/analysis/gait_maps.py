@@ -30,7 +30,7 @@ import os
 
 import numpy as np
 
-from ..core import _hybrid, interrupt
+from ..core import _hybrid
 from ..core.errors import InvalidInputError
 from ..core.model import parameter_vector
 from ..core.params import Params
@@ -237,7 +237,11 @@ class ContinuousProblem(_Problem):
         fn = _ContinuousTask(self)
         if self.executor is not None:
             return list(self.executor.map(fn, tasks))
-        return interrupt.thread_map(fn, tasks, self.workers)   # Ctrl-C stops every thread
+        # the finite differences through the ensemble engine where it takes them (the same
+        # numbers), the rest on threads; Ctrl-C stops every thread
+        return LC.compose_points([t[0] for t in tasks], self.period,
+                                 [self.params_at(mu) for _, mu in tasks], self.variant,
+                                 self.method, {**self.opts, "t_hint": self.t_hint}, self.workers)
 
     def evaluate(self, z, mu, jac=True) -> Evaluation:
         z = np.asarray(z, dtype=float)

@@ -49,6 +49,7 @@ cdef extern from "pdw_batch.h":
         double max_speed
         long stop_steps
         int periodic_k
+        int stop_touch_down
         double periodic_tol
         int method
         double t_end
@@ -146,13 +147,14 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
               double max_speed, long stop_steps, int periodic_k, double periodic_tol,
               dict out, long i0, long i1, int lanes, bint vector, int method=0,
               double t_end=0.0, double rtol=1e-6, double atol=1e-8, double h_max=0.0,
-              double event_tol=1e-9, long max_steps=0, int isa=0):
+              double event_tol=1e-9, long max_steps=0, int isa=0, int stop_touch_down=0):
     """Advance walkers [i0, i1) with `lanes` lanes (GIL released), writing rows of `out`.
 
     method: index into the compiled method table (pdw.core.integrators.METHODS); 0 (cdm) takes
     the lockstep cdm loop (pdw_batch_cdm, `vector` applies), any other the per-lane rounds of
     pdw_batch_method with t_end (0: n_steps dt), rtol, atol, h_max (0: t_end), event_tol and
     max_steps (0: no budget) as `pdw.core._core.run` takes them; dt is then the first step.
+    stop_touch_down: 1 or 2, stop each walker at that leg's first touch-down; 0: off.
     isa: the lane loop of cdm and rodas4, a value of ISAS (-1: per-lane scalar stages; an
     unsupported one falls back to it).
 
@@ -180,6 +182,8 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
         raise ValueError("dt must be finite and > 0, n_steps and stop_steps >= 0, max_speed > 0; "
                          "got dt = %r, n_steps = %d, stop_steps = %d, max_speed = %r"
                          % (dt, n_steps, stop_steps, max_speed))
+    if stop_touch_down < 0 or stop_touch_down > 2:
+        raise ValueError("stop_touch_down must be 0 (off), 1 or 2, got %d" % stop_touch_down)
     if periodic_k < 0 or periodic_k == 1 or periodic_k > PDW_STEP_RING or not (periodic_tol >= 0):
         raise ValueError("periodic_k must be 0 (off) or in [2, %d] and periodic_tol >= 0, got %d, %r"
                          % (PDW_STEP_RING, periodic_k, periodic_tol))
@@ -251,6 +255,7 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     job.max_speed = max_speed
     job.stop_steps = stop_steps
     job.periodic_k = periodic_k
+    job.stop_touch_down = stop_touch_down
     job.periodic_tol = periodic_tol
     job.method = method
     job.t_end = t_end if t_end > 0 else n_steps * dt

@@ -86,6 +86,7 @@ cdef extern from "pdw_sim.h":
         double event_tol
         int record_events
         long stop_steps
+        int stop_touch_down
         int periodic_k
         double periodic_tol
         double *rec_t
@@ -418,14 +419,16 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         double rtol=1e-6, double atol=1e-8, double h_max=0.0, long max_records=0,
         long event_capacity=256, double event_tol=1e-9, bint record_events=True,
         long stop_steps=0, int periodic_k=0, double periodic_tol=0.0, double t_end=0.0,
-        long max_steps=0, long poll_every=POLL_EVERY, buffers=None, approach_speeds0=None):
+        long max_steps=0, long poll_every=POLL_EVERY, buffers=None, approach_speeds0=None,
+        int stop_touch_down=0):
     """Run one simulation in compiled code (GIL released). Returns a dict of arrays and status.
 
     The online gait analysis runs for every method: the result's "gait" holds the last
     min(n_gait_steps, PDW_STEP_RING) complete steps (rows of layout STEP, oldest first), with
     the step and event counts. record_events=False stores no event (only counts). stop_steps > 0
     stops at that many complete steps, periodic_k > 0 when the last periodic_k steps agree within
-    periodic_tol (relative); "stop_reason" says which (layout STOP).
+    periodic_tol (relative), stop_touch_down = 1 or 2 at that leg's first touch-down (the final
+    state is the event's); "stop_reason" says which (layout STOP).
 
     Fixed-step methods take n_steps steps of dt; adaptive ones integrate to t_end (default
     n_steps*dt) with first step dt, locating flag switches to within event_tol [s], and fail
@@ -457,6 +460,8 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         raise ValueError("dt must be > 0, got %r" % dt)
     if method < 0 or method >= pdw_nmethods:
         raise ValueError("method id %d out of range [0, %d)" % (method, pdw_nmethods))
+    if stop_touch_down < 0 or stop_touch_down > 2:
+        raise ValueError("stop_touch_down must be 0 (off), 1 or 2, got %d" % stop_touch_down)
     if periodic_k < 0 or periodic_k == 1 or periodic_k > PDW_STEP_RING:
         raise ValueError("periodic_k must be 0 (off) or in [2, %d], got %d" % (PDW_STEP_RING, periodic_k))
     cdef long n_rec_cap = 0
@@ -520,6 +525,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     s.events = &v_e[0, 0] if record_events else NULL
     s.ev_capacity = events.shape[0] if record_events else 0
     s.stop_steps = stop_steps
+    s.stop_touch_down = stop_touch_down
     s.periodic_k = periodic_k
     s.periodic_tol = periodic_tol
     pdw_gait_init(&s.gait)

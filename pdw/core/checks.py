@@ -63,6 +63,11 @@ def count(name, value, lo=0, hi=MAX_COUNT):
     return v
 
 
+def leg_or_off(name, value):
+    """0 (off), or a leg number in the paper's numbering: 1 or 2."""
+    return count(name, value, lo=0, hi=2)
+
+
 def choice(name, value, allowed):
     """One of ``allowed`` (compared as is: no case folding, no stripping)."""
     if not isinstance(value, str) or value not in allowed:

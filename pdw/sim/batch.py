@@ -28,7 +28,7 @@ from .gait import Steps, steps_from_rows
 from .simulation import _REASONS, _check_count, _check_positive
 
 _STATUS = {0: "interrupted", 1: "walked", 2: "fell", 3: "diverged", 5: "diverged", 6: "periodic"}
-_STOP = {0: "t_end", 1: "steps", 2: "periodic"}
+_STOP = {i: ("t_end" if i == 0 else name) for i, name in enumerate(_layout.STOP)}
 LANES = 8
 """Default lanes per block (walkers advanced in lockstep by one thread)."""
 ISA_ENV = "PDW_BATCH_ISA"
@@ -180,7 +180,7 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
                    periodic_steps=0, periodic_tol=1e-3, fall_hip_height=None, fall_depth=None,
                    max_speed=1e3, check_step="warn", rtol=1e-6, atol=1e-8, h_max=None,
                    event_tol=1e-9, max_steps=None, *, executor=None, chunk_size=None,
-                   record=None, record_every=1) -> BatchResult:
+                   record=None, record_every=1, stop_touch_down=0) -> BatchResult:
     """Simulate N walkers at once: the result of `pdw.simulate` for each, without recording.
 
     Parameters
@@ -233,6 +233,9 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
         bitwise path (``vector=False``) those runs are the lanes' arithmetic: same ``x_final``.
     record_every : int
         Sampling of the recorded walkers (every k-th step, >= 1).
+    stop_touch_down : {0, 1, 2}
+        As `simulate`: stop each walker at the first touch-down of leg 1 or 2 (``stop_reason``
+        ``"touch_down"``, ``x_final`` the event's state); 0: off.
 
     Returns
     -------
@@ -255,7 +258,7 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
                   periodic_tol=periodic_tol, fall_hip_height=fall_hip_height,
                   fall_depth=fall_depth, max_speed=max_speed, check_step=check_step,
                   rtol=rtol, atol=atol, h_max=h_max, event_tol=event_tol, max_steps=max_steps,
-                  record=record, record_every=record_every)
+                  record=record, record_every=record_every, stop_touch_down=stop_touch_down)
         if chunk_size is None:
             chunk_size = max(1, math.ceil(n / 8))
         return run_chunked(simulate_batch, kw, executor, chunk_size)
@@ -292,6 +295,7 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
     if not isinstance(vector, (bool, np.bool_)):
         raise InvalidInputError("vector must be True or False, got %r" % (vector,))
     stop_steps = _check_count("stop_steps", stop_steps)
+    stop_touch_down = checks.leg_or_off("stop_touch_down", stop_touch_down)
     periodic_steps = _check_count("periodic_steps", periodic_steps)
     if periodic_steps == 1 or periodic_steps > _layout.STEP_RING:
         raise InvalidInputError("periodic_steps must be 0 (off) or in [2, %d], got %d"
@@ -324,7 +328,8 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
                                 "or take a larger dt" % (n_steps, budget))
     t_stop = t_end if adaptive else n_steps * dt
     opts = dict(method=METHODS.index(method), t_end=t_stop, rtol=rtol, atol=atol, h_max=h_max,
-                event_tol=event_tol, max_steps=budget, isa=_batch.ISAS[batch_isa()])
+                event_tol=event_tol, max_steps=budget, isa=_batch.ISAS[batch_isa()],
+                stop_touch_down=stop_touch_down)
     if n:
         chunks = _chunks(n, threads, lanes)
         args = (k, x, pvec, f0, hip, depth, dt, n_steps, max_speed, stop_steps, periodic_steps,
@@ -351,7 +356,7 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
                  fall_hip_height=fall_hip_height, fall_depth=fall_depth, max_speed=max_speed,
                  check_step=check_step, rtol=rtol, atol=atol,
                  h_max=None if h_max == 0.0 else h_max, event_tol=event_tol,
-                 max_steps=max_steps))
+                 max_steps=max_steps, stop_touch_down=stop_touch_down))
     return res
 
 

@@ -249,7 +249,7 @@ _DEFAULTS = dict(t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
                  features=None, record_events=True, record_energies=False, stop_steps=0,
                  periodic_steps=0, periodic_tol=1e-3, check_step="warn", t_eval=None,
                  dense_output=False, out=None, max_steps=None,
-                 contact=None, approach_speeds0=None)
+                 contact=None, approach_speeds0=None, stop_touch_down=0)
 
 
 def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float = 1e-4,
@@ -265,7 +265,8 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
              t_eval: ArrayLike | None = None, dense_output: bool = False,
              out: RecordBuffer | None = None, max_steps: int | None = None,
              contact: _contact.Contact | dict | str | None = None,
-             approach_speeds0: tuple[float, float] | None = None) -> Result:
+             approach_speeds0: tuple[float, float] | None = None,
+             stop_touch_down: int = 0) -> Result:
     """Simulate the walker from ``x0`` for ``t_end`` seconds (or run a `pdw.Scene`).
 
     ``simulate(scene)`` runs the scene (as `pdw.run`); no other argument may be given then.
@@ -330,6 +331,10 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
         With ``periodic_steps = k >= 2``: stop (status ``"periodic"``) as soon as the last k
         steps agree, each of L, travel, P and cycle within ``periodic_tol`` relative
         (``max - min <= tol * abs(latest)``). 0: off.
+    stop_touch_down : {0, 1, 2}
+        1 or 2: stop at that leg's first touch-down (status ``"walked"``, ``stop_reason``
+        ``"touch_down"``); the final state is the event's (located to ``event_tol`` by the
+        adaptive methods). The touch-down Poincare map's end (`pdw.limit_cycle`). 0: off.
     check_step : {"warn", "error", "off"}
         Fixed-step methods: compare dt with `pdw.sim.stepsize.step_limit` (the method's estimated
         stability limit for these parameters) and warn (`pdw.StepSizeWarning`) or refuse
@@ -418,6 +423,7 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
     if record_energies and not record_every:
         raise InvalidInputError("record_energies needs recorded states (record_every > 0)")
     stop_steps = _check_count("stop_steps", stop_steps)
+    stop_touch_down = checks.leg_or_off("stop_touch_down", stop_touch_down)
     periodic_steps = _check_count("periodic_steps", periodic_steps)
     if periodic_steps == 1 or periodic_steps > _layout.STEP_RING:
         raise InvalidInputError("periodic_steps must be 0 (off) or in [2, %d], got %d"
@@ -458,7 +464,8 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
                     bool(record_forces), hip, depth, max_speed, rtol, atol, h_max,
                     event_tol=event_tol, record_events=bool(record_events), stop_steps=stop_steps,
                     periodic_k=periodic_steps, periodic_tol=periodic_tol, t_end=t_end,
-                    max_steps=budget, buffers=buffers, approach_speeds0=v_in0)
+                    max_steps=budget, buffers=buffers, approach_speeds0=v_in0,
+                    stop_touch_down=stop_touch_down)
     wall = time.perf_counter() - start
     energies = None
     if record_energies and raw["interrupted"] is None:

@@ -58,6 +58,7 @@ static void load_walker(const pdw_batch_job *job, long i, pdw_sim *s)
     s->max_speed = job->max_speed;
     s->stop_steps = job->stop_steps;
     s->periodic_k = job->periodic_k;
+    s->stop_touch_down = job->stop_touch_down;
     s->periodic_tol = job->periodic_tol;
     pdw_gait_init(&s->gait);
     memcpy(s->x, job->x0 + i*PDW_NX, PDW_NX * sizeof(double));

@@ -32,6 +32,7 @@ typedef struct pdw_batch_job {
     double max_speed;
     long stop_steps;            /* 0: off */
     int periodic_k;             /* 0: off */
+    int stop_touch_down;        /* 1 or 2: stop at that leg's first touch-down; 0: off */
     double periodic_tol;
     /* methods other than cdm (pdw_batch_method): the settings of pdw_sim as pdw.simulate
      * (pdw/core/_core.pyx run) sets them */

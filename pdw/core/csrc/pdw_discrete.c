@@ -96,6 +96,7 @@ static int gait_touch_down(pdw_sim *s, int j, double t, double x)
     g->has_td[j] = 1;
     g->prev_td_t = t;
     g->has_prev_td = 1;
+    if (stop == PDW_STOP_NONE && s->stop_touch_down == j + 1) stop = PDW_STOP_TOUCH_DOWN;
     return stop;
 }
 

@@ -87,6 +87,8 @@ typedef struct pdw_sim {
                                  * online gait analysis sees them either way) */
     long stop_steps;            /* stop (PDW_STATUS_DONE, PDW_STOP_STEPS) at this many complete
                                  * gait steps; 0: no limit */
+    int stop_touch_down;        /* 1 or 2: stop (PDW_STATUS_DONE, PDW_STOP_TOUCH_DOWN) at that leg's
+                                 * first touch-down (the state then is the event's); 0: off */
     int periodic_k;             /* stop (PDW_STATUS_PERIODIC) when the last periodic_k steps agree:
                                  * each PDW_PERIODIC_FIELDS descriptor within periodic_tol (relative,
                                  * max - min <= tol |latest|); 0: off. 2 <= k <= PDW_STEP_RING */
