@@ -46,7 +46,8 @@ run's, its approach speed the one it got at the start (or at a later touch-down 
 Nothing in the compiled code is changed: the loop records every accepted step (a few thousand
 samples) and Python picks the one at the event. The simulation runs to
 ``1.3 * t_hint + 0.05`` s (``t_hint``: the previous period, default 0.75 s) and, if the touch-down
-has not happened by then, again to ``t_max``.
+has not happened by then, again to ``t_max``. (`pdw.analysis.poincare` holds `step`; many maps
+at once, through the ensemble engine with ``stop_touch_down=1``: `pdw.analysis.step_maps`.)
 
 *Restarting the discrete state.* At the section both legs are support, so nobody is armed
 (docs/model.md section 5) and the restart's discrete state equals the running one, except for the
@@ -65,8 +66,10 @@ Newton shooting and Floquet multipliers
 `find_gait` solves P^n(z) = z (n = ``period``, default 1) by Newton's method with a damped step
 (halved until the residual decreases). The Jacobian DP is taken by **central differences** with
 an absolute step ``fd_step`` (default 1e-5 in every coordinate: rad, m/s, rad/s, um), each column
-from two step-map evaluations (2 len(z) per Jacobian, run in parallel threads: the compiled loop
-releases the GIL). With the default tolerances (rtol 1e-10, atol 1e-12, event_tol 1e-12) one map
+from two step-map evaluations (2 len(z) per Jacobian; for period 1 with an adaptive method and
+the default laws as walkers of one `pdw.simulate_batch` call, rodas4 in the ensemble engine's
+vectorized lanes, bitwise the scalar maps: `pdw.analysis.step_maps`; otherwise in parallel
+threads: the compiled loop releases the GIL). With the default tolerances (rtol 1e-10, atol 1e-12, event_tol 1e-12) one map
 evaluation is reproducible to ~1e-10, so the Jacobian is good to ~1e-5 and Newton converges to a
 residual max|P(z) - z| < ``tol`` = 1e-9 (the floor is ~3e-10). The Floquet multipliers are the
 eigenvalues of the len(z) x len(z) Jacobian of P^n at the fixed point (6 x 6 for the default

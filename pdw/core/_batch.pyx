@@ -1,6 +1,6 @@
 # cython: language_level=3
 """Thin Cython layer over the ensemble engine (csrc/pdw_batch.c): many walkers, W lanes in
-lockstep, threads over disjoint ranges of walkers.
+lockstep, threads sharing one batch through a counter of walkers (or over disjoint ranges).
 
 Private: the public API is `pdw.sim.batch.simulate_batch`. Every array is caller-allocated,
 C-contiguous (typed memoryviews). `run_range` releases the GIL for the whole range.
@@ -69,6 +69,7 @@ cdef extern from "pdw_batch.h":
         int *fail_leg
         double *fail_t
         double *fail_x
+        long *next_walker
         long *lane_steps
         int (*poll)(void *ctx) noexcept nogil
         void *poll_ctx
@@ -147,7 +148,8 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
               double max_speed, long stop_steps, int periodic_k, double periodic_tol,
               dict out, long i0, long i1, int lanes, bint vector, int method=0,
               double t_end=0.0, double rtol=1e-6, double atol=1e-8, double h_max=0.0,
-              double event_tol=1e-9, long max_steps=0, int isa=0, int stop_touch_down=0):
+              double event_tol=1e-9, long max_steps=0, int isa=0, int stop_touch_down=0,
+              long[::1] next_walker=None):
     """Advance walkers [i0, i1) with `lanes` lanes (GIL released), writing rows of `out`.
 
     method: index into the compiled method table (pdw.core.integrators.METHODS); 0 (cdm) takes
@@ -155,6 +157,9 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     pdw_batch_method with t_end (0: n_steps dt), rtol, atol, h_max (0: t_end), event_tol and
     max_steps (0: no budget) as `pdw.core._core.run` takes them; dt is then the first step.
     stop_touch_down: 1 or 2, stop each walker at that leg's first touch-down; 0: off.
+    next_walker: a shared (1,) counter (start it at i0): the threads that call this on the same
+    range [i0, i1) take their walkers from it one by one (atomically), so every lane of every
+    thread keeps busy until the batch runs out; None: the range is this call's alone.
     isa: the lane loop of cdm and rodas4, a value of ISAS (-1: per-lane scalar stages; an
     unsupported one falls back to it).
 
@@ -280,6 +285,11 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     job.fail_x = &fail_x[0, 0]
     cdef long lane_steps = 0
     job.lane_steps = &lane_steps
+    job.next_walker = NULL
+    if next_walker is not None:
+        if next_walker.shape[0] != 1:
+            raise ValueError("next_walker must have shape (1,), got (%d,)" % next_walker.shape[0])
+        job.next_walker = &next_walker[0]
     cdef list pending = []
     job.poll = _poll
     job.poll_ctx = <void *> pending

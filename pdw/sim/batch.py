@@ -6,8 +6,9 @@ one vector loop (glibc's libmvec), the generated stages and the discrete logic (
 anchors, events, online gait descriptors) per lane, exactly as `pdw.simulate`; a lane whose
 walker finishes takes the next one. Every other method of `pdw.METHODS` (rodas4, dopri5, rk4,
 verlet) runs in rounds of one step per lane through the scalar integrator's own C, each lane
-with its own time, step size, accept/reject and located events. Threads (GIL released) take
-disjoint ranges of walkers.
+with its own time, step size, accept/reject and located events (rodas4 in structure-of-arrays
+lanes too). Threads (GIL released) share the batch: each lane takes the next walker from one
+shared counter.
 """
 from __future__ import annotations
 
@@ -201,7 +202,8 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
     flags0 : (2,) or (N, 2) ints in {0, 1}
         Initial support flags of legs 1, 2.
     threads : int, optional
-        Threads taking ranges of walkers (GIL released); default: os.cpu_count().
+        Threads (GIL released), W lanes each, sharing the batch (each lane takes the next
+        walker); default: os.cpu_count().
     lanes : int
         Walkers per block advanced in lockstep (1 ... 64).
     vector : bool
@@ -331,13 +333,14 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
                 event_tol=event_tol, max_steps=budget, isa=_batch.ISAS[batch_isa()],
                 stop_touch_down=stop_touch_down)
     if n:
-        chunks = _chunks(n, threads, lanes)
         args = (k, x, pvec, f0, hip, depth, dt, n_steps, max_speed, stop_steps, periodic_steps,
-                periodic_tol, out)
+                periodic_tol, out, 0, n, lanes, bool(vector))
+        # the threads share the batch: each lane of each takes the next walker from one
+        # counter, so no lane idles while a walker waits (pdw_batch_take)
+        shared = np.zeros(1, dtype=np.int_) if threads > 1 else None
         try:
-            interrupt.thread_map(lambda c: _batch.run_range(*args, c[0], c[1], lanes,
-                                                            bool(vector), **opts),
-                                 chunks, threads)
+            interrupt.thread_map(lambda _: _batch.run_range(*args, next_walker=shared, **opts),
+                                 range(min(threads, -(-n // lanes))), threads)
         except KeyboardInterrupt as e:
             # Ctrl-C: the walkers finished so far, the running ones as they are, the others at
             # their start; every unfinished one "interrupted"
@@ -358,14 +361,6 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
                  h_max=None if h_max == 0.0 else h_max, event_tol=event_tol,
                  max_steps=max_steps, stop_touch_down=stop_touch_down))
     return res
-
-
-def _chunks(n, threads, lanes):
-    """Ranges of walkers for the threads: several per thread (refilling balances them)."""
-    if threads == 1:
-        return [(0, n)]
-    size = max(lanes, math.ceil(n / (4 * threads)))
-    return [(i, min(n, i + size)) for i in range(0, n, size)]
 
 
 def _outputs(n):

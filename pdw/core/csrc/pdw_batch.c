@@ -111,8 +111,7 @@ long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *l
     /* fill every lane (a walker that finishes at its start-up is written out at once) */
     for (int l = 0; l < W; ++l) {
         walker[l] = -1;
-        while (next < i1) {
-            const long i = next++;
+        for (long i; (i = pdw_batch_take(job, &next, i1)) >= 0; ) {
             if (start(job, i, &lanes[l])) { walker[l] = i; running++; break; }
             pdw_batch_finish(job, i, &lanes[l]);
             done++;
@@ -154,8 +153,7 @@ long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *l
             walker[l] = -1;
             running--;
             done++;
-            while (next < i1) {
-                const long i = next++;
+            for (long i; (i = pdw_batch_take(job, &next, i1)) >= 0; ) {
                 if (start(job, i, &lanes[l])) { walker[l] = i; running++; break; }
                 pdw_batch_finish(job, i, &lanes[l]);
                 done++;
@@ -206,8 +204,10 @@ long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim
     if (W < 1) W = 1;
     if (W > PDW_BATCH_MAXW) W = PDW_BATCH_MAXW;
     for (int l = 0; l < W; ++l) {
-        walker[l] = -1;
-        if (next < i1) { walker[l] = next; pdw_batch_start_method(job, next++, &lanes[l]); running++; }
+        if ((walker[l] = pdw_batch_take(job, &next, i1)) >= 0) {
+            pdw_batch_start_method(job, walker[l], &lanes[l]);
+            running++;
+        }
     }
     while (running > 0) {
         if (pdw_batch_poll_stop(job, &since_poll, walker, W, lanes)) {
@@ -225,7 +225,10 @@ long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim
             walker[l] = -1;
             running--;
             done++;
-            if (next < i1) { walker[l] = next; pdw_batch_start_method(job, next++, &lanes[l]); running++; }
+            if ((walker[l] = pdw_batch_take(job, &next, i1)) >= 0) {
+                pdw_batch_start_method(job, walker[l], &lanes[l]);
+                running++;
+            }
         }
     }
     return done;
@@ -316,8 +319,7 @@ static int soa_start(const pdw_batch_job *job, long i, pdw_sim *s, pdw_soa_state
 static long soa_refill(const pdw_batch_job *job, long *next, long i1, pdw_sim *s,
                        pdw_soa_state *S, int l, long *done)
 {
-    while (*next < i1) {
-        const long i = (*next)++;
+    for (long i; (i = pdw_batch_take(job, next, i1)) >= 0; ) {
         if (soa_start(job, i, s, S, l)) return i;
         pdw_batch_finish(job, i, s);
         ++*done;

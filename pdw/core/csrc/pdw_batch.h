@@ -6,7 +6,8 @@
  * W lanes: each lane is a pdw_sim (its own time, flags, arming, anchors, events, online gait
  * descriptors, through pdw_discrete.c), the sin/cos of all lanes are computed in one loop the
  * compiler vectorizes (pdw_batch_trig.c), and a lane whose walker finishes is refilled with
- * the next walker at once. Threads take disjoint ranges [i0, i1) of one job. */
+ * the next walker at once. Threads take disjoint ranges [i0, i1) of one job, or share one
+ * range through job->next_walker. */
 #ifndef PDW_BATCH_H
 #define PDW_BATCH_H
 
@@ -54,6 +55,10 @@ typedef struct pdw_batch_job {
     int *fail_reason, *fail_leg;/* (n,) PDW_REASON_*, leg (-1: none) */
     double *fail_t;             /* (n,) */
     double *fail_x;             /* (n, PDW_NX) */
+    /* --- work sharing (may be NULL): the threads of one batch call their ranges on the whole
+     * batch with one shared counter; each lane takes the next walker from it (atomically), so
+     * no lane idles while a walker of the batch waits, whichever thread it would be in --- */
+    long *next_walker;
     /* --- diagnostics (out, may be NULL): += the steps the structure-of-arrays lane loops
      * committed (the others went through the scalar step: events, failures, starts, ends) --- */
     long *lane_steps;
@@ -159,6 +164,16 @@ long pdw_batch_rodas4_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw
                           int isa, pdw_ros_soa *S);
 
 /* --- the lane loops' shared pieces (pdw_batch.c) ------------------------------------------ */
+
+/* The next walker of [*next, i1) for a lane, or -1 when none is left: from the shared counter
+ * job->next_walker when there is one (atomically: threads share it), else from *next. */
+static inline long pdw_batch_take(const pdw_batch_job *job, long *next, long i1)
+{
+    long i;
+    if (job->next_walker) i = __atomic_fetch_add(job->next_walker, 1, __ATOMIC_RELAXED);
+    else i = (*next)++;
+    return i < i1 ? i : -1;
+}
 
 /* Write lane s's walker i into job's outputs. */
 void pdw_batch_finish(const pdw_batch_job *job, long i, const pdw_sim *s);

@@ -99,11 +99,9 @@ long pdw_batch_rodas4_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw
     memset(S, 0, sizeof *S);
     for (int l = 0; l < W8; ++l) loaded[l] = 0;
     for (int l = 0; l < W; ++l) {
-        walker[l] = -1;
         mode[l] = LANE_SCALAR;
-        if (next < i1) {
-            walker[l] = next;
-            pdw_batch_start_method(job, next++, &lanes[l]);
+        if ((walker[l] = pdw_batch_take(job, &next, i1)) >= 0) {
+            pdw_batch_start_method(job, walker[l], &lanes[l]);
             fresh[l] = 1;
             running++;
         }
@@ -135,9 +133,8 @@ long pdw_batch_rodas4_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw
                 walker[l] = -1;
                 running--;
                 done++;
-                if (next < i1) {
-                    walker[l] = next;
-                    pdw_batch_start_method(job, next++, s);
+                if ((walker[l] = pdw_batch_take(job, &next, i1)) >= 0) {
+                    pdw_batch_start_method(job, walker[l], s);
                     fresh[l] = 1;
                     running++;
                 }
