@@ -1,6 +1,8 @@
-"""Many touch-down step maps at once through the ensemble engine (docs/ensemble.md, "Where the
-engine is used"): the finite differences of `pdw.limit_cycle.jacobian` (so `find_gait` and
-`floquet`), continuation's (`pdw.analysis.gait_maps`) and `pdw.cell_mapping.cell_map`.
+"""Many touch-down step maps at once (docs/ensemble.md, "Where the engine is used"): the finite
+differences of `pdw.limit_cycle.jacobian` (so `find_gait` and `floquet`) and of continuation
+(`pdw.analysis.gait_maps`) through `compose_points`, `pdw.cell_mapping.cell_map`'s images
+through `map_images`: through the ensemble engine (`images`) where it takes them, else on a
+thread pool of scalar steps (`map_batch`, `_compose`).
 
 One step of the map (`pdw.limit_cycle.step`) is a run from the section point's state with
 flags (1, 1) until leg 1's next touch-down, whose located state gives z'. Here every point is a
