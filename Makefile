@@ -93,6 +93,7 @@ SAN_TESTS ?= tests/test_hardening_boundary.py tests/test_hardening_status.py \
              tests/test_hardening_input.py tests/test_hardening_fuzz.py tests/test_simulation.py \
              tests/test_hybrid.py tests/test_integrators.py tests/test_features.py \
              tests/test_hardening_entry.py tests/test_hardening_interrupt.py tests/test_batch.py \
+             tests/test_step_maps.py \
              tests/test_contact_laws.py tests/test_ode_function.py tests/test_export.py \
              tests/test_dense_output.py
 sanitize: $(STAMP)
