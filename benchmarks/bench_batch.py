@@ -8,7 +8,7 @@ the generated scalar stages per lane, then the structure-of-arrays step compiled
 baseline, AVX2, AVX-512F), bitwise (libm sin/cos) and vector (libmvec sin/cos), on 1 thread,
 then on 2 threads; and rodas4 (rtol 1e-6, atol 1e-8) scalar against batch, per accepted step,
 on every rodas4 lane loop ("scalar" = the scalar rodas4 per lane, then its structure-of-arrays
-try step per instruction set).
+try step per instruction set; bitwise, and once with vector sin/cos).
 Medians of ROUNDS rounds; the load average is printed before and after (the machine is shared:
 read the ratios, taken in the same rounds, before the times).
 
@@ -67,12 +67,13 @@ def main():
                                 record_events=False, on_failure="return",
                                 check_step="off").n_steps for xi in x)
 
-    def batch_rodas(lanes, threads, isa=best):
+    def batch_rodas(lanes, threads, isa=best, vector=False):
         def run():
             os.environ[ISA_ENV] = isa
             try:
                 return int(pdw.simulate_batch(x, t_end=T_END, method="rodas4", rtol=RTOL,
-                                              lanes=lanes, threads=threads).n_steps.sum())
+                                              lanes=lanes, threads=threads,
+                                              vector=vector).n_steps.sum())
             finally:
                 os.environ.pop(ISA_ENV)
         return run
@@ -87,6 +88,7 @@ def main():
               ("rodas4: scalar simulate, 1 thr", scalar_rodas, 1)]
     cases += [("rodas4: batch W=8 %s, 1 thr" % n, batch_rodas(8, 1, n), 1) for n in isas]
     cases += [("rodas4: batch W=16 %s, 1 thr" % best, batch_rodas(16, 1), 1),
+              ("rodas4: batch W=8 vector %s, 1 thr" % best, batch_rodas(8, 1, vector=True), 1),
               ("rodas4: batch W=8 %s, 2 thr" % best, batch_rodas(8, 2), 2)]
     times = {name: [] for name, _, _ in cases}
     cpu = {name: [] for name, _, _ in cases}

@@ -85,7 +85,7 @@ cdef extern from "pdw_batch.h":
     ctypedef struct pdw_ros_soa:
         int W
     long pdw_batch_rodas4_soa(const pdw_batch_job *job, long i0, long i1, int W,
-                              pdw_sim *lanes, int isa, pdw_ros_soa *S) noexcept nogil
+                              pdw_sim *lanes, int vector, int isa, pdw_ros_soa *S) noexcept nogil
 
 
 cdef extern from "pdw_sim.h":
@@ -153,7 +153,8 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     """Advance walkers [i0, i1) with `lanes` lanes (GIL released), writing rows of `out`.
 
     method: index into the compiled method table (pdw.core.integrators.METHODS); 0 (cdm) takes
-    the lockstep cdm loop (pdw_batch_cdm, `vector` applies), any other the per-lane rounds of
+    the lockstep cdm loop (pdw_batch_cdm, `vector` applies; to rodas4's lanes too), any other
+    the per-lane rounds of
     pdw_batch_method with t_end (0: n_steps dt), rtol, atol, h_max (0: t_end), event_tol and
     max_steps (0: no budget) as `pdw.core._core.run` takes them; dt is then the first step.
     stop_touch_down: 1 or 2, stop each walker at that leg's first touch-down; 0: off.
@@ -315,7 +316,7 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
                 done = pdw_batch_cdm(&job, i0, i1, lanes, sims, vector)
             elif isa >= 0:
                 # rodas4's structure-of-arrays lanes (any other method: pdw_batch_method)
-                done = pdw_batch_rodas4_soa(&job, i0, i1, lanes, sims, isa, ros)
+                done = pdw_batch_rodas4_soa(&job, i0, i1, lanes, sims, vector, isa, ros)
             else:
                 done = pdw_batch_method(&job, i0, i1, lanes, sims)
     finally:

@@ -208,10 +208,11 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
         Walkers per block advanced in lockstep (1 ... 64).
     vector : bool
         False (default): the scalar libm sin/cos, so that every walker is bitwise its
-        `simulate` run. True: the sin/cos of a block through glibc's vector routines (libmvec,
-        within 4 ulp of libm's); flag switches on the step grid turn those last bits into
-        step-sized shifts of events, so final states then agree with `simulate` in outcome,
-        not to 1e-12 (docs/ensemble.md).
+        `simulate` run. True (cdm and rodas4): the sin/cos of a block through glibc's vector
+        routines (libmvec, within 4 ulp of libm's); flag switches on the step grid (cdm) and
+        the adaptive step sequence (rodas4) turn those last bits into shifts of events, so final
+        states then agree with `simulate` in outcome, not to 1e-12 (docs/ensemble.md). The
+        results do not depend on the lane or thread a walker runs in.
     stop_steps, periodic_steps, periodic_tol, fall_hip_height, fall_depth, max_speed, check_step
     rtol, atol, h_max, event_tol, max_steps
         As `simulate` (adaptive methods; max_steps is the budget of each walker).
@@ -274,9 +275,9 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
         raise InvalidInputError(str(e)) from None
     if method not in METHODS:
         raise InvalidInputError("method must be one of %s, got %r" % (METHODS, method))
-    if vector and method != "cdm":
-        raise InvalidInputError("vector=True (vector sin/cos) applies to method 'cdm' only, "
-                                "got method %r" % (method,))
+    if vector and method not in ("cdm", "rodas4"):
+        raise InvalidInputError("vector=True (vector sin/cos) applies to methods 'cdm' and "
+                                "'rodas4' only, got method %r" % (method,))
     adaptive = _method_info(method).adaptive
     rtol = _check_positive("rtol", rtol)
     atol = _check_positive("atol", atol)

@@ -158,10 +158,11 @@ long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim
  * keeps its own time, step size, accept/reject and Jacobian; a lane whose accepted step
  * has a flag switch (located by the scalar step), a failure, or that starts, ends or runs
  * out of budget takes that step through the scalar rodas4. Bitwise pdw_batch_method (and
- * `pdw.simulate`). Falls back to pdw_batch_method where the kernel has no batched stages or
- * isa is PDW_ISA_SCALAR or unsupported. */
+ * `pdw.simulate`) with vector = 0; vector = 1: the lanes' sin/cos from libmvec (not bitwise).
+ * Falls back to pdw_batch_method where the kernel has no batched stages or isa is
+ * PDW_ISA_SCALAR or unsupported. */
 long pdw_batch_rodas4_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
-                          int isa, pdw_ros_soa *S);
+                          int vector, int isa, pdw_ros_soa *S);
 
 /* --- the lane loops' shared pieces (pdw_batch.c) ------------------------------------------ */
 

@@ -18,7 +18,9 @@
  * A vector lane's rejected attempts are not committed to its pdw_sim: a lane made scalar
  * mid-way restarts the step from its last accepted point, where pdw_rodas4_advance itself would
  * start (new point, no rejection before), and takes the same rejections again. So every
- * walker is bitwise its pdw_batch_method (and `pdw.simulate`) run. */
+ * walker is bitwise its pdw_batch_method (and `pdw.simulate`) run, with vector = 0 (libm's
+ * sin/cos per lane); vector = 1 takes the lanes' sin/cos from glibc's vector routines (within
+ * 4 ulp: not bitwise; a walker's numbers still do not depend on its lane or thread). */
 #include <float.h>
 #include <math.h>
 #include <string.h>
@@ -26,11 +28,11 @@
 #include "pdw_ode.h"
 
 void pdw_soa_ros_try_base(int kernel, pdw_ros_soa *S, int W, int any_jac, double rtol,
-                          double atol, double max_speed);
+                          double atol, double max_speed, int vector);
 void pdw_soa_ros_try_avx2(int kernel, pdw_ros_soa *S, int W, int any_jac, double rtol,
-                          double atol, double max_speed);
+                          double atol, double max_speed, int vector);
 void pdw_soa_ros_try_avx512(int kernel, pdw_ros_soa *S, int W, int any_jac, double rtol,
-                            double atol, double max_speed);
+                            double atol, double max_speed, int vector);
 
 int pdw_soa_has_ros_kernel_base(int kernel);
 
@@ -72,10 +74,10 @@ static void ros_copy_lane(pdw_ros_soa *S, int d, int l0)
 }
 
 long pdw_batch_rodas4_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
-                          int isa, pdw_ros_soa *S)
+                          int vector, int isa, pdw_ros_soa *S)
 {
     const long kid = job->kernel - pdw_kernels;
-    void (*tryfn)(int, pdw_ros_soa *, int, int, double, double, double) = NULL;
+    void (*tryfn)(int, pdw_ros_soa *, int, int, double, double, double, int) = NULL;
     if (isa == PDW_ISA_BASE) tryfn = pdw_soa_ros_try_base;
     else if (isa == PDW_ISA_AVX2) tryfn = pdw_soa_ros_try_avx2;
     else if (isa == PDW_ISA_AVX512) tryfn = pdw_soa_ros_try_avx512;
@@ -167,7 +169,7 @@ long pdw_batch_rodas4_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw
             S->jac[l] = 0;
         }
         /* (3) every vector lane's attempt */
-        tryfn((int)kid, S, W, any_jac, job->rtol, job->atol, job->max_speed);
+        tryfn((int)kid, S, W, any_jac, job->rtol, job->atol, job->max_speed, vector);
         /* (4) pdw_adaptive_advance's decision, per lane */
         for (int l = 0; l < W; ++l) {
             if (walker[l] < 0 || mode[l] != LANE_VECTOR) continue;
