@@ -68,8 +68,8 @@ def images(points, params, variant, method, options, *, threads=1):
         One parameter set, or one per point.
     variant, method : str
     options : dict
-        `pdw.limit_cycle.step`'s options, complete: ``dt``, ``rtol``, ``atol``, ``event_tol``,
-        ``t_max``, and ``t_hint`` (None: the default).
+        `pdw.limit_cycle.step`'s options (``dt``, ``rtol``, ``atol``, ``event_tol``, ``t_max``,
+        ``t_hint``); those not given take `step`'s defaults.
     threads : int
         Threads of the engine.
 
@@ -81,6 +81,7 @@ def images(points, params, variant, method, options, *, threads=1):
     n = len(points)
     if n == 0:
         return []
+    options = {**_step_defaults(), **options}
     plist = list(params) if isinstance(params, (list, tuple)) else [params] * n
     law = Contact.coerce(options.get("contact"))
     x0, ok = np.zeros((n, 8)), np.zeros(n, dtype=bool)
@@ -129,13 +130,12 @@ def map_images(Z, params=None, variant="paper", method="rodas4", *, workers=None
             out[i], status[i] = s["z"], s["status"]
         return out, status
     bar = progress_bar(progress, n, "step map")
-    full = {**_step_defaults(), **options}
     nw = _workers(workers)
     left = []
     for lo in range(0, n, int(chunk_size)):
         rows = range(lo, min(n, lo + int(chunk_size)))
         for i, im in zip(rows, images(Z[rows.start:rows.stop], params, variant, method,
-                                            full, threads=nw)):
+                                      options, threads=nw)):
             if im is None:
                 left.append(i)
             else:
@@ -193,10 +193,9 @@ def compose_points(points, period, params, variant, method, options, workers=Non
     if len(points) < 3 or not batchable(method, period, options):
         # Ctrl-C stops every thread at its next poll (pdw.core.interrupt)
         return interrupt.thread_map(one, range(len(points)), min(nw, len(points)))
-    full = {**_step_defaults(), **options}
     tasks = [lambda: one(0),
-             lambda: images(points[1:], plist[1:], variant, method, full,
-                                  threads=max(1, nw - 1))]
+             lambda: images(points[1:], plist[1:], variant, method, options,
+                            threads=max(1, nw - 1))]
     first, imgs = interrupt.thread_map(lambda task: task(), tasks, min(nw, 2))
     outs = [first] + [(im, [{"status": "ok", "z": im}]) for im in imgs]
     left = [1 + i for i, im in enumerate(imgs) if im is None]
