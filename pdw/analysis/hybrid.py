@@ -262,11 +262,13 @@ def find_gait(params=None, guess=None, *, tol=1e-10, max_iter=30, fd_step=1e-6, 
         A state on (or near) the section, `STATE` layout. Default: `default_guesses`, tried in
         turn. Each guess is first walked for up to ``settle_steps`` steps (a stable gait
         attracts it); Newton starts from where the walk got to (or from the guess itself
-        when the walker fell at once).
+        when the walker fell at once). An integer in [0, `MAX_STEPS`].
     tol : float
-        Newton converges when max |P(z) - z| < tol.
+        Newton converges when max |P(z) - z| < tol (> 0).
+    max_iter : int
+        Newton iterations per start, in [1, 10**6].
     fd_step : float
-        Step of the central differences of the Jacobian (Newton and multipliers).
+        Step of the central differences of the Jacobian (Newton and multipliers; > 0).
     options
         Step-map options (`DEFAULT_OPTIONS`); default rtol = atol = 1e-12 here.
 
@@ -280,8 +282,14 @@ def find_gait(params=None, guess=None, *, tol=1e-10, max_iter=30, fd_step=1e-6, 
     ------
     GaitNotFoundError
         No guess converged (``attempts`` says what happened to each).
+    pdw.InvalidInputError
+        A count or tolerance out of its range (the message names it).
     """
     params = Params.paper_steady() if params is None else params
+    settle_steps = checks.count("settle_steps", settle_steps, lo=0, hi=MAX_STEPS)
+    max_iter = checks.count("max_iter", max_iter, lo=1, hi=10 ** 6)
+    tol = checks.positive("tol", tol)
+    fd_step = checks.positive("fd_step", fd_step)
     opts = {**_TIGHT, **_options(options)}
     p = _p(params)
     guesses = [_state(guess, "guess")] if guess is not None else default_guesses(params)
@@ -405,6 +413,9 @@ class HybridTrajectory:
         return np.array([s["x_touch"] for s in self.steps if s["status"] == "ok"])
 
 
+#: Most steps one walk takes (`simulate_hybrid`'s n_steps, `find_gait`'s settle_steps): the
+#: step results alone take about 0.5 kB a step.
+MAX_STEPS = 10 ** 7
 #: Largest record `simulate_hybrid` allocates [bytes] (48 bytes a sample).
 MAX_RECORD_BYTES = 4e9
 
@@ -423,7 +434,7 @@ def simulate_hybrid(params=None, state0=None, n_steps=10, *, dt_out=0.002, stanc
     params = Params.paper_steady() if params is None else params
     if stance_leg not in (1, 2):
         raise InvalidInputError("stance_leg must be 1 or 2, got %r" % (stance_leg,))
-    n_steps = checks.count("n_steps", n_steps, lo=1, hi=10 ** 7)
+    n_steps = checks.count("n_steps", n_steps, lo=1, hi=MAX_STEPS)
     s0 = checks.number("s0", s0)
     opts = _options({**options, "dt_out": dt_out})
     dt_out = opts["dt_out"]

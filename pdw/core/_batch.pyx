@@ -188,6 +188,9 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
         raise ValueError("dt must be finite and > 0, n_steps and stop_steps >= 0, max_speed > 0; "
                          "got dt = %r, n_steps = %d, stop_steps = %d, max_speed = %r"
                          % (dt, n_steps, stop_steps, max_speed))
+    _count("n_steps", n_steps, 0)          # a loop bound: beyond MAX_COUNT no run finishes
+    _count("stop_steps", stop_steps, 0)
+    _count("max_steps", max_steps, 0)
     if stop_touch_down < 0 or stop_touch_down > 2:
         raise ValueError("stop_touch_down must be 0 (off), 1 or 2, got %d" % stop_touch_down)
     if periodic_k < 0 or periodic_k == 1 or periodic_k > PDW_STEP_RING or not (periodic_tol >= 0):

@@ -332,8 +332,7 @@ def bench(int k, str what, const double[::1] x, const double[::1] p, int f1, int
         raise ValueError("bench times the kernels of the smooth Coulomb law only")
     _len("x", x.shape[0], PDW_NX)
     _len("p", p.shape[0], PDW_NP)
-    if n < 0:
-        raise ValueError("n must be >= 0, got %d" % n)
+    _count("n", n, 0)
     if (f1 != 0 and f1 != 1) or (f2 != 0 and f2 != 1):
         raise ValueError("flags must be 0 or 1, got (%d, %d)" % (f1, f2))
     cdef int j
@@ -452,10 +451,14 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     _len("p", p.shape[0], PDW_NP)
     if (f1 != 0 and f1 != 1) or (f2 != 0 and f2 != 1):
         raise ValueError("flags must be 0 or 1, got (%d, %d)" % (f1, f2))
-    if n_steps < 0 or record_every < 0 or max_records < 0 or event_capacity < 0 \
-            or stop_steps < 0 or max_steps < 0 or poll_every < 0:
-        raise ValueError("n_steps, record_every, max_records, event_capacity, stop_steps, "
-                         "max_steps and poll_every must be >= 0")
+    # every count in [0, MAX_COUNT] before a size or a loop bound is made of it
+    _count("n_steps", n_steps, 0)
+    _count("record_every", record_every, 0)
+    _count("max_records", max_records, 0)
+    _count("event_capacity", event_capacity, 0)
+    _count("stop_steps", stop_steps, 0)
+    _count("max_steps", max_steps, 0)
+    _count("poll_every", poll_every, 0)
     if not (dt > 0):
         raise ValueError("dt must be > 0, got %r" % dt)
     if method < 0 or method >= pdw_nmethods:
@@ -504,11 +507,13 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
             _rows("buffers[3] (contact)", rec_contact.shape[0],
                   rec_contact.shape[1] if rec_contact.ndim == 2 else -1, n_rec_cap, PDW_NREC)
     else:
-        rec_t = np.zeros(n_rec_cap)
-        rec_x = np.zeros((n_rec_cap, nx))
-        rec_flags = np.zeros((n_rec_cap, 2), dtype=np.intc)
-        rec_contact = np.zeros((n_rec_cap if record_contact else 0, PDW_NREC))
-    events = np.zeros((max(event_capacity, 4) if record_events else 1, PDW_NEVENT))
+        rec_t = _zeros("the record (max_records)", n_rec_cap)
+        rec_x = _zeros("the record (max_records)", (n_rec_cap, nx))
+        rec_flags = _zeros("the record (max_records)", (n_rec_cap, 2), np.intc)
+        rec_contact = _zeros("the record (max_records)",
+                             (n_rec_cap if record_contact else 0, PDW_NREC))
+    events = _zeros("the event buffer (event_capacity)",
+                    (max(event_capacity, 4) if record_events else 1, PDW_NEVENT))
     cdef double[::1] v_t = rec_t
     cdef double[:, ::1] v_x = rec_x
     cdef int[:, ::1] v_f = rec_flags

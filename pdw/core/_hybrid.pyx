@@ -255,12 +255,11 @@ def step(const double[::1] p, const double[::1] y0, dict opts, double t0=0.0, do
     cdef pdw_hybrid_opts o
     cdef pdw_hybrid_result r
     _py(p, y0, "y0")
-    if rec_cap < 0:
-        raise ValueError("rec_cap must be >= 0, got %d" % rec_cap)
+    _count("rec_cap", rec_cap, 0)
     cdef list pending = []
     _fill_opts(&o, opts, pending)
-    rec_t = np.zeros(max(rec_cap, 1))
-    rec_y = np.zeros((max(rec_cap, 1), PDW_NHY))
+    rec_t = _zeros("the record (rec_cap)", max(rec_cap, 1))
+    rec_y = _zeros("the record (rec_cap)", (max(rec_cap, 1), PDW_NHY))
     cdef double[::1] vt = rec_t
     cdef double[:, ::1] vy = rec_y
     with nogil:
@@ -300,18 +299,19 @@ def walk(const double[::1] p, const double[::1] y0, double s0, long n_steps, dic
     """n_steps steps; returns (list of result dicts, rec_t, rec_y, rec_step)."""
     cdef pdw_hybrid_opts o
     _py(p, y0, "y0")
-    if rec_cap < 0:
-        raise ValueError("rec_cap must be >= 0, got %d" % rec_cap)
+    # both counts checked before a size is computed from them: n_steps * sizeof(...) cannot
+    # wrap (MAX_COUNT * sizeof < 2**63), and an allocation that cannot be made is a MemoryError
+    _count("n_steps", n_steps, 1)
+    _count("rec_cap", rec_cap, 0)
     cdef list pending = []
     _fill_opts(&o, opts, pending)
-    if n_steps < 1:
-        raise ValueError("n_steps must be >= 1, got %d" % n_steps)
-    results = np.zeros(n_steps * sizeof(pdw_hybrid_result), dtype=np.uint8)
+    results = _zeros("the step results of %d steps (n_steps)" % n_steps,
+                     n_steps * <long>sizeof(pdw_hybrid_result), np.uint8)
     cdef unsigned char[::1] vr = results
     cdef pdw_hybrid_result *res = <pdw_hybrid_result *> &vr[0]
-    rec_t = np.zeros(max(rec_cap, 1))
-    rec_y = np.zeros((max(rec_cap, 1), PDW_NHY))
-    rec_step = np.zeros(max(rec_cap, 1), dtype=np.int_)
+    rec_t = _zeros("the record (rec_cap)", max(rec_cap, 1))
+    rec_y = _zeros("the record (rec_cap)", (max(rec_cap, 1), PDW_NHY))
+    rec_step = _zeros("the record (rec_cap)", max(rec_cap, 1), np.int_)
     cdef double[::1] vt = rec_t
     cdef double[:, ::1] vy = rec_y
     cdef long[::1] vs = rec_step

@@ -7,6 +7,33 @@ cdef int _len(str name, Py_ssize_t got, Py_ssize_t want) except -1:
     return 0
 
 
+#: The largest count (steps, samples, events) a compiled entry point takes: beyond it no run
+#: could finish and no buffer could be allocated (`pdw.core.checks.MAX_COUNT`).
+MAX_COUNT = 1 << 40
+cdef long _MAX_COUNT = 1 << 40
+
+
+cdef int _count(str name, long v, long lo) except -1:
+    """A count argument in [lo, MAX_COUNT], checked before any size is computed from it."""
+    if v < lo or v > _MAX_COUNT:
+        raise _InvalidInputError("%s = %d is out of range; allowed: integers in [%d, %d]"
+                                 % (name, v, lo, _MAX_COUNT))
+    return 0
+
+
+cdef object _zeros(str what, object shape, object dtype=float):
+    """np.zeros(shape, dtype), or a MemoryError saying what it was for and how large it was."""
+    try:
+        return _np.zeros(shape, dtype=dtype)
+    except (MemoryError, ValueError):
+        n = 1
+        for w in (shape if isinstance(shape, tuple) else (shape,)):
+            n *= w
+        raise MemoryError("%s needs %.3g GB (%d entries of %d bytes), more than can be "
+                          "allocated" % (what, n * _np.dtype(dtype).itemsize / 1e9, n,
+                                         _np.dtype(dtype).itemsize)) from None
+
+
 cdef int _rows(str name, Py_ssize_t r, Py_ssize_t c, Py_ssize_t want_r, Py_ssize_t want_c) except -1:
     if r != want_r or c != want_c:
         raise ValueError("%s must have shape (%d, %d), got (%d, %d)" % (name, want_r, want_c, r, c))
@@ -25,11 +52,15 @@ import re as _re
 
 import numpy as _np
 
+from pdw.core.errors import InvalidInputError as _InvalidInputError
+
 _BUFFER_ERRORS = ("Buffer dtype mismatch", "C-contiguous", "C contiguous",
                   "wrong number of dimensions", "bytes-like object", "buffer interface",
                   "read-only", "Buffer has wrong")
 _C_DTYPES = {"double": _np.dtype(_np.float64), "int": _np.dtype(_np.intc),
              "long": _np.dtype(_np.int_)}
+_INT_ARG = _re.compile(r"\b(int|long)\s+(\w+)")
+_C_INT_RANGE = {"int": (-2 ** 31, 2 ** 31 - 1), "long": (-2 ** 63, 2 ** 63 - 1)}
 _VIEW_ARG = _re.compile(r"(const\s+)?(double|int|long)\[([:, 0-9]*)\]\s+(\w+)")
 
 
@@ -74,11 +105,25 @@ def _named_buffers(fn):
     """Wrap a compiled entry point so that a typed-memoryview conversion error names the
     argument (see above)."""
     specs, names = _buffer_specs(fn)
+    head = (fn.__doc__ or "").split("\n", 1)[0]
+    ints = {m.group(2): m.group(1) for m in _INT_ARG.finditer(head)}
 
     @_functools.wraps(fn)
     def entry(*args, **kwargs):
         try:
             return fn(*args, **kwargs)
+        except OverflowError:
+            # a Python int too large for its C int/long argument: name it and its range
+            given = dict(zip(names, args))
+            given.update(kwargs)
+            for name, ctype in ints.items():
+                v = given.get(name)
+                lo, hi = _C_INT_RANGE[ctype]
+                if isinstance(v, int) and not lo <= v <= hi:
+                    raise _InvalidInputError("%s = %d is out of range; allowed: integers in "
+                                             "[%d, %d] (a C %s)" % (name, v, lo, hi, ctype)) \
+                        from None
+            raise
         except (ValueError, TypeError) as e:
             if not any(s in str(e) for s in _BUFFER_ERRORS):
                 raise
