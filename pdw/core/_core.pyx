@@ -11,6 +11,7 @@ from pdw.core import interrupt as _interrupt
 from pdw.core.errors import InvalidInputError
 
 from cpython.exc cimport PyErr_CheckSignals
+from libc.math cimport NAN
 from libc.string cimport memset, memcpy
 from cpython.buffer cimport (PyObject_GetBuffer, PyBuffer_Release, PyBUF_C_CONTIGUOUS,
                             PyBUF_FORMAT)

@@ -26,6 +26,18 @@ cdef inline int _f64_vector(object x, Py_buffer *view) except -1:
     return 0
 
 
+cdef inline void _nan_unless_finite(const double *x, double *out, int n_out) noexcept nogil:
+    """NaN in every entry of out (n_out) unless the state x (PDW_NX) is finite: NaN in, NaN out
+    (the contact clamp would otherwise read a NaN depth as "no contact" and answer finite
+    numbers, issue 26.5). Eight comparisons a call."""
+    cdef int i
+    for i in range(PDW_NX):
+        if not (x[i] - x[i] == 0.0):        # NaN or +-inf
+            for i in range(n_out):
+                out[i] = NAN
+            return
+
+
 cdef int _bad_state(Py_ssize_t n) except -1:
     raise InvalidInputError("x must be a state of shape (8,) [m, rad, m/s, rad/s], got shape (%d,)" % n)
 
@@ -37,7 +49,9 @@ cdef class OdeFunction:
     kernel. The fast path takes a C-contiguous float64 array of shape (8,) (what ``solve_ivp``
     passes): its buffer is read in place, with one check of shape, type and layout per call.
     Anything else (a list, another dtype, a strided view) takes a slower converting path.
-    No check of finiteness is made per call. Each call returns a *fresh* array (a copy of an
+    A state with a NaN or infinite component gives NaN in every entry of f (and of jac)
+    (eight comparisons a call; the kernel alone would clamp a NaN depth to "no contact" and
+    answer finite numbers). Each call returns a *fresh* array (a copy of an
     internal buffer), so a caller may keep what it gets (``solve_ivp`` does).
     """
     cdef const pdw_kernel *kern
@@ -102,6 +116,7 @@ cdef class OdeFunction:
                 _bad_state(n)
             self.kern.rhs(<const double *> view.buf, self.p, self._flags, self._anchors,
                           self._f_ptr, self.work)
+            _nan_unless_finite(<const double *> view.buf, self._f_ptr, PDW_NX)
             PyBuffer_Release(&view)
             return self._f_out.copy()
         return self.general(t, x)
@@ -123,6 +138,7 @@ cdef class OdeFunction:
         out = np.empty(PDW_NX)
         o = out
         self.kern.rhs(&v[0], self.p, self._flags, self._anchors, &o[0], self.work)
+        _nan_unless_finite(&v[0], &o[0], PDW_NX)
         return out
 
     def checked(self, x):
@@ -159,6 +175,7 @@ cdef class OdeFunction:
                 _bad_state(n)
             self.kern.jacobian(<const double *> view.buf, self.p, self._flags, self._anchors,
                                self._j_ptr, self.work)
+            _nan_unless_finite(<const double *> view.buf, self._j_ptr, PDW_NX * PDW_NX)
             PyBuffer_Release(&view)
             return self._j_out.copy()
         v = _real_states(x, False)
@@ -167,6 +184,7 @@ cdef class OdeFunction:
         out = np.empty((PDW_NX, PDW_NX))
         o = out
         self.kern.jacobian(&v[0], self.p, self._flags, self._anchors, &o[0, 0], self.work)
+        _nan_unless_finite(&v[0], &o[0, 0], PDW_NX * PDW_NX)
         return out
 
     def batch(self, const double[:, ::1] X, double[:, ::1] out=None):
@@ -186,4 +204,5 @@ cdef class OdeFunction:
         with nogil:
             for i in range(n):
                 self.kern.rhs(&X[i, 0], self.p, self._flags, self._anchors, &out[i, 0], w)
+                _nan_unless_finite(&X[i, 0], &out[i, 0], PDW_NX)
         return np.asarray(out)

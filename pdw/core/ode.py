@@ -79,8 +79,9 @@ def ode_function(params: Params | None = None, variant: str = "paper",
     Inputs are validated here, once; a call checks only that x is a C-contiguous float64
     array of shape (8,) (its raw buffer is then read in place; the cost per call is in
     docs/benchmarks.md) and converts anything else (a list, another dtype, a strided view);
-    a wrong shape is `pdw.InvalidInputError` naming x. A non-finite state gives a non-finite
-    derivative. ``solve_ivp(f, (0, T), x0,
+    a wrong shape is `pdw.InvalidInputError` naming x. A state with a NaN or infinite
+    component gives NaN in every entry of f(t, x) and f.jac(t, x) (and in its row of
+    f.batch): NaN in, NaN out (`pdw.rhs` refuses such a state). ``solve_ivp(f, (0, T), x0,
     method="Radau", jac=f.jac)`` integrates one stretch of constant support flags; see
     docs/benchmarks.md for the cost per call (benchmarks/bench_io.py).
 
