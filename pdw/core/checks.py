@@ -3,7 +3,8 @@
 Every check returns the value in its canonical type or raises `pdw.InvalidInputError` naming the
 field and the allowed range. Nothing malformed is coerced into something else: a string is not a
 sequence of flags, 0.9 is not the flag 0, a (2, 4) array is not a state, a complex number is not
-a real one, ``True`` is not the number 1, and NaN is never in range.
+a real one, ``True`` is not the number 1, a masked array's masked entries are not numbers (it is
+refused), and NaN is never in range.
 """
 from __future__ import annotations
 
@@ -18,8 +19,26 @@ from .errors import InvalidInputError
 MAX_COUNT = 2 ** 40
 
 
+def unmasked(name, value):
+    """``value`` itself, or a masked array's data when no entry is masked; a masked array with
+    a masked entry is refused (pdw would otherwise run on the hidden values: numpy's
+    ``asarray`` drops the mask)."""
+    if isinstance(value, np.ma.MaskedArray):
+        mask = np.ma.getmaskarray(value)
+        if mask.any():
+            where = [int(i) for i in np.argwhere(mask)[0]]
+            raise InvalidInputError("%s is a masked array with %d masked entr%s (the first at "
+                                    "%s): pdw does not fill them; pass a plain array (e.g. "
+                                    "x.filled(value))" % (name, int(mask.sum()),
+                                                          "y" if mask.sum() == 1 else "ies",
+                                                          where))
+        return np.ma.getdata(value)
+    return value
+
+
 def _real(name, value):
     """A real scalar as float (no bool, str, complex, None, 0-d arrays of those)."""
+    value = unmasked(name, value)
     if isinstance(value, np.ndarray) and value.ndim == 0:
         value = value[()]
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
@@ -46,7 +65,9 @@ def positive(name, value, hi=None):
 
 
 def count(name, value, lo=0, hi=MAX_COUNT):
-    """An integer in [lo, hi] (no bool; an integral float such as 2.0 is accepted)."""
+    """An integer in [lo, hi] (no bool, no string; an integral float such as 2.0 is accepted,
+    1.5 is not)."""
+    value = unmasked(name, value)
     if isinstance(value, np.ndarray) and value.ndim == 0:
         value = value[()]
     if isinstance(value, (bool, np.bool_)):
@@ -81,6 +102,7 @@ def flags(name, value, n=None):
     tuple (pair) or an int array (n, 2). Strings, non-integers, other lengths are refused."""
     if isinstance(value, (str, bytes)):
         raise InvalidInputError("%s must be two integers in {0, 1}, got the string %r" % (name, value))
+    value = unmasked(name, value)
     try:
         arr = np.asarray(value)
     except (TypeError, ValueError):
@@ -105,6 +127,7 @@ def real_array(name, value, shapes, labels=None, lo=None):
     components (for the message); ``lo``: the smallest allowed value."""
     if isinstance(value, (str, bytes)):
         raise InvalidInputError("%s must be an array of numbers, got the string %r" % (name, value))
+    value = unmasked(name, value)
     try:
         arr = np.asarray(value)
     except (TypeError, ValueError):

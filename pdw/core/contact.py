@@ -18,8 +18,13 @@ flores                 k delta^1.5 (1 + 8(1-e)/(5e) delta_dot/v0)     k [N/m^1.5
 =====================  ============================================  =====================
 
 Every damped law is clamped at 0 (the ground cannot pull). v0 = max(v_in, v_in_min), v_in the
-foot's approach speed captured at its touch-down. k and d default to `Params.k_n`, `Params.d_n`
-(whose units are then the law's).
+foot's approach speed captured at its touch-down. The laws whose k has `Params.k_n`'s units
+(N/m^1.5: hunt_crossley, hertz, lankarani_nikravesh, flores) default k to `Params.k_n`, and
+hunt_crossley d to `Params.d_n`. kelvin_voigt's k and d have other units (N/m, N s/m): they
+never take `Params`' numbers, but default to the law's own calibration to the paper's ground
+(`KELVIN_VOIGT_DEFAULTS`: k = 7318 N/m, d = 112.2 N s/m, the static sink and the drop-test
+restitution of `Params.paper_steady()`'s Hunt-Crossley ground, `pdw.analysis.calibration`;
+docs/contact_laws.md), filled in when the Contact is made, so its repr shows them.
 
 =====================  ====================================================================
 friction law           friction force F_f (+X) of a penetrating support foot, slip velocity v
@@ -61,6 +66,12 @@ UNITS = {
     "lankarani_nikravesh": {"k": "N/m^1.5", "e": "-", "v_in_min": "m/s"},
     "flores": {"k": "N/m^1.5", "e": "-", "v_in_min": "m/s"},
 }
+#: kelvin_voigt's defaults: its own calibration to the paper's ground (not `Params.k_n`,
+#: `Params.d_n`, whose units differ): k = W / delta_s (the Hunt-Crossley static sink under the
+#: walker's weight W) and d such that the drop test at the typical landing gives Hunt-Crossley's
+#: restitution 0.1405 (`pdw.analysis.calibration.calibrate` of `Params.paper_steady()`: k =
+#: 7318.12 N/m, d = 112.211 N s/m; here to 4 figures; a test recomputes them).
+KELVIN_VOIGT_DEFAULTS = {"k": 7318.0, "d": 112.2}
 #: LuGre's parameters: (lower bound, lower bound open, unit, meaning)
 LUGRE_PARAMETERS = {
     "sigma0": (0.0, True, "1/m", "bristle stiffness per unit normal force"),
@@ -100,10 +111,11 @@ class Contact:
         Friction law, one of `FRICTION_LAWS` (``"coulomb"``: the smooth law of Eq. 10 with the
         tangential spring-damper of Eqs. 7, 11).
     k : float, optional
-        Normal stiffness [N/m^1.5; N/m for kelvin_voigt]; default `Params.k_n`.
+        Normal stiffness [N/m^1.5; N/m for kelvin_voigt]; default `Params.k_n`, except
+        kelvin_voigt: its calibrated 7318 N/m (`KELVIN_VOIGT_DEFAULTS`, set on the Contact).
     d : float, optional
         Normal damping of hunt_crossley [N s/m^2.5] or kelvin_voigt [N s/m]; default
-        `Params.d_n`.
+        `Params.d_n` for hunt_crossley, the calibrated 112.2 N s/m for kelvin_voigt.
     e : float, optional
         Coefficient of restitution of lankarani_nikravesh and flores, in (0, 1]; required there.
     v_in_min : float, optional
@@ -166,14 +178,15 @@ class Contact:
             if self.friction != "lugre":
                 raise InvalidInputError("contact.%s is a parameter of the lugre friction law, not "
                                         "of %s" % (name, self.friction))
-            try:
-                v = float(v)
-            except (TypeError, ValueError):
-                raise InvalidInputError("contact.%s must be a number, got %r" % (name, v)) from None
+            v = checks._real("contact." + name, v)   # no strings, booleans or complex
             if not math.isfinite(v) or (v <= lo if lo_open else v < lo):
                 raise InvalidInputError("contact.%s = %r is out of range; allowed: %s %g [%s]"
                                         % (name, v, ">" if lo_open else ">=", lo, unit))
             object.__setattr__(self, name, v)
+        if self.normal == "kelvin_voigt":     # its own units: never Params' k_n, d_n
+            for name, v in KELVIN_VOIGT_DEFAULTS.items():
+                if getattr(self, name) is None:
+                    object.__setattr__(self, name, v)
         if "e" in allowed and self.e is None:
             raise InvalidInputError("contact.e (coefficient of restitution, 0 < e <= 1) is "
                                     "required by the %s law" % self.normal)

@@ -24,7 +24,7 @@ from ..core.integrators import METHODS
 from ..core.integrators import get as _method_info
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
 from . import stepsize as _stepsize
-from .chunks import _plist, honest, record_subset, run_chunked
+from .chunks import _plist, check_record, honest, record_subset, run_chunked
 from .gait import Steps, steps_from_rows
 from .simulation import _REASONS, _check_count, _check_positive
 
@@ -146,6 +146,7 @@ class BatchResult:
 def _rows(x0):
     """x0 as a C-contiguous float (N, 8) array: real numbers only (no strings, complex or
     booleans), finite (`pdw.core.checks.real_array`)."""
+    x0 = checks.unmasked("x0", x0)
     x = np.asarray(x0) if not isinstance(x0, (str, bytes)) else x0
     if isinstance(x, np.ndarray) and x.dtype.kind in "iuf" and x.ndim == 2 \
             and x.shape[1] == len(STATE) and not np.isfinite(x).all():
@@ -254,6 +255,8 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
     """
     x = _rows(x0)
     n = len(x)
+    if record is not None:
+        check_record(record, n)              # before the run, not after it
     if executor is not None or chunk_size is not None:
         kw = dict(x0=x, t_end=t_end, dt=dt, params=params, variant=variant, method=method,
                   flags0=flags0, threads=threads, lanes=lanes, vector=vector,

@@ -15,9 +15,11 @@ executors, recorded subsets, `pdw.simulate`'s end-of-run checks (docs/ensemble.m
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 
 import numpy as np
 
+from ..core import checks
 from ..core.errors import InvalidInputError
 from ..core.params import Params
 from .simulation import NO_STEP_PERIODS, RUNAWAY_ANGLE, RUNAWAY_HIP, _check_count, simulate
@@ -122,10 +124,7 @@ def run_chunked(fn, kw, executor, chunk_size, progress=None):
     per_walker_params = not (params is None or isinstance(params, Params))
     if per_walker_params:
         params = _plist(params, n)
-    record = sorted(set(int(i) for i in kw.get("record") or ()))
-    if record and not (0 <= record[0] and record[-1] < n):
-        raise InvalidInputError("record must list walker indices in [0, %d), got %d"
-                                % (n, record[0] if record[0] < 0 else record[-1]))
+    record = [] if kw.get("record") is None else check_record(kw["record"], n)
     tasks = []
     for lo in range(0, max(n, 1), size):
         hi = min(n, lo + size)
@@ -155,16 +154,27 @@ def run_chunked(fn, kw, executor, chunk_size, progress=None):
 
 # --- recorded subsets ------------------------------------------------------------------------
 
+def check_record(record, n) -> list:
+    """The sorted distinct walker indices of ``record``: a sequence of integers in [0, n) (no
+    1.5, True, "1" or a string of digits: `pdw.core.checks.count`); else `InvalidInputError`
+    naming the entry."""
+    if isinstance(record, (str, bytes, dict)) or not isinstance(record, Iterable) \
+            or (isinstance(record, np.ndarray) and record.ndim != 1):
+        raise InvalidInputError("record must be a sequence of walker indices (integers in "
+                                "[0, %d)), got %r" % (n, record))
+    items = list(record)
+    if items and n == 0:
+        raise InvalidInputError("record must list walker indices in [0, 0), got %r" % (items[0],))
+    return sorted(set(checks.count("record[%d]" % j, i, lo=0, hi=n - 1)
+                      for j, i in enumerate(items)))
+
+
 def record_subset(b, record, record_every, x0, params, flags0, options) -> dict:
     """``{i: Result}``: walkers ``record`` run again through `pdw.simulate` with
     ``record_every`` (states, flags, forces and events recorded, ``on_failure="return"``),
     with the batch's other inputs ``options`` (its keywords that `pdw.simulate` also takes)."""
     n = len(b)
-    idx = sorted(set(int(i) for i in record))
-    bad = [i for i in idx if not 0 <= i < n]
-    if bad:
-        raise InvalidInputError("record must list walker indices in [0, %d), got %d"
-                                % (n, bad[0]))
+    idx = check_record(record, n)
     every = _check_count("record_every", record_every)
     if every < 1:
         raise InvalidInputError("record_every must be >= 1 for recorded walkers, got %d" % every)

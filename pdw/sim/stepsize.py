@@ -31,7 +31,7 @@ from ..core.errors import InvalidInputError, StepSizeError, StepSizeWarning
 from ..core.integrators import METHODS
 from ..core.model import check_variant, contact_forces, jacobian
 from ..core.params import X0_PAPER, Params
-from .stepsize_laws import LAW_CALIBRATION, LUGRE_SIGMA1, law_factor, law_message, law_of  # noqa: F401
+from .stepsize_laws import LAW_CALIBRATION, LUGRE_SIGMA1, law_factor, law_message, law_of, law_params  # noqa: F401
 
 NQ = _core.NQ
 NX = _core.NX
@@ -454,7 +454,7 @@ def step_limit(params: Params | None = None, method: str = "cdm", variant: str =
         check_variant(variant)
     except ValueError as e:
         raise InvalidInputError(str(e)) from None
-    lim = _step_limit(params, method, variant)
+    lim = _step_limit(law_params(params, contact), method, variant)
     law = law_of(contact)
     if law == "hunt_crossley" or method not in FIXED_STEP:
         return lim
@@ -489,7 +489,7 @@ def check_step(dt: float, params: Params, method: str, variant: str, mode: str =
     if mode == "off" or method not in FIXED_STEP:
         return None
     f = law_factor(law_of(contact), method, contact, variant)
-    if not dt > f * _dt_max(params, method, variant):
+    if not dt > f * _dt_max(law_params(params, contact), method, variant):
         return None
     lim = step_limit(params, method, variant, contact)
     msg = lim.message(dt)

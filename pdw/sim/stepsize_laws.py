@@ -9,10 +9,20 @@ each law calibrated to the paper's ground on `paper_steady` (benchmarks/step_lim
 docs/contact_laws.md). The factor keeps each law's limit as far below its measured walking edge
 as the default law's is there. It carries the law's own physics -- LuGre's bristle damping
 sigma1 F_n above all -- only at the calibrated parameters, plus LuGre's sigma1 (`law_factor`).
+
+Kelvin-Voigt's k [N/m] and d [N s/m] have other units than the default law's k_n, d_n: read as
+Hunt-Crossley numbers they mean another ground, so its estimate is taken at its calibrated k, d
+(`law_params`: the point its factor was fitted at), and the factor is scaled by how much the
+explicit limit of the law's own contact oscillator (`oscillator_limit`, the landing foot's
+effective mass on the law's spring and damper) falls from its calibrated k, d to the run's
+(issue 26.4: k = 1e5 N/m, d = 1e6 N s/m diverged at 0.2 ms under cdm at dt = 1e-4 and the
+estimate, at 4.9e-4 s, said nothing).
 """
 from __future__ import annotations
 
-from ..core.contact import LUGRE_DEFAULTS
+import math
+
+from ..core.contact import KELVIN_VOIGT_DEFAULTS, LUGRE_DEFAULTS
 
 #: Per variant, contact law and fixed-step method: dt_max = factor x the default law's estimate
 #: at the run's parameters. Fitted by benchmarks/step_limits_laws.py (benchmarks/results/
@@ -59,10 +69,38 @@ def law_of(contact) -> str:
     return contact.normal
 
 
+#: Effective mass of a landing foot along the normal [kg] (`pdw.analysis.calibration.
+#: typical_landing` on the default walker, docs/contact_laws.md): the mass of the contact
+#: oscillator of `oscillator_limit`.
+LANDING_MASS = 0.455
+
+
+def oscillator_limit(k: float, d: float, m: float = LANDING_MASS) -> float:
+    """Explicit (central difference) stability limit [s] of the contact oscillator
+    m x'' + d x' + k x = 0: (2 / w) (sqrt(1 + z^2) - z), w = sqrt(k / m), z = d / (2 m w)
+    (Belytschko, Liu & Moran, Nonlinear Finite Elements, 2000, Eq. 6.3.23); 2 m / d when the
+    damper dominates, 2 / w when the spring does."""
+    w = math.sqrt(k / m)
+    z = d / (2.0 * m * w)
+    return 2.0 / w / (math.sqrt(1.0 + z * z) + z)     # = (2/w)(sqrt(1+z^2) - z), no cancellation
+
+
+def law_params(params, contact):
+    """The parameters the default law's estimate is taken at for ``contact``'s law: the run's
+    (``contact.parameters(params)``), except Kelvin-Voigt's, whose k, d are not Hunt-Crossley
+    numbers: its calibrated ones (`KELVIN_VOIGT_DEFAULTS`; d_n stays 0 without normal
+    damping)."""
+    if contact is None or contact.normal != "kelvin_voigt":
+        return params
+    kv = KELVIN_VOIGT_DEFAULTS
+    return params.replace(k_n=kv["k"], d_n=kv["d"] if params.d_n != 0 else 0.0)
+
+
 def law_factor(law: str, method: str, contact=None, variant: str = "paper") -> float:
     """`LAW_CALIBRATION` [variant][law][method]; LuGre on another normal law: the smaller
     factor; LuGre with a bristle damping sigma1 above `LUGRE_SIGMA1`: times
-    LUGRE_SIGMA1 / sigma1."""
+    LUGRE_SIGMA1 / sigma1; Kelvin-Voigt stiffer or more damped than calibrated: times
+    `oscillator_limit` at its k, d over that at `KELVIN_VOIGT_DEFAULTS`."""
     cal = LAW_CALIBRATION[variant]
     if law.startswith("lugre+"):
         f = min(cal["lugre"][method], cal[law[6:]][method])
@@ -71,16 +109,21 @@ def law_factor(law: str, method: str, contact=None, variant: str = "paper") -> f
     if law.startswith("lugre") and contact is not None:
         s1 = contact.sigma1 if contact.sigma1 is not None else LUGRE_DEFAULTS["sigma1"]
         f *= min(1.0, LUGRE_SIGMA1 / s1) if s1 > 0 else 1.0
+    if law.endswith("kelvin_voigt") and contact is not None:
+        ref = oscillator_limit(**KELVIN_VOIGT_DEFAULTS)
+        f *= min(1.0, oscillator_limit(contact.k, contact.d) / ref)
     return f
 
 
 def law_message(lim, dt: float) -> str:
     """The warning / error text of a `StepLimit` of a non-default law at step ``dt``."""
     return ("dt = %.3g s exceeds the estimated stability limit %.2g s of method %r with the "
-            "contact law %r (variant %r): the default law's estimate at these parameters, "
+            "contact law %r (variant %r): the default law's estimate at these parameters%s, "
             "%.2g s, times the law's factor %.2g, fitted on its measured limit "
             "(docs/contact_laws.md). Above it the typical gait falls or diverges spuriously. "
             "Use dt <= %.2g, or method='rodas4' (L-stable, no step limit); check_step='off' "
             "disables this check."
-            % (dt, lim.dt_max, lim.method, lim.law, lim.variant, lim.dt_max / lim.law_factor,
+            % (dt, lim.dt_max, lim.method, lim.law, lim.variant,
+               " (Kelvin-Voigt's: at its calibrated k, d; the factor scaled to the run's)"
+               if lim.law.endswith("kelvin_voigt") else "", lim.dt_max / lim.law_factor,
                lim.law_factor, lim.dt_max))
