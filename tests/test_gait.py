@@ -81,3 +81,45 @@ def test_stance_forces_peak_settle_and_friction_sign_change():
         assert st["Fn_settled"] == pytest.approx(st["weight"], rel=0.06)
         assert st["Ft_early"] < 0 < st["Ft_late"]                     # friction - to +
         assert any(d == "-+" for _, d in st["Ft_sign_changes"])
+
+
+# --- issue 26, item 6: steady() says whether the steps it averages are steady ----------------
+
+def _fell_after_one_step():
+    """The paper's start with thetad1 x 0.8 takes one complete step and falls at 1.6 s
+    (found by a scan of the start's rates)."""
+    x = np.array(pdw.X0_PAPER)
+    x[6] *= 0.8
+    r = pdw.simulate(x, t_end=3.5, record_every=0, on_failure="return")
+    assert r.status == "fell" and len(pdw.steps(r)) == 1
+    return r
+
+
+def test_steady_of_a_run_that_fell_after_one_step_is_not_converged():
+    r = _fell_after_one_step()
+    sd = pdw.steps(r).steady()
+    assert sd["converged"] is False
+    assert sd["last"] == 1 and sd["n_steps"] == 1
+    assert np.isnan(sd["spread_L"])
+
+
+def test_steady_of_a_transient_is_not_converged_and_of_a_converged_gait_is():
+    r = pdw.simulate(t_end=3.5, record_every=0)             # the paper's start: 5 steps, decaying
+    sd = pdw.steps(r).steady()
+    assert r.status == "walked" and sd["last"] == 4 and sd["converged"] is False
+    assert sd["spread_L"] > 1e-3 * sd["L"]
+    r = pdw.simulate(t_end=20, params=pdw.Params.paper_steady(), record_every=0)
+    sd = pdw.steps(r).steady()
+    assert sd["converged"] is True
+    assert sd["spread_L"] <= 1e-3 * sd["L"] and sd["spread_P"] <= 1e-3 * sd["P"]
+    # the tolerance decides: tighter than the cdm grid's 2 dt on P, not converged
+    assert pdw.steps(r).steady(rtol=1e-4)["converged"] is False
+
+
+def test_steady_checks_its_arguments():
+    st = pdw.steps(pdw.simulate(t_end=1.0, record_every=0))
+    for bad in (0, 1.5, "4", True):
+        with pytest.raises(pdw.InvalidInputError, match="last"):
+            st.steady(bad)
+    with pytest.raises(pdw.InvalidInputError, match="rtol"):
+        st.steady(rtol=0.0)

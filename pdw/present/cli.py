@@ -176,6 +176,10 @@ def _run(args):
                   "v = %.4f m/s, cycle = %.4f s, double support = %.1f ms (%.2f %%)"
                   % (sd["last"], sd["L"], sd["travel"], sd["P"], sd["v"], sd["cycle"],
                      1e3 * sd["double_support"], 100 * sd["ds_fraction"])]
+        if not sd["converged"]:
+            lines[-1] = lines[-1].replace("steady (", "not yet steady (", 1)
+            lines.append("(not converged: L changes by up to %.2g m, P by %.2g s between the "
+                         "last steps)" % (sd["spread_L"], sd["spread_P"]))
     elif not res.walked:
         lines += ["", "no steady values: the run %s at t = %.4f s" % (res.status, res.t_final)]
     print("\n".join(lines))

@@ -69,8 +69,9 @@ def walk_report(result, last=4) -> str:
         "", "Steps (docs/model.md section 8 definitions):", st.to_text(), ""]
     if len(st):
         sd = st.steady(last)
-        lines.append("Last %d steps (mean, largest change between successive steps) vs the paper:"
-                     % sd["last"] if result.walked else
+        lines.append("Last %d steps (mean, largest change between successive steps%s) vs the "
+                     "paper:" % (sd["last"], "" if sd["converged"] else "; not converged")
+                     if result.walked else
                      "Last %d steps before the run %s (mean, largest change; not a steady gait):"
                      % (sd["last"], result.status))
         lines.append("%-22s %10s %10s %10s" % ("", "pdw", "change", "paper"))

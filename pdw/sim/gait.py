@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 
-from ..core import _layout
+from ..core import _layout, checks
 
 if TYPE_CHECKING:                 # annotations only (simulation imports this module)
     import pandas
@@ -58,28 +58,47 @@ class Steps:
     def __getitem__(self, name):
         return self.table[name]
 
-    def steady(self, last: int = 4) -> dict[str, float | int]:
-        """The steady gait: the mean of the last ``last`` complete steps.
+    def steady(self, last: int = 4, *, rtol: float = 1e-3) -> dict[str, float | int | bool]:
+        """The steady gait: the mean of the last ``last`` complete steps, and whether they
+        have converged.
 
         Parameters
         ----------
         last : int
-            Steps to average (fewer when the run has fewer; NaN entries are skipped).
+            Steps to average (>= 1; fewer when the run has fewer; NaN entries are skipped;
+            ``converged`` needs at least 2).
+        rtol : float
+            ``converged`` needs every consecutive pair of the averaged steps to agree in L,
+            travel, P and cycle within rtol relative to the mean (the tolerance of a scene's
+            periodic stop, `pdw.Scene`); > 0.
 
         Returns
         -------
         dict
-            ``n_steps`` (all steps), ``last`` (steps averaged), the means of ``L``, ``travel``
-            [m], ``P``, ``cycle``, ``double_support`` [s], ``v`` [m/s], ``ds_fraction`` [-],
-            and for each ``spread_<name>``: the largest absolute difference between
-            consecutive averaged steps (how far from steady they still are; NaN for one step).
+            ``n_steps`` (all steps), ``last`` (steps averaged), ``converged`` (bool: ``last``
+            full steps were averaged and they agree within ``rtol``; False for a run with
+            fewer steps, e.g. one that fell after one step, or one still in its transient),
+            the means of ``L``, ``travel`` [m], ``P``, ``cycle``, ``double_support`` [s],
+            ``v`` [m/s], ``ds_fraction`` [-], and for each ``spread_<name>``: the largest
+            absolute difference between consecutive averaged steps (how far from steady they
+            still are; NaN for one step). The means are those of the steps there are, steady
+            or not: read them as a steady gait only when ``converged`` is True. ``converged``
+            says nothing about how the run ended (`Result.status`).
         """
-        out: dict[str, float | int] = {"n_steps": len(self), "last": min(last, len(self))}
+        last = checks.count("last", last, lo=1)
+        rtol = checks.positive("rtol", rtol)
+        out: dict[str, float | int | bool] = {"n_steps": len(self), "last": min(last, len(self)),
+                                              "converged": False}
+        agree = last >= 2
         for name in ("L", "travel", "P", "v", "cycle", "double_support", "ds_fraction"):
             a = self.table[name]
             a = a[np.isfinite(a)][-last:]
             out[name] = float(np.mean(a)) if len(a) else float("nan")
-            out["spread_" + name] = float(np.max(np.abs(np.diff(a)))) if len(a) > 1 else float("nan")
+            spread = float(np.max(np.abs(np.diff(a)))) if len(a) > 1 else float("nan")
+            out["spread_" + name] = spread
+            if name in ("L", "travel", "P", "cycle"):
+                agree = agree and len(a) == last and spread <= rtol * abs(out[name])
+        out["converged"] = bool(agree)
         return out
 
     def to_dataframe(self) -> pandas.DataFrame:
