@@ -474,7 +474,8 @@ def _saved():
 def _load(data):
     """A saved result with random arrays replaced, dropped or mutated and random metadata
     fields replaced by junk: pdw.load gives an InvalidInputError or a Result whose arrays
-    are consistent and finite."""
+    are consistent, its times finite (a state, force or energy may be NaN or inf: a run's
+    data, which a saved diverged run holds, issue 26.3)."""
     import json
     s = _saved()
     a = {k: v.copy() for k, v in s["arrays"].items()}
@@ -500,7 +501,7 @@ def _load(data):
         r = pdw.load(path)
     except pdw.InvalidInputError:
         return
-    assert r.x.shape == (len(r.t), 8) and np.isfinite(r.x).all() and np.isfinite(r.t).all()
+    assert r.x.shape == (len(r.t), 8) and np.isfinite(r.t).all()
     assert r.flags.shape == (len(r.t), 2) and set(np.unique(r.flags)) <= {0, 1}
     assert r.status in ("walked", "periodic", "fell", "diverged", "no_steps", "interrupted")
 

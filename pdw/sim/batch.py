@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 import os
+import pathlib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -23,10 +24,11 @@ from ..core.errors import InvalidInputError
 from ..core.integrators import METHODS
 from ..core.integrators import get as _method_info
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
+from . import files as _files
 from . import stepsize as _stepsize
 from .chunks import _plist, check_record, honest, record_subset, run_chunked
 from .gait import Steps, steps_from_rows
-from .simulation import _REASONS, _check_count, _check_positive
+from .simulation import _REASONS, Event, Result, _check_count, _check_positive
 
 _STATUS = {0: "interrupted", 1: "walked", 2: "fell", 3: "diverged", 5: "diverged", 6: "periodic"}
 _STOP = {i: ("t_end" if i == 0 else name) for i, name in enumerate(_layout.STOP)}
@@ -121,6 +123,12 @@ class BatchResult:
         """The last gait steps of walker i (at most STEP_RING), as `pdw.steps` gives them."""
         n = min(int(self.n_gait_steps[i]), _layout.STEP_RING)
         return steps_from_rows(self.gait_rows[i, :n])
+
+    def save(self, path) -> pathlib.Path:
+        """Write the batch (every per-walker array, its settings, the recorded walkers'
+        `Result` s) with its provenance to ``path`` (``.npz``); `pdw.load` reads it back as a
+        BatchResult (`pdw.sim.files`)."""
+        return _files.save(self, path)
 
     def to_dataframe(self):
         """One row per walker: status, stop_reason, t_final, the final state (columns
@@ -391,3 +399,9 @@ def _result(out, dt, t_end, method, variant):
         n_touch_down=out["n_touch_down"], n_lift_off=out["n_lift_off"],
         n_gait_steps=out["n_gait_steps"], gait_rows=out["gait"], dt=dt, t_end=t_end,
         method=method, variant=variant)
+
+
+# the BatchResult's file kind (pdw.sim.files owns the format)
+_files.register(_files.BATCH_FORMAT, BatchResult, _files.batch_to_file,
+                lambda arrays, meta: _files.batch_from_file(arrays, meta, BatchResult, Result,
+                                                            Event))

@@ -102,9 +102,8 @@ class Steps:
         return out
 
     def to_dataframe(self) -> pandas.DataFrame:
-        """One row per step as a pandas DataFrame (`pdw.sim.io.steps_to_dataframe`; needs
+        """One row per step as a pandas DataFrame (`steps_to_dataframe`; needs
         pandas): the columns of `table`, units in ``df.attrs["units"]``."""
-        from .io import steps_to_dataframe
         return steps_to_dataframe(self)
 
     def describe_step(self, k: int = -1) -> str:
@@ -203,3 +202,23 @@ def steps(result_or_events: Result | Sequence[Event]) -> Steps:
         prev_td_t = e.t
     table = {f: np.array([r[f] for r in rows], dtype=int if f == "leg" else float) for f in FIELDS}
     return Steps(table)
+
+
+#: Units of the step descriptors (`pdw.core._layout.STEP`).
+STEP_UNITS = {"leg": "", "t_lift_off": "s", "t_touch_down": "s", "L": "m", "travel": "m",
+              "P": "s", "v": "m/s", "cycle": "s", "double_support": "s", "ds_fraction": ""}
+
+
+def steps_to_dataframe(steps):
+    """One row per gait step (columns `pdw.core._layout.STEP`); units in ``df.attrs``. Needs
+    pandas."""
+    try:
+        import pandas as pd
+    except ImportError:
+        raise ImportError("this export needs pandas (pip install pandas)") from None
+    df = pd.DataFrame({k: np.asarray(v) for k, v in steps.table.items()})
+    df.index.name = "step"
+    if "leg" in df:
+        df["leg"] = df["leg"].astype(int)
+    df.attrs["units"] = dict(STEP_UNITS)
+    return df

@@ -33,6 +33,7 @@ from ..core.integrators import METHODS
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
 from ..core.params import X0_PAPER, Params
 from . import dense as _dense
+from . import files as _files
 from . import io as _io
 from . import stepsize as _stepsize
 from .buffers import RecordBuffer
@@ -198,10 +199,10 @@ class Result:
         return _io.result_to_dataframe(self)
 
     def to_xarray(self) -> xarray.Dataset:
-        """The run as an xarray Dataset (`pdw.sim.io.result_to_xarray`; needs xarray):
+        """The run as an xarray Dataset (`pdw.sim.files.result_to_xarray`; needs xarray):
         ``x`` (time x state), ``flags`` and forces (time x leg), units in each variable's
         ``attrs["units"]``, provenance and settings in ``ds.attrs``."""
-        return _io.result_to_xarray(self)
+        return _files.result_to_xarray(self)
 
     def save(self, path: str | os.PathLike) -> pathlib.Path:
         """Write the run with its provenance (pdw version, INPUT_HASH, source revision,
@@ -215,9 +216,11 @@ class Result:
         Returns
         -------
         pathlib.Path
-            The file written.
+            The file written (`pdw.sim.files`: every Result pdw returns -- any status, contact
+            law, dense output, features, t_eval -- is read back by `pdw.load` as it was, NaN
+            and inf data included).
         """
-        return _io.save(self, path)
+        return _files.save(self, path)
 
     def summary(self) -> str:
         """One line: method, status, steps and step size, end time, events, gait steps (and the
@@ -580,3 +583,10 @@ def _result(raw, params, variant, method, dt, t_end, wall, on_failure,
                      np.array2string(failure["x"], precision=5), advice),
                   t=failure["t"], x=failure["x"], reason=failure["reason"], result=res)
     return res
+
+
+# the Result's file kind (pdw.sim.files owns the format; the classes are registered here, where
+# they are defined)
+_files.register(_files.FORMAT, Result, _files.result_to_file,
+                lambda arrays, meta: _files.result_from_file(arrays, meta, Result, Event),
+                to_xarray=_files.result_to_xarray)
