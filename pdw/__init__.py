@@ -77,6 +77,7 @@ from .sim.gait import Steps, steps
 from .sim.scene import Scene, run
 from .sim.simulation import Event, Result, simulate
 from .studies import sweep
+from .studies.table import load_sweep
 
 # The public modules of __all__ keep their flat import paths (``import pdw.hybrid``,
 # ``from pdw.sweep import run_study``) from before the layers.
@@ -93,6 +94,6 @@ __all__ = [
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait", "Scene", "run",
     "limit_cycle", "cell_mapping", "find_gait", "sweep",
     "StepSizeWarning", "StepSizeError", "examples", "continue_gait", "Branch", "Bifurcation",
-    "ode_function", "OdeFunction", "load", "RecordBuffer",
+    "ode_function", "OdeFunction", "load", "load_sweep", "RecordBuffer",
     "Contact", "Progress",
 ]

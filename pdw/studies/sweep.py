@@ -30,13 +30,10 @@ from its CSV: rerunning skips the points already there and computes only the oth
 from __future__ import annotations
 
 import concurrent.futures as cf
-import csv
 import dataclasses
 import datetime
 import fcntl
-import io
 import json
-import math
 import os
 import pathlib
 import platform
@@ -53,69 +50,11 @@ from ..core.progress import Progress, progress_bar  # noqa: F401 (pdw.sweep.Prog
 from ..core.provenance import source_revision
 from .points import _classify, _newton_point, batchable, groups, run_point, run_points  # noqa: F401 (pdw.sweep.run_point)
 from .study import COLUMNS, Study, check_name, load_study, parse_study, settings_hash  # noqa: F401 (pdw.sweep.parse_study)
+from .table import csv_line, fmt, header, load_sweep, read_rows  # noqa: F401 (pdw.sweep.read_rows)
 
-# --- CSV (resumable) ------------------------------------------------------------------------------
+# --- CSV (resumable): the format is pdw.studies.table's --------------------------------------
 
-def _header(study):
-    return ["index"] + study.axis_names + list(COLUMNS)
-
-
-def _fmt(v):
-    if isinstance(v, float):
-        return repr(v) if math.isfinite(v) else ("nan" if math.isnan(v) else repr(v))
-    if isinstance(v, (np.floating,)):
-        return repr(float(v))
-    return str(v)
-
-
-def _parse(v):
-    try:
-        return float(v) if v not in ("",) else ""
-    except ValueError:
-        return v
-
-
-def read_rows(path, study) -> dict:
-    """Rows already in a study's CSV, by index; checks that they belong to ``study`` (same
-    columns, same axis values). Malformed lines (a write cut by a kill), rows computed under
-    other settings (their ``settings`` hash differs: another preset, method, [run], fixed
-    parameter or model) and ``error`` rows are dropped: they are computed again."""
-    path = pathlib.Path(path)
-    if not path.exists():
-        return {}
-    text = path.read_text()
-    lines = text.splitlines()
-    if not lines:
-        return {}
-    header = next(csv.reader([lines[0]]))
-    if header != _header(study):
-        raise PdwError("%s: its columns %s are not this study's %s; use a fresh output folder "
-                       "or resume=False (--fresh)" % (path, header, _header(study)))
-    pts = dict(study.points())
-    rows = {}
-    for line in lines[1:]:
-        rec = next(csv.reader([line]), None)
-        if rec is None or len(rec) != len(header):
-            continue                                   # torn line
-        row = dict(zip(header, rec))
-        try:
-            k = int(row["index"])
-        except ValueError:
-            continue
-        if k not in pts or any(not np.isclose(float(row[a]), pts[k][a], rtol=1e-12, atol=0)
-                               for a in study.axis_names):
-            raise PdwError("%s: row %s does not match this study's point %s; use a fresh output "
-                           "folder or resume=False (--fresh)" % (path, row["index"], pts.get(k)))
-        if row["status"] in ("", "error") or row["settings"] != study.task(k, pts[k])["settings"]:
-            continue
-        rows[k] = {c: (int(row[c]) if c == "index" else _parse(row[c])) for c in header}
-    return rows
-
-
-def _csv_line(row, header):
-    buf = io.StringIO()
-    csv.writer(buf, lineterminator="\n").writerow([_fmt(row.get(c, "")) for c in header])
-    return buf.getvalue()
+_header, _fmt, _csv_line = header, fmt, csv_line       # the names this module used
 
 
 # --- progress -------------------------------------------------------------------------------------
