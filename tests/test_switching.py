@@ -163,3 +163,31 @@ def test_lift_off_needs_above_and_moving_up(h2, dy2, expect):
                      on_failure="return", check_step="off")
     lo = [e for e in r.events if e.leg == 2 and e.kind == "lift_off" and e.t == 0.0]
     assert len(lo) == expect, r.events
+
+
+@pytest.mark.parametrize("method", ["cdm", "rodas4"])
+def test_lane_loops_switch_crafted_states_as_the_scalar_loop(method, monkeypatch):
+    """The ensemble engine's copies of the rules (the masks of the structure-of-arrays lane
+    loops, per instruction set) on the crafted threshold states: each walker's flags, event
+    counts and final state bit for bit the scalar loop's, which the tests above pin to the
+    reference. Many of these states switch in their first steps, where the lane loops hand
+    over between the start-up and the lanes."""
+    from pdw.core import _batch
+    from pdw.sim.batch import ISA_ENV, simulate_batch
+    cases = _crafted(np.random.default_rng(7), 48)
+    X = np.array([c[0] for c in cases])
+    F = np.array([c[1] for c in cases])
+    kw = dict(t_end=6 * DT, dt=DT, method=method, variant="paper", check_step="off")
+    if method == "rodas4":
+        kw.update(rtol=1e-6, atol=1e-8)
+    ref = [pdw.simulate(x, flags0=tuple(f), record_every=0, on_failure="return", **kw)
+           for x, f in zip(X, F)]
+    assert sum(r.event_counts["touch_down"] + r.event_counts["lift_off"] for r in ref) >= 20
+    for isa in [n for n in _batch.ISAS if _batch.isa_supported(n)]:
+        monkeypatch.setenv(ISA_ENV, isa)
+        b = simulate_batch(X, flags0=F, lanes=8, threads=1, **kw)
+        for i, r in enumerate(ref):
+            assert b.status[i] == r.status, (isa, i)
+            assert b.n_touch_down[i] == r.event_counts["touch_down"], (isa, i)
+            assert b.n_lift_off[i] == r.event_counts["lift_off"], (isa, i)
+            np.testing.assert_array_equal(b.x_final[i], r.x_final, err_msg="%s %d" % (isa, i))
