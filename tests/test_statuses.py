@@ -63,3 +63,52 @@ def test_each_velocity_is_checked_against_max_speed(k, method):
     assert r.failure["t"] == 0.0
     ok = pdw.simulate(x0, max_speed=6.0, **kw)
     assert ok.failure is None or ok.failure["reason"] != REASON["speed"]
+
+
+# ---- the end-of-run checks of simulate and of the batch (docs/ensemble.md) --------------------
+
+@pytest.mark.parametrize("leg", [1, 2])
+def test_a_leg_turning_past_a_full_turn_is_a_runaway(leg):
+    """Feet far above the ground, one leg spun at 300 rad/s: it passes 2 pi within 0.05 s; the
+    run reached its end but is "diverged" (runaway), whichever leg it is."""
+    x0 = np.array(pdw.X0_PAPER, float)
+    x0[1] += 1.0
+    x0[5 + leg] = 300.0
+    r = pdw.simulate(x0, t_end=0.05, dt=1e-5, method="rk4", flags0=(0, 0), record_every=10,
+                     check_step="off", on_failure="return")
+    assert abs(r.x_final[1 + leg]) > 2 * np.pi > abs(r.x_final[4 - leg])       # only this leg
+    assert r.status == "diverged" and "runaway" in r.failure["reason"], r.status
+    b = pdw.simulate_batch(x0[None, :], t_end=0.05, dt=1e-5, method="rk4", flags0=(0, 0),
+                           check_step="off")
+    assert b.status[0] == "diverged" and "runaway" in b.failure_reason[0]
+
+
+def test_batch_reports_every_loop_status_as_simulate_does():
+    """The batch's names of the compiled loops' statuses are simulate's public ones
+    (`Result.status`): "done" is "walked", a singular step matrix is "diverged" (as
+    `SingularSystemError` is a `DivergedError`)."""
+    from pdw.core import _layout
+    from pdw.sim import batch
+    public = {"running": "interrupted", "done": "walked", "singular": "diverged"}
+    for code, name in batch._STATUS.items():
+        loop = _layout.STATUS[code]
+        assert name == public.get(loop, loop), (code, loop, name)
+    assert set(batch._STATUS) >= {_layout.STATUS.index(s) for s in ("done", "fell", "diverged",
+                                                                     "singular", "periodic")}
+
+
+def test_batch_no_steps_is_judged_on_touch_downs():
+    """`pdw.sim.chunks.honest`: a walker that reached its end after two pendulum periods
+    without a touch-down did not walk ("no_steps"), whatever its lift-offs; one touch-down
+    is enough to be "walked"."""
+    from pdw.sim.chunks import honest
+    x0 = np.tile(np.asarray(pdw.X0_PAPER, float), (3, 1))
+    b = pdw.simulate_batch(x0, t_end=0.2, check_step="off")
+    assert list(b.status) == ["walked"] * 3
+    period = 2 * np.pi * np.sqrt(pdw.Params.paper().l / pdw.Params.paper().g)
+    b.t_final[:] = 2.01 * period
+    b.n_touch_down[:] = [0, 1, 0]
+    b.n_lift_off[:] = [2, 0, 0]
+    b.t_final[2] = 1.99 * period                          # too short to judge
+    honest(b, x0, pdw.Params.paper())
+    assert list(b.status) == ["no_steps", "walked", "walked"]

@@ -191,3 +191,16 @@ def test_lane_loops_switch_crafted_states_as_the_scalar_loop(method, monkeypatch
             assert b.n_touch_down[i] == r.event_counts["touch_down"], (isa, i)
             assert b.n_lift_off[i] == r.event_counts["lift_off"], (isa, i)
             np.testing.assert_array_equal(b.x_final[i], r.x_final, err_msg="%s %d" % (isa, i))
+
+
+@pytest.mark.parametrize("method", ["rodas4", "dopri5"])
+def test_adaptive_methods_settle_a_lift_off_and_its_arming_together(method):
+    """A downhill support foot just above the ground and rising lifts off at t = 0 and, in the
+    same update, is armed (it is a swing foot above the ground, downhill of the other): the
+    adaptive loops apply the rules until nothing changes, so no switch is pending at the start
+    of the first step, which is then the full trial step, not one cut at the arming."""
+    x0 = _state(0.2, -0.1, 1e-6, 0.3, 0.0)
+    r = pdw.simulate(x0, t_end=2e-3, dt=1e-4, method=method, variant="consistent", flags0=(1, 1),
+                     record_every=1, on_failure="return", check_step="off")
+    assert [(e.t, e.leg, e.kind) for e in r.events] == [(0.0, 1, "lift_off")]
+    assert r.t[1] - r.t[0] == pytest.approx(1e-4, rel=1e-12)
