@@ -10,7 +10,7 @@ SOURCES := $(wildcard generated/*.c generated/*.h pdw/core/*.pyx pdw/core/*.pxi 
 # an extra's requirements, read from pyproject.toml (installed without rebuilding pdw)
 EXTRA_REQS = $(PY) -c "import sys, tomllib; print('\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies'][sys.argv[1]]))"
 
-.PHONY: docs all run test lint test-all derive check-generated bench study sanitize clean distclean
+.PHONY: docs all run test lint test-all derive check-generated bench study sanitize mutation clean distclean
 
 all: $(STAMP)
 
@@ -110,6 +110,12 @@ sanitize: $(STAMP)
 	  LD_PRELOAD="$$(gcc -print-file-name=libasan.so) $$(gcc -print-file-name=libubsan.so)" \
 	  $(abspath $(PY)) -m pytest -q -p no:cacheprovider $(SAN_TESTS) \
 	  --deselect tests/test_export.py::test_source_revision_is_pdws_own_not_the_cwds
+
+## mutation: the mutation campaign (docs/testing.md): each mutant of benchmarks/mutation.py
+## applied, rebuilt (object cache in build/mutation-cc), its focused tests run, the source
+## restored; results in benchmarks/results/mutation.json. It edits the working tree while it runs
+mutation: $(STAMP)
+	$(PY) benchmarks/mutation.py $(MUTATION_ARGS)
 
 clean:
 	rm -rf build out
