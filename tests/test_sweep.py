@@ -300,18 +300,20 @@ fallback = false
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
-def test_ctrl_c_ends_a_sweep_at_once_keeping_the_finished_rows(tmp_path):
-    """Two batches on two threads: the first (8 walkers that fall within seconds) finishes,
-    the second (8 walkers for 20000 s: minutes) runs. Ctrl-C then stops the running batch at
-    its next poll: the command exits with 130 within seconds (it used to wait for the batch),
-    the finished rows stay in the CSV, and a rerun resumes from them."""
+@pytest.mark.parametrize("backend", ["thread", "process"])
+def test_ctrl_c_ends_a_sweep_at_once_keeping_the_finished_rows(tmp_path, backend):
+    """Two batches on two workers: the first (8 walkers that fall within seconds) finishes,
+    the second (8 walkers for 20000 s: minutes) runs. Ctrl-C (to the command only, not its
+    workers) then stops the running batch: at its next poll (threads) or by ending the pool's
+    processes. The command exits with 130 within seconds (it used to wait for the batch), the
+    finished rows stay in the CSV, and a rerun resumes from them."""
     f = tmp_path / "fastslow.toml"
     f.write_text(_FAST_SLOW)
     out = tmp_path / "out"
     child = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
              "from pdw.present.cli import main; sys.exit(main(sys.argv[1:]))")
     proc = subprocess.Popen([sys.executable, "-c", child, "sweep", str(f), "--out", str(out),
-                             "--workers", "2", "--backend", "thread", "--no-figures",
+                             "--workers", "2", "--backend", backend, "--no-figures",
                              "--no-progress"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True)
     try:
