@@ -79,6 +79,17 @@ def test_a_spec_name_cannot_leave_the_output_folder(tmp_path, capsys, name):
     assert not pathlib.Path("/tmp/pdw-continue-escape.csv").exists()
 
 
+def test_run_spec_in_python_checks_the_name_too(tmp_path, monkeypatch):
+    """The API under the command (`cli_continue.run_spec` of a spec dict) applies the same
+    rule before computing."""
+    calls = []
+    monkeypatch.setattr(cli_continue, "continue_gait", lambda *a, **k: calls.append(1))
+    spec = _with(("name",), "../escape")
+    with pytest.raises(cli_continue.InvalidInputError, match="plain file name"):
+        cli_continue.run_spec(spec, out=tmp_path / "o")
+    assert calls == [] and list(tmp_path.iterdir()) == []
+
+
 # --- issue 26 item 11: the whole spec, before the first point ---------------------------------
 
 BAD = [
