@@ -33,7 +33,11 @@ The spec (docs/continuation.md; examples in pdw/examples/continuations/, run by
 
 Writes ``<out>/<name>.csv`` (the points of every branch, with ``branch`` and ``period_n``
 columns), ``<out>/<name>.json`` (provenance: spec, code version, settings, per-branch summary
-with the bifurcations, map evaluations, wall time) and ``<out>/<name>.png``.
+with the bifurcations, map evaluations, wall time) and ``<out>/<name>.png`` (not with
+``--no-figures``, which needs no matplotlib; without it and without matplotlib the command
+stops before the work, exit code 4). The whole spec is checked first
+(`pdw.present.continue_spec.check_spec`: every key's type and range, exit code 2); ``name``
+must be a plain file name (`pdw.core.paths.file_stem`).
 """
 from __future__ import annotations
 
