@@ -10,7 +10,7 @@ SOURCES := $(wildcard generated/*.c generated/*.h pdw/core/*.pyx pdw/core/*.pxi 
 # an extra's requirements, read from pyproject.toml (installed without rebuilding pdw)
 EXTRA_REQS = $(PY) -c "import sys, tomllib; print('\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies'][sys.argv[1]]))"
 
-.PHONY: docs all run test lint test-all derive check-generated bench study sanitize mutation clean distclean
+.PHONY: docs all run test test-quick lint test-all derive check-generated bench study sanitize mutation clean distclean
 
 all: $(STAMP)
 
@@ -39,6 +39,12 @@ test: $(STAMP)
 	$(PY) -m derive --check
 	$(MAKE) --no-print-directory lint
 	$(PY) -m pytest -q
+
+## test-quick: a fast subset (marker quick: parameters, simulate, gait steps, scenes, the ODE
+## object, the command line, output files, the package's shape; tests/conftest.py QUICK_FILES),
+## without the generated-code check and lint
+test-quick: $(STAMP)
+	$(PY) -m pytest -q -m "quick and not slow"
 
 ## lint: ruff (rules in pyproject.toml), the import contract (layers, no cycles: docs/architecture.md)
 ## and mypy on the public modules ([tool.mypy] in pyproject.toml)

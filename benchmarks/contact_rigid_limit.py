@@ -1,6 +1,6 @@
 """The rigid-ground limit of each dissipative normal law (issue 12; docs/contact_laws.md).
 
-The hybrid model's heel strike is perfectly inelastic (MODEL.md section 9); a compliant law
+The hybrid model's heel strike is perfectly inelastic (docs/model.md section 9); a compliant law
 approaches it only if, as the ground stiffens, its impact restitution goes to 0. The scaling:
 
 * hunt_crossley: d_n = d_n0 (k/k0)^(4/3), which keeps the linearised damping ratio at the

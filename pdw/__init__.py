@@ -31,6 +31,7 @@ examples                the scenes and studies shipped with pdw (``pdw run --lis
 Progress                the progress bar of long jobs (``progress=`` of sweeps, cell maps, basins,
                         continuation, figures; tqdm when installed, quiet off a terminal)
 PdwError, SimulationError, DivergedError, InvalidInputError   the error hierarchy
+GaitNotFoundError       no periodic gait from any starting guess (find_gait, continue_gait)
 STATE, VARIANTS         the state layout and the contact variants (docs/model.md section 6)
 """
 import sys as _sys
@@ -39,7 +40,7 @@ from . import examples  # package data: the shipped scenes and studies
 from .analysis import cell_mapping, hybrid, limit_cycle
 from .analysis.branch import Bifurcation, Branch
 from .analysis.continuation import continue_gait
-from .analysis.gait_types import Gait
+from .analysis.gait_types import Gait, GaitNotFoundError
 from .analysis.limit_cycle import find_gait
 from .core import __version__  # noqa: F401 (pdw.__version__)
 from .core._layout import INPUT_HASH
@@ -95,5 +96,5 @@ __all__ = [
     "limit_cycle", "cell_mapping", "find_gait", "sweep",
     "StepSizeWarning", "StepSizeError", "examples", "continue_gait", "Branch", "Bifurcation",
     "ode_function", "OdeFunction", "load", "load_sweep", "RecordBuffer",
-    "Contact", "Progress",
+    "Contact", "Progress", "GaitNotFoundError",
 ]

@@ -63,3 +63,28 @@ def test_steps_and_gait_reprs_are_short():
     _repr_ok(repr(g), ["hybrid", "stable", "period", "|multipliers|"])
     assert "%.6g" % g.period in repr(g)
     assert np.isfinite(g.period)
+
+
+def test_import_pdw_needs_no_fcntl():
+    """Issue 26 item 16: `import pdw` (and a study file's parsing) works where fcntl does not
+    exist (Windows); the lock imports it where it is taken."""
+    code = ("import sys\n"
+            "class Block:\n"
+            "    def find_spec(self, name, path=None, target=None):\n"
+            "        if name == 'fcntl':\n"
+            "            raise ImportError('no fcntl here')\n"
+            "sys.meta_path.insert(0, Block())\n"
+            "sys.modules.pop('fcntl', None)\n"
+            "import pdw, pdw.sweep, pdw.present.cli\n"
+            "assert 'fcntl' not in sys.modules, 'fcntl was imported'\n"
+            "print('ok', pdw.__version__)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         cwd=pathlib.Path(__file__).resolve().parent.parent, timeout=120)
+    assert out.returncode == 0 and out.stdout.startswith("ok"), out.stderr[-2000:]
+
+
+def test_gait_not_found_error_is_public():
+    """Issue 26 item 12: the error find_gait and continue_gait raise is importable from pdw."""
+    from pdw.analysis.gait_types import GaitNotFoundError
+    assert pdw.GaitNotFoundError is GaitNotFoundError and "GaitNotFoundError" in pdw.__all__
+    assert issubclass(pdw.GaitNotFoundError, pdw.PdwError)

@@ -2,6 +2,8 @@
 import io
 import json
 import os
+import pathlib
+import re
 import subprocess
 import sys
 
@@ -118,15 +120,92 @@ def test_warnings_are_one_line_without_source(tmp_path, capsys):
     assert "cli.py" not in err and "warnings.warn" not in err
 
 
-def test_missing_optional_dependency_names_the_extra(tmp_path, capsys, monkeypatch):
-    monkeypatch.setitem(sys.modules, "matplotlib", None)       # import matplotlib -> ImportError
-    for mod in [m for m in sys.modules if m.startswith("pdw.plots")]:
+def _no_module(monkeypatch, name):
+    """Simulate an optional dependency that is not installed: ``import name`` raises."""
+    monkeypatch.setitem(sys.modules, name, None)
+    for mod in [m for m in sys.modules if m.startswith(name + ".")]:
         monkeypatch.delitem(sys.modules, mod)
-    rc = cli.main(["walk", "--t-end", "0.5", "--out", str(tmp_path)])
+
+
+# issue 26 item 9: one rule for a missing optional dependency, checked before the work
+
+@pytest.mark.parametrize("module", ["matplotlib", "PIL"])
+def test_walk_without_the_plot_extra_refuses_before_the_work(tmp_path, capsys, monkeypatch,
+                                                             module):
+    if module == "PIL":                 # matplotlib itself imports PIL: have it imported already
+        pytest.importorskip("matplotlib.pyplot")
+    _no_module(monkeypatch, module)
+    ran = []
+    monkeypatch.setattr(Scene, "run", lambda self: ran.append(1))
+    rc = cli.main(["walk", "--t-end", "0.5", "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err
+    assert rc == 4 and ran == [] and not (tmp_path / "o").exists()
+    assert err.strip().splitlines() == [
+        "pdw: error: %s is not installed (needed for the figures and the GIF): pip install "
+        "'pdw[plot]', or run with --no-figures; nothing was computed" % module]
+
+
+def test_walk_no_figures_needs_no_plot_extra(tmp_path, capsys, monkeypatch):
+    _no_module(monkeypatch, "matplotlib")
+    rc = cli.main(["walk", "--t-end", "0.5", "--no-figures", "--out", str(tmp_path)])
     assert rc == 0 and (tmp_path / "steps.csv").exists()
-    assert err.strip().splitlines() == ["pdw: no figures: matplotlib is not installed: "
-                                        "pip install 'pdw[plot]' (or --no-figures)"]
+    assert capsys.readouterr().err == ""
+
+
+def test_sweep_without_matplotlib_refuses_before_the_work(tmp_path, capsys, monkeypatch):
+    _no_module(monkeypatch, "matplotlib")
+    f = tmp_path / "tiny.toml"
+    f.write_text('name = "tiny"\n[scene]\nstop = { t_end = 1.0 }\n[[axes]]\nname = "k_n"\n'
+                 'values = [1.0e5]\n[run]\nfallback = false\nsteady = 2\n')
+    out = tmp_path / "o"
+    rc = cli.main(["sweep", str(f), "--out", str(out), "--no-progress", "--backend", "serial"])
+    err = capsys.readouterr().err
+    assert rc == 4 and not out.exists(), err
+    assert "matplotlib is not installed (needed for the figure)" in err and "--no-figures" in err
+    rc = cli.main(["sweep", str(f), "--out", str(out), "--no-progress", "--backend", "serial",
+                   "--no-figures"])
+    assert rc == 0 and sorted(p.name for p in out.iterdir()) == ["tiny.csv", "tiny.json"]
+
+
+@pytest.mark.parametrize("where", [["--dask-local"], ["--scheduler", "tcp://127.0.0.1:1"]])
+def test_sweep_without_dask_exits_4_before_the_work(tmp_path, capsys, monkeypatch, where):
+    _no_module(monkeypatch, "distributed")
+    out = tmp_path / "o"
+    rc = cli.main(["sweep", "--example", "fig11_k_n", "--out", str(out), "--no-progress",
+                   "--no-figures"] + where)
+    err = capsys.readouterr().err
+    assert rc == 4 and not out.exists()
+    assert err.strip().splitlines() == [
+        "pdw: error: distributed is not installed (needed for --scheduler and --dask-local): "
+        "pip install 'pdw[dask]'; nothing was computed"]
+
+
+def test_invalid_input_is_reported_before_a_missing_dependency(tmp_path, capsys, monkeypatch):
+    _no_module(monkeypatch, "matplotlib")
+    bad = tmp_path / "bad.toml"
+    bad.write_text("t_ends = 1.0\n")
+    assert cli.main(["walk", "--scene", str(bad), "--out", str(tmp_path)]) == 2
+    assert "t_ends" in capsys.readouterr().err
+
+
+def test_a_run_that_raises_a_divergence_exits_3(tmp_path, capsys):
+    """The exit-code table holds for errors too: a scene whose divergence is an error
+    (on_failure = "raise") ends with code 3 ("fell or diverged"), not 2 ("invalid input")."""
+    scene = tmp_path / "div.toml"
+    scene.write_text('[params]\nk_n = 1e8\n[integrator]\nmethod = "rk4"\ndt = 0.01\n'
+                     '[stop]\nt_end = 2.0\non_failure = "raise"\n')
+    rc = cli.main(["run", str(scene)])
+    err = capsys.readouterr().err
+    assert rc == 3 and "diverged at t = " in err and "Traceback" not in err, err
+
+
+def test_the_readme_exit_code_table_is_the_commands(capsys):
+    """The README's exit codes are `cli.EXIT_CODES`, and it says they hold for every command."""
+    readme = (pathlib.Path(__file__).resolve().parent.parent / "README.md").read_text()
+    text = " ".join(readme.split("Exit codes")[1].split("\n\n")[0].split())
+    assert text.startswith(", the same for every command:"), text
+    codes = [int(c) for c in re.findall(r"(?<![\w.])(\d{1,3}) (?=[a-z])", text)]
+    assert codes == list(cli.EXIT_CODES), text
 
 
 @pytest.mark.parametrize("extra, match", [
@@ -194,3 +273,47 @@ def test_walk_draws_a_bar_over_its_figures_on_a_terminal_only(tmp_path, monkeypa
     assert rc == 0 and (tmp_path / "walker.gif").exists()
     drawn = "figures" in err.getvalue()
     assert drawn == (flag == []), err.getvalue()
+
+
+# issue 26 item 12: every example listed, each with its whole first sentence
+
+def test_list_examples_shows_every_example_with_a_whole_sentence(capsys):
+    assert cli.main(["run", "--list-examples"]) == 0
+    out = capsys.readouterr().out
+    for name in (pdw.examples.scenes() + pdw.examples.studies()
+                 + pdw.examples.continuations()):
+        assert "\n  %s " % name in out, name
+    assert "pdw continue --example NAME" in out
+    # the entries (a name line plus its indented continuation lines) close their parentheses
+    entries = []
+    for line in out.splitlines():
+        if line.startswith("   "):
+            entries[-1] += line
+        elif line.startswith("  "):
+            entries.append(line)
+    assert len(entries) == len(pdw.examples.scenes() + pdw.examples.studies()
+                               + pdw.examples.continuations())
+    for e in entries:
+        text = " ".join(e.split())
+        assert text.count("(") == text.count(")"), text
+    typical = " ".join(out.split("\n  typical_gait")[1].split("example studies")[0].split())
+    assert typical.endswith("agree within 0.1 %."), typical
+
+
+# issue 26 item 2: names from user input never leave --out; a scene's name is a label only
+
+@pytest.mark.parametrize("name", ["../../escape", "/tmp/pdw-scene-escape", "", ".hidden"])
+def test_scene_names_do_not_name_files(tmp_path, capsys, name):
+    scene = tmp_path / "in" / "s.toml"
+    scene.parent.mkdir()
+    scene.write_text('name = "%s"\n[stop]\nt_end = 0.3\n' % name)
+    box = tmp_path / "box"
+    for argv in (["run", str(scene), "--out", str(box / "run")],
+                 ["walk", "--scene", str(scene), "--no-figures", "--out", str(box / "walk")]):
+        assert cli.main(argv) in (0, 3)
+    written = sorted(str(p.relative_to(tmp_path)) for p in tmp_path.rglob("*") if p.is_file())
+    assert written == ["box/run/run.json", "box/run/scene.toml", "box/run/steps.csv",
+                       "box/run/trajectory.npz", "box/walk/report.txt", "box/walk/run.json",
+                       "box/walk/scene.toml", "box/walk/steps.csv", "box/walk/trajectory.npz",
+                       "in/s.toml"]
+    assert not pathlib.Path("/tmp/pdw-scene-escape").exists()

@@ -206,3 +206,38 @@ def test_block_parser_and_skip_marker(tmp_path):
     assert [(b["lang"], b["skip"]) for b in bs] == [("python", None), ("sh", "too slow"),
                                                     ("", None)]
     assert bs[0]["code"] == "x = 1" and bs[0]["line"] == 3
+
+
+#: References that must not come back (issue 26 item 17): the specification is docs/model.md,
+#: the product never points at the development workspace, and the compiled modules and the
+#: layouts live in pdw.core.
+STALE = re.compile(r"MODEL\.md|\.\./shared|/work/shared|(?<![\w.])shared/|pdw\._layout\b|"
+                   r"pdw\._core\b|pdw\._hybrid\b|pdw\._batch\b")
+TEXT_SUFFIXES = {".py", ".pyx", ".pxi", ".pyi", ".c", ".h", ".inc", ".md", ".toml", ".txt",
+                 ".rst", ".cfg", ".in"}
+
+
+def _product_files():
+    yield ROOT / "README.md"
+    for top in ("pdw", "docs", "benchmarks"):
+        for p in sorted((ROOT / top).rglob("*")):
+            if p.is_file() and p.suffix in TEXT_SUFFIXES and "__pycache__" not in p.parts:
+                yield p
+
+
+def test_no_stale_references_in_the_product():
+    hits = []
+    for p in _product_files():
+        for n, line in enumerate(p.read_text(encoding="utf-8", errors="replace").splitlines(), 1):
+            if STALE.search(line):
+                hits.append("%s:%d: %s" % (p.relative_to(ROOT), n, line.strip()))
+    assert hits == [], "\n".join(hits)
+
+
+def test_the_stale_reference_pattern_catches_what_it_should():
+    for bad in ("see MODEL.md section 6", "../shared/paper.pdf", "/work/shared/tools",
+                "`pdw._layout.FEATURES`", "pdw._core", "in shared/notes"):
+        assert STALE.search(bad), bad
+    for good in ("docs/model.md section 6", "pdw.core._layout.FEATURES", "pdw.core._core",
+                 "a shared library", "shared memory"):
+        assert not STALE.search(good), good

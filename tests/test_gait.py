@@ -123,3 +123,17 @@ def test_steady_checks_its_arguments():
             st.steady(bad)
     with pytest.raises(pdw.InvalidInputError, match="rtol"):
         st.steady(rtol=0.0)
+
+
+def test_steps_of_a_batch_points_to_its_per_walker_steps():
+    """Issue 26 item 12: pdw.steps(batch_result) says to use b.steps(i), not "not iterable";
+    other wrong arguments name what pdw.steps takes."""
+    b = pdw.simulate_batch(np.tile(pdw.X0_PAPER, (2, 1)), t_end=0.2)
+    with pytest.raises(pdw.InvalidInputError, match=r"b\.steps\(i\)"):
+        pdw.steps(b)
+    for bad in (5, "events", [1, 2], None):
+        with pytest.raises(pdw.InvalidInputError, match="a Result or a sequence of its Events"):
+            pdw.steps(bad)
+    r = pdw.simulate(t_end=1.5)                  # a one-pass iterator of events still works
+    assert pdw.steps(iter(r.events)).table["L"].tolist() == pdw.steps(r).table["L"].tolist()
+    assert len(pdw.steps(r)) == 2

@@ -3,8 +3,13 @@
 import concurrent.futures as cf
 import csv
 import json
+import os
 import pathlib
+import signal
+import stat
+import subprocess
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -253,3 +258,88 @@ def test_all_studies():
     studies.main([])
     text = (_results.RESULTS / "studies.txt").read_text()
     assert "fig11_k_n" in text and "table5_r" in text
+
+
+# --- issue 26 item 12: file modes, the lock file, Ctrl-C ---------------------------------------
+
+@pytest.mark.parametrize("umask", [0o022, 0o027])
+def test_sweep_files_get_the_umask_mode_and_the_lock_file_goes(tmp_path, umask):
+    """Outputs are written like any new file under the user's umask (0644 under 022: readable
+    by collaborators), not mkstemp's private 0600; the lock file is removed at the end."""
+    pytest.importorskip("matplotlib")
+    old = os.umask(umask)
+    try:
+        res = S.run_study(S.parse_study(TINY.replace("t_end = 6.0", "t_end = 1.0")), tmp_path,
+                          backend="serial", progress=False, figures=plot_study)
+    finally:
+        os.umask(old)
+    modes = {p.name: stat.S_IMODE(p.stat().st_mode) for p in tmp_path.iterdir()}
+    assert modes == {"tiny.csv": 0o666 & ~umask, "tiny.json": 0o666 & ~umask,
+                     "tiny.png": 0o666 & ~umask}, {k: oct(v) for k, v in modes.items()}
+    assert set(res.paths) == {"csv", "json", "png"}
+
+
+def test_the_lock_file_goes_after_an_error_too(tmp_path):
+    with pytest.raises(KeyboardInterrupt):
+        S.run_study(S.parse_study(TINY), tmp_path, executor=KillAfter(1), progress=False,
+                    figures=False, batch=False)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["tiny.csv"]
+
+
+_FAST_SLOW = """
+name = "fastslow"
+[scene.stop]
+t_end = 20000.0
+[[axes]]
+name = "gamma"
+values = [0.05, 0.052, 0.054, 0.056, 0.058, 0.06, 0.062, 0.064,
+          0.019, 0.0192, 0.0194, 0.0196, 0.0198, 0.02, 0.0202, 0.0204]
+[run]
+fallback = false
+"""
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+@pytest.mark.parametrize("backend", ["thread", "process"])
+def test_ctrl_c_ends_a_sweep_at_once_keeping_the_finished_rows(tmp_path, backend):
+    """Two batches on two workers: the first (8 walkers that fall within seconds) finishes,
+    the second (8 walkers for 20000 s: minutes) runs. Ctrl-C (to the command only, not its
+    workers) then stops the running batch: at its next poll (threads) or by ending the pool's
+    processes. The command exits with 130 within seconds (it used to wait for the batch), the
+    finished rows stay in the CSV, and a rerun resumes from them."""
+    f = tmp_path / "fastslow.toml"
+    f.write_text(_FAST_SLOW)
+    out = tmp_path / "out"
+    child = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
+             "from pdw.present.cli import main; sys.exit(main(sys.argv[1:]))")
+    proc = subprocess.Popen([sys.executable, "-c", child, "sweep", str(f), "--out", str(out),
+                             "--workers", "2", "--backend", backend, "--no-figures",
+                             "--no-progress"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and len(_csv_rows(out / "fastslow.csv")) < 8:
+            assert proc.poll() is None, proc.communicate()
+            time.sleep(0.2)
+        assert len(_csv_rows(out / "fastslow.csv")) == 8, "the fast batch did not finish"
+        time.sleep(1.0)                               # the slow batch is running
+        sent = time.monotonic()
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=60)         # the slow batch alone runs for minutes
+        took = time.monotonic() - sent
+    finally:
+        proc.kill()
+    assert proc.returncode == 130 and "interrupted" in err, err[-2000:]
+    assert took < 10.0, took                          # a poll is milliseconds; + the exit
+    rows = _csv_rows(out / "fastslow.csv")
+    assert sorted(int(r["index"]) for r in rows) == list(range(8))
+    assert all(r["status"] == "fell" for r in rows)
+    assert sorted(S.read_rows(out / "fastslow.csv", S.parse_study(_FAST_SLOW))) == list(range(8))
+    assert sorted(p.name for p in out.iterdir()) == ["fastslow.csv"]     # no lock file left
+
+
+def _csv_rows(path):
+    try:
+        return _csv(path)
+    except FileNotFoundError:
+        return []

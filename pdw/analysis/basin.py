@@ -21,13 +21,12 @@ import hashlib
 import json
 import os
 import pathlib
-import tempfile
 import time
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..core import _layout
+from ..core import _layout, paths
 from ..core.errors import InvalidInputError
 from ..core.params import Params
 from ..core.progress import progress_bar
@@ -109,7 +108,7 @@ def _save(path, **arrays):
     """Write the checkpoint atomically (a temporary file in the same folder, then rename)."""
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix="." + path.name, suffix=".tmp.npz")
+    fd, tmp = paths.temp_file(path, suffix=".tmp.npz")
     os.close(fd)
     try:
         np.savez(tmp, **arrays)

@@ -53,6 +53,18 @@ def check():
         raise KeyboardInterrupt("cancelled: the pool of this task was interrupted")
 
 
+def call_with_token(token: Token, fn, *args):
+    """``fn(*args)`` in the calling thread with ``token`` as its cancel token: for tasks that a
+    thread pool of someone else's runs (`pdw.sweep.run_study`'s executor); setting the token
+    stops the compiled loops of ``fn`` at their next poll."""
+    before = current()
+    _local.token = token
+    try:
+        return fn(*args)
+    finally:
+        _local.token = before
+
+
 def thread_map(fn, items, workers: int, bar=None) -> list:
     """``[fn(x) for x in items]`` on ``workers`` threads, in order, stoppable by Ctrl-C.
 

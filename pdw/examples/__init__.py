@@ -58,8 +58,21 @@ def study_path(name: str) -> pathlib.Path:
 
 
 def describe(path: pathlib.Path) -> str:
-    """The first comment line of an example file (its one-line description)."""
+    """An example file's description: the first sentence of its leading comment (the comment
+    lines before the first key, joined; a sentence ends at ". " before a capital letter or at
+    the end of the comment), whole: never cut inside a parenthesis."""
+    words = []
     for line in path.read_text().splitlines():
-        if line.startswith("#"):
-            return line.lstrip("# ").strip()
-    return ""
+        if not line.startswith("#"):
+            if words or line.strip():
+                break
+            continue
+        words += line.lstrip("#").split()
+    text = " ".join(words)
+    depth = 0
+    for i, ch in enumerate(text):
+        depth += {"(": 1, ")": -1}.get(ch, 0)
+        if (ch == "." and depth == 0 and i + 2 < len(text) and text[i + 1] == " "
+                and text[i + 2].isupper()):
+            return text[:i + 1]
+    return text

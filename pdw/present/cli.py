@@ -11,10 +11,12 @@ options given on the command line win.
 prints the run's summary, its gait descriptors and, for a run that walked, their steady values;
 with ``--out DIR`` it writes steps.csv, run.json and the scene as run (scene.toml).
 
-Exit codes (`EXIT_CODES`): 0 the run walked (or the command succeeded); 2 invalid input or
-usage; 3 the run ended without walking (fell, or diverged); 4 an optional dependency is
-missing (the message names the extra to install); 130 interrupted; 141 the output was closed
-(``pdw walk | head``).
+Exit codes (`EXIT_CODES`, the same for every command): 0 the run walked (or the command
+succeeded); 2 invalid input or usage; 3 the run ended without walking (fell, or diverged, or no
+gait was found: `pdw.SimulationError`, `pdw.GaitNotFoundError`); 4 an optional dependency is
+missing (`pdw.present.deps`: checked before the work; the message names the extra to install
+and the option that does without, e.g. ``--no-figures``); 130 interrupted; 141 the output was
+closed (``pdw walk | head``).
 """
 from __future__ import annotations
 
@@ -24,43 +26,36 @@ import json
 import os
 import pathlib
 import sys
+import textwrap
 import warnings
 
 import numpy as np
 
 from .. import examples
-from ..core.errors import PdwError
+from ..analysis.gait_types import GaitNotFoundError
+from ..core.errors import PdwError, SimulationError
 from ..core.integrators import METHODS
 from ..core.provenance import provenance
 from ..sim.gait import steps
 from ..sim.scene import PRESETS, Scene
 from .cli_continue import add_cli as add_continue_cli
 from .cli_sweep import add_cli as add_sweep_cli
+from .deps import EXTRAS, MissingDependency, missing_extra, require  # noqa: F401 (cli.EXTRAS)
 from .report import walk_report
 
 EXIT_CODES = {0: "the run walked (or the command succeeded)",
               2: "invalid input or usage (the message names the field)",
-              3: "the run ended without walking: it fell or diverged",
-              4: "an optional dependency is missing (the message names the extra)",
+              3: "the run ended without walking: it fell or diverged (or no gait was found)",
+              4: "an optional dependency is missing (checked before the work; the message "
+                 "names the extra)",
               130: "interrupted (Ctrl-C)",
               141: "the output was closed early (e.g. `pdw walk | head`)"}
-#: Optional dependencies and the extra that installs them.
-EXTRAS = {"matplotlib": "plot", "PIL": "plot", "distributed": "dask", "dask": "dask",
-          "scipy": "test", "sympy": "derive"}
 
 
 def _version() -> str:
     from ..core import __version__
     from ..core._layout import INPUT_HASH
     return "pdw %s (model input hash %s)" % (__version__, INPUT_HASH[:12])
-
-
-def missing_extra(e: ImportError) -> str | None:
-    """One line naming the extra that provides the module ``e`` failed to import, or None."""
-    top = (getattr(e, "name", None) or "").split(".")[0]
-    if top not in EXTRAS:
-        return None
-    return "%s is not installed: pip install 'pdw[%s]'" % (top, EXTRAS[top])
 
 
 # --- shared output ------------------------------------------------------------------------------
@@ -119,6 +114,8 @@ def walk_scene(args) -> Scene:
 
 def _walk(args):
     scene = walk_scene(args)
+    if not args.no_figures and scene.record.every != 0:
+        require("matplotlib", "PIL", purpose="the figures and the GIF")
     res = scene.run()
     text = walk_report(res)
     print(text)
@@ -130,14 +127,8 @@ def _walk(args):
         if res.x.shape[0] < 2:
             print("no figures: nothing was recorded (record.every = 0)")
         else:
-            try:
-                from .plots import save_all
-                written += save_all(res, out, progress=not args.no_progress)
-            except ImportError as e:
-                hint = missing_extra(e)
-                if hint is None:
-                    raise
-                print("pdw: no figures: %s (or --no-figures)" % hint, file=sys.stderr)
+            from .plots import save_all
+            written += save_all(res, out, progress=not args.no_progress)
     print("\nwrote: " + ", ".join(str(p) for p in written))
     return 0 if res.walked else 3
 
@@ -145,12 +136,17 @@ def _walk(args):
 # --- pdw run ------------------------------------------------------------------------------------
 
 def _list_examples():
-    print("example scenes (pdw run --example NAME):")
-    for name in examples.scenes():
-        print("  %-16s %s" % (name, examples.describe(examples.scene_path(name))))
-    print("example studies (pdw sweep --example NAME):")
-    for name in examples.studies():
-        print("  %-16s %s" % (name, examples.describe(examples.study_path(name))))
+    """Every shipped example, by command, with its whole first sentence (wrapped, indented)."""
+    for title, names, path_of in (
+            ("example scenes (pdw run --example NAME)", examples.scenes(), examples.scene_path),
+            ("example studies (pdw sweep --example NAME)", examples.studies(),
+             examples.study_path),
+            ("example continuations (pdw continue --example NAME)", examples.continuations(),
+             examples.continuation_path)):
+        print(title + ":")
+        for name in names:
+            print(textwrap.fill(examples.describe(path_of(name)), width=96,
+                                initial_indent="  %-18s " % name, subsequent_indent=" " * 21))
     return 0
 
 
@@ -247,6 +243,9 @@ def main(argv=None):
             devnull = os.open(os.devnull, os.O_WRONLY)
             os.dup2(devnull, sys.stdout.fileno())
         return 141
+    except (SimulationError, GaitNotFoundError) as e:   # the run fell or diverged, no gait
+        print("pdw: error: %s" % e, file=sys.stderr)
+        return 3
     except PdwError as e:
         print("pdw: error: %s" % e, file=sys.stderr)
         return 2
@@ -256,6 +255,9 @@ def main(argv=None):
     except ValueError as e:
         print("pdw: invalid input: %s" % e, file=sys.stderr)
         return 2
+    except MissingDependency as e:         # found before the work (deps.require)
+        print("pdw: error: %s" % e, file=sys.stderr)
+        return 4
     except ImportError as e:
         hint = missing_extra(e)
         if hint is None:

@@ -33,7 +33,11 @@ The spec (docs/continuation.md; examples in pdw/examples/continuations/, run by
 
 Writes ``<out>/<name>.csv`` (the points of every branch, with ``branch`` and ``period_n``
 columns), ``<out>/<name>.json`` (provenance: spec, code version, settings, per-branch summary
-with the bifurcations, map evaluations, wall time) and ``<out>/<name>.png``.
+with the bifurcations, map evaluations, wall time) and ``<out>/<name>.png`` (not with
+``--no-figures``, which needs no matplotlib; without it and without matplotlib the command
+stops before the work, exit code 4). The whole spec is checked first
+(`pdw.present.continue_spec.check_spec`: every key's type and range, exit code 2); ``name``
+must be a plain file name (`pdw.core.paths.file_stem`).
 """
 from __future__ import annotations
 
@@ -53,67 +57,39 @@ from ..analysis.branch import _jsonable
 from ..analysis.continuation import continue_gait, follow_cascade
 from ..core.contact import Contact
 from ..core.errors import InvalidInputError
-from ..core.params import Params
+from . import continue_spec, deps
 
 try:
     import tomllib
 except ImportError:                                    # pragma: no cover - Python < 3.11
     import tomli as tomllib
 
-KEYS = {"name", "title", "model", "preset", "variant", "parameter", "stop", "start", "params",
-        "couple", "continuation", "contact", "plot"}
-CONTINUATION_KEYS = {"step", "method", "max_points", "step_min", "step_max", "tol",
-                     "locate_tol", "log", "detect", "max_newton", "fd_step", "options",
-                     "cascade", "period", "workers"}
-
-
-def preset(name, **overrides) -> Params:
-    """The walker of a spec's ``preset``."""
-    from ..analysis import hybrid as H
-    if name == "compass":
-        return H.compass_gait_params(**overrides)
-    if name == "simplest":
-        base = dict(l=1.0, c=1.0, w=0.0, r=0.0, J_l=0.0, m_h=1.0, m_l=1e-4, k_hip=0.0,
-                    d_hip=0.0, gamma=0.009, g=1.0)
-        return Params(**{**base, **overrides})
-    if name in ("paper", "paper_steady"):
-        return getattr(Params, name)(**overrides)
-    raise InvalidInputError("preset must be compass, simplest, paper or paper_steady, got %r"
-                            % (name,))
+KEYS, CONTINUATION_KEYS = continue_spec.KEYS, continue_spec.CONTINUATION_KEYS
+preset = continue_spec.preset
 
 
 def load_spec(path) -> dict:
-    text = pathlib.Path(path).read_text()
+    """Read a continuation spec and check all of it (`pdw.present.continue_spec.check_spec`):
+    a bad value anywhere is an `InvalidInputError` naming the key, before any work."""
+    try:
+        text = pathlib.Path(path).read_text()
+    except OSError as e:
+        raise InvalidInputError("cannot read continuation file %s: %s" % (path, e)) from None
     try:
         spec = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise InvalidInputError("%s: not valid TOML: %s" % (path, e)) from None
-    bad = set(spec) - KEYS
-    if bad:
-        raise InvalidInputError("%s: unknown key(s) %s; allowed: %s"
-                                % (path, sorted(bad), sorted(KEYS)))
-    for k in ("name", "parameter", "stop"):
-        if k not in spec:
-            raise InvalidInputError("%s: missing %r" % (path, k))
-    bad = set(spec.get("continuation", {})) - CONTINUATION_KEYS
-    if bad:
-        raise InvalidInputError("%s: [continuation] unknown key(s) %s; allowed: %s"
-                                % (path, sorted(bad), sorted(CONTINUATION_KEYS)))
-    if "contact" in spec:
-        if spec.get("model", "continuous") != "continuous":
-            raise InvalidInputError("%s: [contact] is a section of the continuous model's specs; "
-                                    "model = %r has rigid ground" % (path, spec.get("model")))
-        try:
-            spec["contact"] = Contact.coerce(dict(spec["contact"])).as_dict()
-        except InvalidInputError as e:
-            raise InvalidInputError("%s: [contact] %s" % (path, e)) from None
+    spec = continue_spec.check_spec(spec, str(path))
     spec["_source"], spec["_path"] = text, str(path)
     return spec
 
 
-def run_spec(spec, out=None, progress=False):
-    """Run a loaded spec: (branches, paths written); ``progress`` (False, True or a
-    `pdw.Progress`) as in `pdw.continue_gait`."""
+def run_spec(spec, out=None, progress=False, *, figures=True):
+    """Run a spec (checked again here: `pdw.present.continue_spec.check_spec`): (branches,
+    paths written); ``progress`` (False, True or a `pdw.Progress`) as in `pdw.continue_gait`;
+    ``figures=False``: no diagram (no matplotlib needed)."""
+    spec = {**continue_spec.check_spec(spec, spec.get("_path", "spec")),
+            **{k: v for k, v in spec.items() if k.startswith("_")}}
     params = preset(spec.get("preset", "paper_steady"), **spec.get("params", {}))
     par = spec["parameter"]
     couple = dict(spec.get("couple", {}))
@@ -143,16 +119,19 @@ def run_spec(spec, out=None, progress=False):
     out.mkdir(parents=True, exist_ok=True)
     paths = {"csv": out / ("%s.csv" % spec["name"]), "json": out / ("%s.json" % spec["name"]),
              "png": out / ("%s.png" % spec["name"])}
+    if not figures:
+        del paths["png"]
     _write_csv(branches, paths["csv"])
     with open(paths["json"], "w") as fh:
         json.dump(_provenance(spec, branches, wall), fh, indent=2, default=_jsonable)
-    from .plots_continuation import plot_branches
-    plot = spec.get("plot", {})
-    ax = plot_branches(branches, y=plot.get("y", "step_length"),
-                       x_scale=float(plot.get("x_scale", 1.0)), x_label=plot.get("x_label"),
-                       title=spec.get("title"), path=paths["png"])
-    import matplotlib.pyplot as plt
-    plt.close(ax.figure)
+    if figures:
+        from .plots_continuation import plot_branches
+        plot = spec["plot"]
+        ax = plot_branches(branches, y=plot["y"], x_scale=plot["x_scale"],
+                           x_label=plot.get("x_label"), title=spec.get("title"),
+                           path=paths["png"])
+        import matplotlib.pyplot as plt
+        plt.close(ax.figure)
     return branches, paths
 
 
@@ -191,6 +170,8 @@ def add_cli(subparsers):
     s.add_argument("--example", help="run an example continuation shipped with pdw (%s)"
                                      % ", ".join(examples.continuations()))
     s.add_argument("--out", help="output folder (default out/continuation/<name>)")
+    s.add_argument("--no-figures", action="store_true",
+                   help="skip the diagram (no matplotlib needed)")
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
     s.set_defaults(func=cli_main)
     return s
@@ -200,7 +181,10 @@ def cli_main(args):
     if (args.spec is None) == (args.example is None):
         raise InvalidInputError("give a continuation file or --example NAME (one of them)")
     spec = load_spec(examples.continuation_path(args.example) if args.example else args.spec)
-    branches, paths = run_spec(spec, args.out, progress=not args.no_progress)
+    if not args.no_figures:
+        deps.require("matplotlib", purpose="the diagram")
+    branches, paths = run_spec(spec, args.out, progress=not args.no_progress,
+                               figures=not args.no_figures)
     for b in branches:
         print("period %d: %d points, %s in [%.8g, %.8g], %d map evaluations, %.1f s; %s"
               % (b.period_n, len(b), b.parameter, b.values.min(), b.values.max(), b.n_maps,

@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import contextlib
 import os
-import sys
 
 from .. import examples
 from ..core.errors import PdwError
 from ..studies.study import load_study
 from ..studies.sweep import run_study
+from .deps import require
 from .study_plots import plot_study
 
 
@@ -45,10 +45,8 @@ def add_cli(subparsers):
 
 
 def _dask():
-    try:
-        import distributed
-    except ImportError as e:
-        raise PdwError("Dask is not installed: pip install 'pdw[dask]'") from e
+    require("distributed", purpose="--scheduler and --dask-local")
+    import distributed
     return distributed
 
 
@@ -62,6 +60,11 @@ def cli_main(args):
         raise PdwError("--workers sizes a local pool or --dask-local; a --scheduler cluster "
                        "has its own workers")
     study = load_study(examples.study_path(args.example) if args.example else args.study)
+    # what the command needs, before the work (exit code 4: pdw.present.deps)
+    if args.scheduler or args.dask_local:
+        _dask()
+    if not args.no_figures:
+        require("matplotlib", purpose="the figure")
     executor = None
     with contextlib.ExitStack() as stack:
         if args.scheduler or args.dask_local:
@@ -86,7 +89,4 @@ def cli_main(args):
              ", ".join("%s %d" % kv for kv in sorted(counts.items()))))
     for p in res.paths.values():
         print("wrote %s" % p)
-    if not args.no_figures and "png" not in res.paths:
-        print("pdw: no figure: matplotlib is not installed: pip install 'pdw[plot]'",
-              file=sys.stderr)
     return 0

@@ -1,5 +1,6 @@
 """The figure of a parameter study (``pdw sweep``): L, P, v and double support against the
-first axis, one line per value of the second (docs/studies.md)."""
+first axis, one line per value of the second (docs/studies.md); the points without a gait
+(the walker fell, or the run diverged) marked along the bottom of every panel."""
 from __future__ import annotations
 
 import os
@@ -7,14 +8,18 @@ import pathlib
 
 import numpy as np
 
+#: How points without steady values are marked (at the bottom of each panel): status ->
+#: (marker, colour, legend label).
+NO_GAIT = {"fell": ("x", "tab:red", "fell (no gait)"), "diverged": ("+", "0.3", "diverged")}
 _PANELS = (("L", "step length L [m]", 1.0), ("P", "step period P [s]", 1.0),
            ("v", "step velocity v [m/s]", 1.0), ("ds_fraction", "double support [% of cycle]", 100.0))
 
 
 def plot_study(study, rows, path):
     """L, P, v and double support against the first axis (one line per value of the second);
-    points that are not period-one are drawn hollow; the paper's end points ([paper] table) as
-    black markers. Returns the path."""
+    points that are not period-one are drawn hollow; points whose walker fell (or whose run
+    diverged) as `NO_GAIT` markers along the bottom of every panel, in the legend; the paper's
+    end points ([paper] table) as black markers. Returns the path."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -36,6 +41,13 @@ def plot_study(study, rows, path):
             ax.set_xlabel(x_name)
             ax.set_ylabel(ylabel)
             ax.grid(alpha=0.3)
+    for status, (marker, colour, label) in NO_GAIT.items():
+        xs = np.array([r[x_name] for r in rows if r["status"] == status], dtype=float)
+        if len(xs):
+            for ax in axs.flat:
+                ax.plot(xs, np.full(len(xs), 0.03), marker, color=colour, ms=8, mew=1.8, ls="",
+                        transform=ax.get_xaxis_transform(), clip_on=False,
+                        label="%s: %d point%s" % (label, len(xs), "s" * (len(xs) != 1)))
     paper = study.paper
     if paper:
         at = paper.get("at", {})

@@ -20,12 +20,14 @@ its events (``record_events=False``) it returns `Result.gait`.
 """
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 
 from ..core import _layout, checks
+from ..core.errors import InvalidInputError
 
 if TYPE_CHECKING:                 # annotations only (simulation imports this module)
     import pandas
@@ -172,7 +174,19 @@ def steps(result_or_events: Result | Sequence[Event]) -> Steps:
     src: Any = result_or_events       # duck-typed: a Result, or a sequence of events
     if getattr(src, "events_recorded", True) is False:
         return src.gait
-    events = sorted(getattr(src, "events", src), key=lambda e: e.t)
+    if not hasattr(src, "events") and callable(getattr(src, "steps", None)):
+        raise InvalidInputError("pdw.steps takes one run (a Result or its events); for the "
+                                "walkers of a %s b use b.steps(i) (walker i)"
+                                % type(src).__name__)
+    events = getattr(src, "events", src)
+    if isinstance(events, (str, bytes)) or not isinstance(events, Iterable):
+        raise InvalidInputError("pdw.steps takes a Result or a sequence of its Events, got %s"
+                                % type(src).__name__)
+    events = list(events)
+    if any(not all(hasattr(e, a) for a in ("t", "kind", "leg")) for e in events):
+        raise InvalidInputError("pdw.steps takes a Result or a sequence of its Events, got %s"
+                                % type(src).__name__)
+    events = sorted(events, key=lambda e: e.t)
     last_td: dict[int, Any] = {1: None, 2: None}     # (t, x_D) of each leg's latest touch-down
     last_lo: dict[int, Any] = {1: None, 2: None}     # (t, x_D) of each leg's latest lift-off
     prev_td_t = None

@@ -15,11 +15,10 @@ import hashlib
 import itertools
 import json
 import pathlib
-import re
 
 import numpy as np
 
-from ..core import _layout, _toml, checks
+from ..core import _layout, _toml, checks, paths
 from ..core.errors import InvalidInputError
 from ..core.params import Params
 from ..sim.scene import Scene
@@ -45,8 +44,9 @@ MOVED = {"preset": "scene.preset", "variant": "scene.variant", "method": "scene.
 COLUMNS = ("status", "gait", "source", "L", "P", "v", "cycle", "double_support", "ds_fraction", "travel",
            "spread_L", "spread_cycle", "n_steps", "max_multiplier", "t_final", "wall_s", "error",
            "settings")
-#: A study name is a plain file name: letters, digits, "_", "-", "+", "." (not first).
-NAME_RE = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.+-]{0,99}")
+#: A study name is a plain file name (`pdw.core.paths.file_stem`, the rule of every name that
+#: becomes a file name).
+NAME_RE = paths.NAME_RE
 #: Most points one study may have (also the most values of one axis).
 MAX_POINTS = 10 ** 6
 
@@ -125,12 +125,9 @@ def settings_hash(task) -> str:
 
 
 def check_name(name, where="study"):
-    """A study name must be a plain file name (no folder, no "..", no absolute path)."""
-    if not isinstance(name, str) or not NAME_RE.fullmatch(name) or name in (".", ".."):
-        raise InvalidInputError("%s: name must be a plain file name (letters, digits, '_', '-', "
-                                "'+', '.'; not starting with '.'; at most 100 characters), got %r"
-                                % (where, name))
-    return name
+    """A study name must be a plain file name (no folder, no "..", no absolute path):
+    `pdw.core.paths.file_stem`."""
+    return paths.file_stem(name, where)
 
 
 def _typecheck(where, key, value, typ):

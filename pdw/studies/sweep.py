@@ -32,20 +32,19 @@ from __future__ import annotations
 import concurrent.futures as cf
 import dataclasses
 import datetime
-import fcntl
 import json
 import os
 import pathlib
 import platform
 import signal
 import sys
-import tempfile
 import threading
 import time
 
 import numpy as np
 
-from ..core.errors import InvalidInputError, PdwError
+from ..core import interrupt, paths
+from ..core.errors import InvalidInputError
 from ..core.progress import Progress, progress_bar  # noqa: F401 (pdw.sweep.Progress)
 from ..core.provenance import source_revision
 from .points import _classify, _newton_point, batchable, groups, run_point, run_points  # noqa: F401 (pdw.sweep.run_point)
@@ -129,54 +128,25 @@ def _die_with_parent(ppid):
     threading.Thread(target=watch, daemon=True, name="pdw-parent-watch").start()
 
 
-class _FolderLock:
-    """An exclusive lock (fcntl.flock) on ``<out>/.pdw-sweep.lock``: one sweep per folder."""
+#: One sweep per output folder (`pdw.core.paths.FolderLock`: portable, removed when released).
+_FolderLock = paths.FolderLock
+_write_atomic = paths.write_atomic
 
-    def __init__(self, folder):
-        self.path = pathlib.Path(folder) / LOCK_NAME
-        self.f = None
 
-    def __enter__(self):
-        f = open(self.path, "a+")
+def _stop_workers(pool):
+    """Terminate the worker processes of our own process pool (after Ctrl-C: their running
+    points are lost anyway, and the pool's shutdown would otherwise wait for them)."""
+    if not isinstance(pool, cf.ProcessPoolExecutor):
+        return
+    stop = getattr(pool, "terminate_workers", None)          # Python >= 3.14
+    if stop is not None:
+        stop()
+        return
+    for proc in list((getattr(pool, "_processes", None) or {}).values()):
         try:
-            fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            f.seek(0)
-            holder = f.read().strip() or "?"
-            f.close()
-            raise PdwError("%s is in use by another sweep (process %s holds %s): wait for it to "
-                           "finish, or write to another folder (--out)"
-                           % (self.path.parent, holder, self.path.name)) from None
-        f.seek(0)
-        f.truncate()
-        f.write("%d\n" % os.getpid())
-        f.flush()
-        self.f = f
-        return self
-
-    def __exit__(self, *exc):
-        fcntl.flock(self.f, fcntl.LOCK_UN)
-        self.f.close()
-        return False
-
-
-def _write_atomic(path, text):
-    """Write ``text`` to ``path`` through a temporary file in the same folder (fsync, rename):
-    readers see the old file or the new one, never a part."""
-    path = pathlib.Path(path)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix="." + path.name + ".", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", newline="") as f:
-            f.write(text)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
+            proc.terminate()
+        except (OSError, AttributeError):                   # pragma: no cover - gone already
             pass
-        raise
 
 
 def _make_executor(backend, workers):
@@ -230,7 +200,7 @@ def run_study(study, out=None, *, executor=None, workers=None, backend="thread",
     check_name(study.name)
     out = pathlib.Path(out or pathlib.Path("out") / "studies" / study.name)
     out.mkdir(parents=True, exist_ok=True)
-    with _FolderLock(out):
+    with paths.FolderLock(out, LOCK_NAME, "sweep"):
         return _run_locked(study, out, executor, workers, backend, resume, progress, figures,
                            batch)
 
@@ -257,6 +227,7 @@ def _run_locked(study, out, executor, workers, backend, resume, progress, figure
     else:
         exec_desc = "serial"
     bar = progress_bar(progress, len(points), study.name, done=len(done))
+    token = interrupt.Token(interrupt.current())
     computed = []
     error = None
     # points that share the scene run as batches (pdw.studies.points), one task a group
@@ -282,13 +253,19 @@ def _run_locked(study, out, executor, workers, backend, resume, progress, figure
                     record(fn(u))
             else:
                 ex = executor if executor is not None else own
-                futs = [ex.submit(fn, u) for u in units]
+                # a thread's task gets a cancel token: on Ctrl-C its compiled loops stop at
+                # their next poll (pdw.core.interrupt) instead of running to the end
+                threads = isinstance(ex, cf.ThreadPoolExecutor)
+                futs = [ex.submit(interrupt.call_with_token, token, fn, u) if threads
+                        else ex.submit(fn, u) for u in units]
                 try:
                     for fut in cf.as_completed(futs):
                         record(fut.result())
                 except BaseException:
+                    token.set()
                     for fut in futs:
                         fut.cancel()
+                    _stop_workers(own)
                     # keep what finished meanwhile
                     for fut in futs:
                         if fut.done() and not fut.cancelled() and fut.exception() is None:
@@ -298,7 +275,9 @@ def _run_locked(study, out, executor, workers, backend, resume, progress, figure
             error = e
         finally:
             if own is not None:
-                own.shutdown(wait=error is None, cancel_futures=True)
+                # after an interrupt the running tasks stop within a poll (threads) or were
+                # terminated (processes): waiting for them is short
+                own.shutdown(wait=True, cancel_futures=True)
     if error is not None:
         raise error
     rows = [done[k] for k, _ in points]
