@@ -19,9 +19,9 @@ from typing import Any
 import numpy as np
 
 from .gait_types import Gait
+from .testfunctions import KINDS, LABELS
 
-#: bifurcation kinds
-KINDS = ("fold", "period_doubling", "neimark_sacker", "end")
+__all__ = ["Bifurcation", "Branch", "KINDS", "LABELS"]
 
 
 @dataclass(eq=False)
@@ -49,6 +49,16 @@ class Bifurcation:
     z, mu, tangent, eigenvector, multipliers : ndarray
         Section point, internal parameter coordinate, unit tangent (z, u) of the branch,
         the critical eigenvector (real part, for a period doubling), multipliers.
+    located : bool
+        True when the final bracket is within ``locate_tol`` and the test function vanishes
+        continuously there (`pdw.analysis.continuation_engine.locate`). False: it was only
+        *detected* between ``bracket[0]`` and ``bracket[1]``, ``value`` is just the best point
+        found, and ``location_note`` says why the location failed.
+    bracket : tuple of float
+        The final bracket (parameter values, ascending).
+    label : str
+        AUTO-style label: type (LP, PD, NS, BP, EP, UZ) and running number on its branch,
+        e.g. ``"PD1"`` (set by the continuation).
     """
 
     kind: str
@@ -63,16 +73,38 @@ class Bifurcation:
     eigenvector: Any = None
     multipliers: Any = None
     details: dict = field(default_factory=dict)
+    located: bool = True
+    bracket: Any = None
+    location_note: str = ""
+    label: str = ""
+
+    @property
+    def type_label(self) -> str:
+        """AUTO's two-letter type of this kind (`LABELS`)."""
+        return LABELS.get(self.kind, "UZ")
+
+    def describe(self) -> str:
+        """One line: label, kind, where (located value +- bracket, or the bracket when only
+        detected) and why."""
+        head = "%s %s" % (self.label or self.type_label, self.kind)
+        if self.located:
+            return "%s at %.8g (+-%.2g): %s" % (head, self.value, self.tolerance, self.reason)
+        lo, hi = self.bracket if self.bracket is not None else (self.value, self.value)
+        return ("%s DETECTED, NOT LOCATED: between %.8g and %.8g (%s); %s"
+                % (head, lo, hi, self.location_note, self.reason))
 
     def __repr__(self):
-        return "Bifurcation(%s at %.8g (+-%.2g), %s)" % (self.kind, self.value, self.tolerance,
-                                                        self.reason)
+        return "Bifurcation(%s)" % self.describe()
 
     def as_dict(self) -> dict:
-        """JSON-able fields: kind, value, tolerance, index, reason, z (or None), and the
-        multipliers as ``multipliers_re`` and ``multipliers_im`` lists."""
+        """JSON-able fields: kind, label, value, tolerance, located, bracket, location_note,
+        index, reason, z (or None), and the multipliers as ``multipliers_re`` and
+        ``multipliers_im`` lists."""
         m = np.zeros(0) if self.multipliers is None else np.asarray(self.multipliers)
-        return {"kind": self.kind, "value": self.value, "tolerance": self.tolerance,
+        return {"kind": self.kind, "label": self.label, "value": self.value,
+                "tolerance": self.tolerance, "located": bool(self.located),
+                "bracket": None if self.bracket is None else [float(v) for v in self.bracket],
+                "location_note": self.location_note,
                 "index": self.index, "reason": self.reason,
                 "z": None if self.z is None else np.asarray(self.z).tolist(),
                 "multipliers_re": [float(np.real(v)) for v in m],

@@ -40,17 +40,49 @@ from typing import Callable, Literal, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..core import checks
 from ..core.errors import InvalidInputError
 from ..core.params import Params
 from ..core.progress import Progress, progress_bar
 from . import hybrid as H
 from . import limit_cycle as LC
+from . import testfunctions as TF
 from .branch import Bifurcation, Branch
 from .continuation_engine import Engine, Point, check_crossings, tests
 from .gait_maps import ContinuousProblem, HybridProblem
 from .gait_types import Gait, GaitNotFoundError
 
 MODELS = ("continuous", "hybrid")
+METHODS = ("pseudo_arclength", "natural")
+
+
+def _check_options(o: dict) -> dict:
+    """Range-check the continuation's options (those present in ``o``; None = the default),
+    each error naming its option and allowed range; returns them normalised."""
+    out = dict(o)
+    if "method" in o and o["method"] not in METHODS:
+        raise InvalidInputError("method must be 'pseudo_arclength' or 'natural', got %r"
+                                % (o["method"],))
+    for k in ("step", "step_min", "step_max", "tol", "locate_tol", "stall_length"):
+        if o.get(k) is not None:
+            out[k] = checks.positive(k, o[k])
+    if o.get("fd_step") is not None:
+        out["fd_step"] = checks.number("fd_step", o["fd_step"], lo=0.0, lo_open=True, hi=0.1)
+    if o.get("step_min") is not None and o.get("step_max") is not None \
+            and out["step_min"] > out["step_max"]:
+        raise InvalidInputError("step_min (%r) must not exceed step_max (%r)"
+                                % (o["step_min"], o["step_max"]))
+    for k, lo in (("max_points", 2), ("max_newton", 1), ("period", 1), ("stall_points", 2)):
+        if o.get(k) is not None:
+            out[k] = checks.count(k, o[k], lo=lo, hi=10 ** 7)
+    if o.get("workers") is not None:
+        out["workers"] = checks.count("workers", o["workers"], lo=1, hi=4096)
+    for k in ("stop", "value"):
+        if o.get(k) is not None:
+            out[k] = checks.number(k, o[k])
+    if o.get("at") is not None:
+        out["at"] = [checks.number("at[%d]" % i, v) for i, v in enumerate(o["at"])]
+    return out
 
 
 # --- the driver -------------------------------------------------------------------------------
@@ -93,11 +125,13 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
                   step_max: float | None = None, tol: float | None = None,
                   locate_tol: float | None = None,
                   params_of: Callable[[float], Params] | None = None, log: bool = False,
-                  detect: Sequence[str] = ("fold", "period_doubling", "neimark_sacker", "end"),
+                  detect: Sequence[str] = TF.DEFAULT_DETECT,
                   max_newton: int = 8, executor: Executor | None = None,
                   workers: int | None = None, fd_step: float = 1e-5,
                   options: dict | None = None, at: Sequence[float] = (),
-                  progress: bool | Progress = False) -> Branch:
+                  progress: bool | Progress = False,
+                  events: Sequence[TF.TestFunction] = (), stall_points: int = 8,
+                  stall_length: float = 1e-3) -> Branch:
     """Follow the period-``period`` gait of ``params`` as ``parameter`` moves towards ``stop``.
 
     Parameters
@@ -140,9 +174,10 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
     log : bool
         Continue in log(parameter) (for parameters spanning decades, e.g. k_n).
     detect : tuple of str
-        Which test functions to watch (`pdw.branch.KINDS`).
+        Which built-in test functions to watch (`pdw.analysis.testfunctions.BUILTIN`: "fold",
+        "period_doubling", "neimark_sacker", "end", "branch_point").
     max_newton : int
-        Newton iterations of the corrector per point.
+        Newton iterations of the corrector per point (>= 1).
     executor, workers : concurrent.futures.Executor, int
         Where the continuous model's finite-difference evaluations run (default: threads).
     fd_step : float
@@ -158,18 +193,28 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
     progress : bool or pdw.Progress
         A bar over the branch's points (up to ``max_points``) on stderr when it is a terminal
         (`pdw.core.progress`).
+    events : sequence of TestFunction
+        User test functions, e.g. ``pdw.analysis.testfunctions.Event("step_length", 0.4)``
+        (step length = 0.4 m): located like bifurcations and reported with them (kind
+        ``"event"``, label UZ).
+    stall_points, stall_length : int, float
+        The continuation stops as *stalled* when the last ``stall_points`` steps together
+        advanced less than ``stall_length`` in arclength (scaled coordinates: the requested
+        range is 1), i.e. the corrector only converges for ever smaller steps.
+
+    Every option is range-checked (`pdw.InvalidInputError` naming it).
 
     Returns
     -------
     Branch
     """
     t0 = time.perf_counter()
-    if method not in ("pseudo_arclength", "natural"):
-        raise InvalidInputError("method must be 'pseudo_arclength' or 'natural', got %r"
-                                % (method,))
-    bad = set(detect) - {"fold", "period_doubling", "neimark_sacker", "end"}
-    if bad:
-        raise InvalidInputError("detect: unknown kind(s) %s" % sorted(bad))
+    _check_options(dict(method=method, step=step, step_min=step_min, step_max=step_max,
+                        tol=tol, locate_tol=locate_tol, max_points=max_points,
+                        max_newton=max_newton, period=period, workers=workers,
+                        fd_step=fd_step, stop=stop, value=value, at=at,
+                        stall_points=stall_points, stall_length=stall_length))
+    TF.select(detect, events)
     prob = _problem(params, parameter, model, variant, period, params_of, log, options,
                     executor, workers, fd_step)
     if value is None:
@@ -191,14 +236,15 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
                             locate_tol=locate_tol, detect=detect, max_newton=max_newton,
                             direction=details.get("direction"), origin=details.get("origin"),
                             settings=dict(log=log, variant=variant, fd_step=fd_step), t0=t0,
-                            at=at, progress=progress)
+                            at=at, progress=progress, events=events,
+                            stall_points=stall_points, stall_length=stall_length)
 
 
 def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_points=200,
                      step=None, step_min=None, step_max=None, tol=1e-10, locate_tol=None,
-                     detect=("fold", "period_doubling", "neimark_sacker", "end"), max_newton=8,
+                     detect=TF.DEFAULT_DETECT, max_newton=8,
                      direction=None, origin=None, settings=None, t0=None, at=(),
-                     progress=False) -> Branch:
+                     progress=False, events=(), stall_points=8, stall_length=1e-3) -> Branch:
     """The continuation proper, on any problem object (`pdw.analysis.gait_maps`: ``dim``, ``evaluate``,
     ``coord``/``value``, ``gait``, ``ADMISSIBLE``, ...), from the fixed point z0 at ``value``
     towards ``stop``; the arguments as in `continue_gait` (``direction``: (dz, dmu) to orient
@@ -206,6 +252,12 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
     parameter values where a point is also computed, by a natural correction, whenever the
     branch passes them)."""
     t0 = time.perf_counter() if t0 is None else t0
+    o = _check_options(dict(method=method, step=step, step_min=step_min, step_max=step_max,
+                            tol=tol, locate_tol=locate_tol, max_points=max_points,
+                            max_newton=max_newton, stop=stop, value=value, at=at,
+                            stall_points=stall_points, stall_length=stall_length))
+    max_points, max_newton = o["max_points"], o["max_newton"]
+    functions = TF.select(detect, events)
     mu0, mu_stop = prob.coord(float(value)), prob.coord(float(stop))
     if not np.isfinite(mu_stop) or mu_stop == mu0:
         raise InvalidInputError("stop must differ from the start value %r, got %r"
@@ -213,13 +265,14 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
     scale = mu_stop - mu0          # signed: u runs from 0 to 1
     if hasattr(prob, "lam_rel"):
         prob.lam_step = prob.lam_rel * max(abs(mu0), abs(scale))
-    eng = Engine(prob, mu0, scale, tol, max_newton, method == "natural")
-    ds = abs(step / scale) if step else 0.02
+    eng = Engine(prob, mu0, scale, tol, max_newton, method == "natural", functions)
     step_min = 1e-6 if step_min is None else step_min
     step_max = 0.1 if step_max is None else step_max
+    if step_min > step_max:
+        raise InvalidInputError("step_min (%r) must not exceed step_max (%r)"
+                                % (step_min, step_max))
+    ds = min(max(abs(step / scale), step_min), step_max) if step else min(0.02, step_max)
     locate_tol = 1e-6 * abs(scale) if locate_tol is None else locate_tol
-    if int(max_points) < 2:
-        raise InvalidInputError("max_points must be >= 2, got %r" % (max_points,))
     x0 = np.append(np.asarray(z0, dtype=float), 0.0)
     e = np.zeros(prob.dim + 1)
     e[-1] = 1.0
@@ -234,7 +287,9 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
         ref = np.append(np.asarray(dz, dtype=float), dmu / scale)
     pts = [Point(first, ev, eng.tangent(ev, ref), 0, 0.0)]
     pts[0].tests = tests(eng, pts[0])
-    bifs = []
+    bifs: list = []
+    advances: list = []            # the arclength of every accepted step
+    last_failure = "none: Newton needed >= 5 iterations"
     stop_reason = "max_points (%d) reached" % max_points
     bar, seen = progress_bar(progress, int(max_points), "continuation %s" % prob.parameter), 0
     while len(pts) < max_points:
@@ -249,23 +304,28 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
                 b = Point(c, evc, eng.tangent(evc, a.tangent), 0,
                           (1.0 - a.x[-1]) / a.tangent[-1])
                 b.tests = tests(eng, b)
-                bifs += check_crossings(eng, a, b, len(pts) - 1, locate_tol, detect)
+                bifs += check_crossings(eng, a, b, len(pts) - 1, locate_tol)
                 pts.append(b)
                 stop_reason = "reached stop = %.10g" % float(stop)
                 break
         if b is None:
+            last_failure = str(why)
             ds *= 0.5
             if ds < step_min:
+                beyond = eng.value(a.x + 2 * ds * a.tangent)
                 bifs.append(Bifurcation(
                     kind="end", value=eng.value(a.x), gait=None, index=len(pts) - 1,
                     tolerance=abs(ds * 2 * scale), reason="the corrector fails beyond the "
-                    "last point: %s" % why, z=a.x[:-1].copy(), mu=eng.mu(a.x),
-                    tangent=a.tangent.copy(), multipliers=a.mult.copy()))
-                stop_reason = "end of the family: %s" % why
+                    "last point: %s" % _explain(prob, why), z=a.x[:-1].copy(), mu=eng.mu(a.x),
+                    tangent=a.tangent.copy(), multipliers=a.mult.copy(), located=False,
+                    bracket=tuple(sorted((eng.value(a.x), beyond))),
+                    location_note="the last converged point; the corrector fails at every "
+                    "step down to step_min = %g" % step_min))
+                stop_reason = "end of the family: %s" % _explain(prob, why)
                 break
             continue
         b.tests = tests(eng, b)
-        found = check_crossings(eng, a, b, len(pts) - 1, locate_tol, detect)
+        found = check_crossings(eng, a, b, len(pts) - 1, locate_tol)
         ends = [f for f in found if f.kind == "end"]
         bifs += found
         u = b.x[-1]
@@ -293,7 +353,18 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
                     pts.append(extra)
         pts.append(b)
         if u < -1e-9 and not eng.natural:
-            stop_reason = "the branch returned past the start value (after a fold)"
+            folds = [f for f in bifs if f.kind == "fold"]
+            stop_reason = ("the branch returned past the start value (after the fold at "
+                           "%.8g)" % folds[-1].value if folds else
+                           "the branch went back past the start value")
+            break
+        advances.append(b.ds)
+        recent = advances[-stall_points:]
+        if len(advances) >= stall_points and sum(recent) < stall_length:
+            stop_reason = ("stalled: the last %d steps advanced %.3g in arclength together "
+                           "(stall_length %.3g; the range is 1): the corrector converges only "
+                           "for ever smaller steps (last failure: %s)"
+                           % (stall_points, sum(recent), stall_length, last_failure))
             break
         if its <= 2:
             ds = min(ds * 1.5, step_max)
@@ -301,11 +372,33 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
             ds = max(ds * 0.7, step_min)
     bar.update(len(pts) - seen)
     bar.close()
+    label_points(bifs)
     return _branch(eng, pts, bifs, stop_reason, prob, time.perf_counter() - t0,
                    dict(method=method, tol=tol, locate_tol=locate_tol, step_min=step_min,
                         step_max=step_max, start_value=float(value), stop=float(stop),
                         options=dict(getattr(prob, "opts", {})), origin=origin,
                         **(settings or {})))
+
+
+def _explain(prob, why) -> str:
+    """A step-map failure, with the option that caused it where known (the hybrid map's
+    ``min_step_angle``: a strike is only armed at a step angle at least that large)."""
+    why = str(why)
+    if getattr(prob, "model", "") == "hybrid" and ("no_strike" in why or "fell" in why):
+        ang = getattr(prob, "last_step_angle", None)
+        lim = prob.opts.get("min_step_angle", 0.0)
+        if ang is not None and ang < 1.1 * lim:
+            return ("%s: the step angle at heel strike (%.4g rad at the last gait) reaches the "
+                    "option min_step_angle = %g rad, below which a strike is not armed"
+                    % (why, ang, lim))
+    return why
+
+
+def label_points(bifs) -> None:
+    """AUTO-style labels: the type (LP, PD, NS, BP, EP, UZ) and a running number along the
+    branch, in branch order (``Bifurcation.label``, e.g. "PD1", "LP2")."""
+    for k, f in enumerate(sorted(bifs, key=lambda f: f.index), start=1):
+        f.label = "%s%d" % (f.type_label, k)
 
 
 def _branch(eng, pts, bifs, stop_reason, prob, wall, settings) -> Branch:

@@ -160,6 +160,7 @@ class HybridProblem(_Problem):
         if isinstance(out, str):
             return Evaluation(False, out)
         y, DP, steps = out
+        self.last_step_angle = float(min(s["y_minus"][1] - s["y_minus"][0] for s in steps))
         Pz = y[list(H._SECTION)]
         M = P_lam = None
         if jac:
