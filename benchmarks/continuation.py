@@ -8,6 +8,8 @@ and docs/figures/continuation_*.png.
     python benchmarks/continuation.py rigid     # k_n 1e5 -> 1e9, consistent, d_n ~ k_n^(4/3)
     python benchmarks/continuation.py rigid_paper  # the same in the paper variant: its end
     python benchmarks/continuation.py fig11     # Fig. 11 (k_n): continuation vs the sweep
+    python benchmarks/continuation.py simplest_limit  # simplest walker's doubling, m_l/m_h -> 0
+    python benchmarks/continuation.py kelvin_voigt    # Kelvin-Voigt's d_n branch (docs/contact_laws.md)
 """
 from __future__ import annotations
 
@@ -229,6 +231,37 @@ def part_fig11(rounds=2):
     say("load average after: %s" % (os.getloadavg(),))
 
 
+def _simplest(gamma, m_l):
+    return pdw.Params(l=1.0, c=1.0, w=0.0, r=0.0, J_l=0.0, m_h=1.0, m_l=m_l, k_hip=0.0,
+                      d_hip=0.0, gamma=gamma, g=1.0)
+
+
+def part_simplest_limit():
+    say("== simplest walker: first period doubling against m_l/m_h (hybrid, locate_tol 1e-10) ==")
+    vals = {}
+    for m in (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8):
+        b = continue_gait(_simplest(0.009, m), "gamma", 0.02, model="hybrid", locate_tol=1e-10)
+        pd = b.of_kind("period_doubling")[0]
+        vals[m] = pd.value
+        say("m_l/m_h = %.0e: gamma_PD = %.10f (located %s, bracket %.1e), %.2f s"
+            % (m, pd.value, pd.located, pd.tolerance, b.wall_time))
+    g7, g8 = vals[1e-7], vals[1e-8]
+    say("linear extrapolation to m_l/m_h = 0 from 1e-7 and 1e-8: gamma_PD = %.10f"
+        % (g8 - (g7 - g8) * 1e-8 / (1e-7 - 1e-8)))
+
+
+def part_kelvin_voigt():
+    from pdw.analysis.calibration import calibrate
+    P0 = pdw.Params.paper_steady()
+    kv = calibrate(P0).contacts["kelvin_voigt"]
+    say("== Kelvin-Voigt (k = %.6g, d = %.6g): continued in d_n down to 10 ==" % (kv.k, kv.d))
+    b = continue_gait(P0.replace(k_n=kv.k, d_n=kv.d), "d_n", 10.0, step=5.0, max_points=40,
+                      options=dict(contact=pdw.Contact("kelvin_voigt")), workers=2)
+    _branch_line(b)
+    for f in b.bifurcations:
+        say("  " + f.describe())
+
+
 if __name__ == "__main__":
     parts = sys.argv[1:] or ["hybrid"]
     for part in parts:
@@ -236,7 +269,8 @@ if __name__ == "__main__":
         t0 = time.perf_counter()
         {"hybrid": part_hybrid, "hybrid_paper": part_hybrid_paper, "gamma": part_gamma,
          "dhip": part_dhip, "rigid": part_rigid,
-         "rigid_paper": part_rigid_paper, "fig11": part_fig11}[part]()
+         "rigid_paper": part_rigid_paper, "fig11": part_fig11,
+         "simplest_limit": part_simplest_limit, "kelvin_voigt": part_kelvin_voigt}[part]()
         say("(%s: %.1f s wall; python benchmarks/continuation.py %s)"
             % (part, time.perf_counter() - t0, part))
         RESULTS.mkdir(exist_ok=True)

@@ -154,3 +154,22 @@ def test_an_end_caused_by_min_step_angle_names_the_option():
     assert "min_step_angle" in b.stop_reason, b.stop_reason
     ends = b.of_kind("end")
     assert ends and "min_step_angle" in ends[-1].reason
+
+
+def _simplest(gamma, m_l):
+    return pdw.Params(l=1.0, c=1.0, w=0.0, r=0.0, J_l=0.0, m_h=1.0, m_l=m_l, k_hip=0.0,
+                      d_hip=0.0, gamma=gamma, g=1.0)
+
+
+def test_simplest_walker_limit_of_the_period_doubling():
+    """The README's 0.015073 is the m_l/m_h = 1e-4 preset's; the limit m_l/m_h -> 0 is
+    0.0150884: the doubling converges linearly in m_l/m_h (each decade closes the gap ten-fold),
+    so gamma(1e-8) is within 2e-8 of the limit."""
+    g = {m: continue_gait(_simplest(0.009, m), "gamma", 0.02, model="hybrid",
+                          locate_tol=1e-11).of_kind("period_doubling")[0].value
+         for m in (1e-4, 1e-6, 1e-7, 1e-8)}
+    assert abs(g[1e-4] - 0.015073) < 5e-7
+    r = (g[1e-6] - g[1e-7]) / (g[1e-7] - g[1e-8])
+    assert 8.0 < r < 12.0
+    limit = g[1e-8] - (g[1e-7] - g[1e-8]) / 9.0
+    assert abs(limit - 0.0150884) < 5e-8

@@ -206,8 +206,7 @@ def cli_main(args):
               % (b.period_n, len(b), b.parameter, b.values.min(), b.values.max(), b.n_maps,
                  b.wall_time, b.stop_reason))
         for f in b.bifurcations:
-            print("  %-16s at %s = %.10g (+- %.2g): %s" % (f.kind, b.parameter, f.value,
-                                                            f.tolerance, f.reason))
+            print("  " + f.describe())
     for p in paths.values():
         print("wrote %s" % p)
     return 0
