@@ -260,6 +260,17 @@ def part_kelvin_voigt():
     _branch_line(b)
     for f in b.bifurcations:
         say("  " + f.describe())
+    say("== the same from d_n = 109.5 up, step 0.1 (the period doubling, located) ==")
+    b = continue_gait(P0.replace(k_n=kv.k, d_n=109.5), "d_n", 110.2, step=0.1, max_points=30,
+                      options=dict(contact=pdw.Contact("kelvin_voigt")), workers=2)
+    _branch_line(b)
+    for f in b.bifurcations:
+        say("  " + f.describe())
+        say("    multipliers %s; finite-difference cross-check (fd_step x10): %.3g %s"
+            % (np.round(f.multipliers[:3], 5), f.details.get("fd_check", np.nan),
+               f.details.get("fd_check_note", "")))
+    for v, m in zip(b.values, b.multipliers):
+        say("  d_n = %.6f  multipliers %s" % (v, np.round(m[:3], 4)))
 
 
 if __name__ == "__main__":

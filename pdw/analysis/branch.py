@@ -13,11 +13,13 @@ from __future__ import annotations
 import csv
 import json
 import os
+import time
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from ..core.errors import InvalidInputError
 from .gait_types import Gait
 from .testfunctions import KINDS, LABELS
 
@@ -149,6 +151,8 @@ class Branch:
     settings: dict = field(default_factory=dict)
     problem: Any = field(default=None, repr=False)
     switcher: Any = field(default=None, repr=False)
+    extender: Any = field(default=None, repr=False)
+    provenance: dict = field(default_factory=dict)
 
     def __len__(self):
         return len(self.values)
@@ -183,6 +187,57 @@ class Branch:
             ``pdw.continue_gait(..., period=2n, start=gait)`` follow its branch.
         """
         return self.switcher(self, bifurcation, amplitude=amplitude, **kw)
+
+    def extend(self, stop: float, **kw: Any) -> "Branch":
+        """Continue this branch beyond its last point towards ``stop`` (also for a branch read
+        back by `pdw.load`): the new branch starts at the last point, in the direction the
+        branch was going. ``**kw``: `pdw.continue_gait`'s options (the saved model, variant,
+        contact, period and parameter coordinate are reused; a branch continued with
+        ``params_of`` needs it again). See `pdw.analysis.continuation.extend_branch`."""
+        if self.extender is None:
+            raise InvalidInputError("this branch cannot be extended (no problem attached)")
+        return self.extender(self, stop, **kw)
+
+    # --- files ------------------------------------------------------------------------------------
+
+    ARRAYS = ("values", "period", "step_length", "double_support", "multipliers", "stable",
+              "state", "z", "orbit", "tangents", "step_size", "newton_iterations")
+
+    def save(self, path: str | os.PathLike) -> str | os.PathLike:
+        """Write the branch to ``path`` (``.npz``: its arrays, and as JSON its settings,
+        bifurcations, the problem (base parameters, model, variant, contact, period, parameter
+        coordinate) and provenance: pdw version, input hash, source revision, time). `pdw.load`
+        reads it back; the loaded branch can be extended (`extend`) and switched at its period
+        doublings (`switch`)."""
+        if not str(path).endswith(".npz"):
+            raise InvalidInputError("Branch.save: path must end in .npz, got %r" % str(path))
+        from ..core.provenance import provenance
+        arrays: dict[str, Any] = {k: np.asarray(getattr(self, k)) for k in self.ARRAYS}
+        prob = self.problem
+        problem = None
+        if prob is not None and getattr(prob, "base", None) is not None:
+            opts = {k: (v.as_dict() if hasattr(v, "as_dict") else v)
+                    for k, v in getattr(prob, "opts", {}).items()}
+            problem = {"params": prob.base.as_dict(), "parameter": prob.parameter,
+                       "model": prob.model, "period": prob.period, "log": prob.log,
+                       "variant": getattr(prob, "variant", "paper"),
+                       "fd_step": getattr(prob, "fd_step", 1e-5), "options": opts,
+                       "params_of": prob._of is not None}
+        bifs = []
+        for b in self.bifurcations:
+            d = b.as_dict()
+            d.update(mu=b.mu, tangent=_list(b.tangent), eigenvector=_list(b.eigenvector),
+                     origin=None)
+            bifs.append(d)
+        meta = {"format": BRANCH_FORMAT, "parameter": self.parameter, "model": self.model,
+                "period_n": self.period_n, "stop_reason": self.stop_reason,
+                "n_maps": self.n_maps, "wall_time": self.wall_time,
+                "settings": self.settings, "bifurcations": bifs, "problem": problem,
+                "provenance": {**provenance(), "written": time.strftime(
+                    "%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "history": self.provenance}}
+        arrays["meta"] = np.array(json.dumps(meta, default=_jsonable))
+        np.savez(path, **arrays)
+        return path
 
     # --- output -------------------------------------------------------------------------------
 
@@ -236,6 +291,14 @@ class Branch:
         import importlib
         plots = importlib.import_module("pdw.present.plots_continuation")
         return plots.plot_branches([self], ax=ax, y=y, **kw)
+
+
+#: the ``meta["format"]`` of a branch file (`Branch.save`)
+BRANCH_FORMAT = "pdw-branch-1"
+
+
+def _list(a):
+    return None if a is None else np.asarray(a, dtype=float).tolist()
 
 
 def _jsonable(o):

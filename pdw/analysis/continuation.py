@@ -33,6 +33,8 @@ branch, tangent to (v, 0), does.
 from __future__ import annotations
 
 import copy
+import json
+import os
 import time
 from concurrent.futures import Executor
 from typing import Callable, Literal, Sequence
@@ -44,10 +46,11 @@ from ..core import checks
 from ..core.errors import InvalidInputError
 from ..core.params import Params
 from ..core.progress import Progress, progress_bar
+from ..sim import files as _files
 from . import hybrid as H
 from . import limit_cycle as LC
 from . import testfunctions as TF
-from .branch import Bifurcation, Branch
+from .branch import BRANCH_FORMAT, Bifurcation, Branch
 from .continuation_engine import Engine, Point, check_crossings, tests
 from .gait_maps import ContinuousProblem, HybridProblem
 from .gait_types import Gait, GaitNotFoundError
@@ -417,7 +420,93 @@ def _branch(eng, pts, bifs, stop_reason, prob, wall, settings) -> Branch:
         newton_iterations=np.array([p.iters for p in pts]),
         bifurcations=bifs, stop_reason=stop_reason, n_maps=prob.n_maps, wall_time=wall,
         settings={**settings, "scale": eng.scale, "mu0": eng.mu0}, problem=prob,
-        switcher=switch_branch)
+        switcher=switch_branch, extender=extend_branch)
+
+
+# --- branches as files ------------------------------------------------------------------------
+
+def load_branch(path: str | os.PathLike) -> Branch:
+    """Read a branch written by `Branch.save` (also reached through `pdw.load`). The problem is
+    rebuilt from the saved base parameters, model, variant, contact and period, so the branch
+    can be extended (`Branch.extend`) and switched (`Branch.switch`); a branch continued with
+    ``params_of`` is read without it (extend it with ``params_of=`` again)."""
+    try:
+        with np.load(path, allow_pickle=False) as f:
+            arrays = {k: f[k] for k in f.files}
+        meta = json.loads(str(arrays.pop("meta")))
+    except (OSError, ValueError, KeyError, EOFError) as e:
+        raise InvalidInputError("%s is not a readable pdw branch file (.npz written by "
+                                "Branch.save): %s: %s" % (path, type(e).__name__, e)) from None
+    if meta.get("format") != BRANCH_FORMAT:
+        raise InvalidInputError("%s is not a pdw branch file (format %r)"
+                                % (path, meta.get("format")))
+    missing = [k for k in Branch.ARRAYS if k not in arrays]
+    if missing:
+        raise InvalidInputError("%s: branch file lacks %s" % (path, ", ".join(missing)))
+    prob = None
+    pr = meta.get("problem")
+    if pr is not None and not pr.get("params_of"):
+        opts = dict(pr["options"])
+        if isinstance(opts.get("contact"), dict):
+            from ..core.contact import Contact
+            opts["contact"] = Contact(**opts["contact"])
+        opts.pop("t_hint", None)
+        prob = _problem(Params(**pr["params"]), pr["parameter"], pr["model"], pr["variant"],
+                        pr["period"], None, pr["log"], opts, None, None, pr["fd_step"])
+        st = meta["settings"]
+        if hasattr(prob, "lam_rel"):
+            prob.lam_step = prob.lam_rel * max(abs(st["mu0"]), abs(st["scale"]))
+    bifs = []
+    for d in meta["bifurcations"]:
+        m = np.array(d["multipliers_re"]) + 1j * np.array(d["multipliers_im"])
+        bifs.append(Bifurcation(
+            kind=d["kind"], value=d["value"], gait=None, index=d["index"],
+            tolerance=d["tolerance"], reason=d["reason"],
+            z=None if d["z"] is None else np.array(d["z"]), mu=d["mu"],
+            tangent=None if d["tangent"] is None else np.array(d["tangent"]),
+            eigenvector=None if d["eigenvector"] is None else np.array(d["eigenvector"]),
+            multipliers=m, located=d["located"],
+            bracket=None if d["bracket"] is None else tuple(d["bracket"]),
+            location_note=d["location_note"], label=d["label"]))
+    settings = meta["settings"]
+    if isinstance(settings.get("origin"), list):
+        settings["origin"] = (settings["origin"][0], np.array(settings["origin"][1]))
+    return Branch(parameter=meta["parameter"], model=meta["model"], period_n=meta["period_n"],
+                  **{k: arrays[k] for k in Branch.ARRAYS}, bifurcations=bifs,
+                  stop_reason=meta["stop_reason"], n_maps=meta["n_maps"],
+                  wall_time=meta["wall_time"], settings=settings, problem=prob,
+                  switcher=switch_branch, extender=extend_branch,
+                  provenance=meta["provenance"])
+
+
+_files.LOADERS[BRANCH_FORMAT] = load_branch
+
+
+def extend_branch(branch: Branch, stop: float, **kw) -> Branch:
+    """Continue ``branch`` from its last point towards ``stop`` (`Branch.extend`)."""
+    prob = branch.problem
+    if prob is None:
+        raise InvalidInputError("this branch has no problem to continue (it was continued "
+                                "with params_of or by run_continuation on a custom problem)")
+    v = float(branch.values[-1])
+    t = np.asarray(branch.tangents[-1], dtype=float)
+    scale = float(branch.settings["scale"])
+    mult = branch.multipliers[-1]
+    g = Gait(state=branch.state[-1], period=float(branch.period[-1]),
+             step_length=float(branch.step_length[-1]),
+             double_support=float(branch.double_support[-1]), multipliers=mult,
+             model=branch.model, params=prob.params_at(prob.coord(v)),
+             details={"z": np.array(branch.z[-1]), "value": v,
+                      "direction": (t[:-1], t[-1] * scale)})
+    opts = dict(model=branch.model, period=prob.period, log=prob.log,
+                options={k: val for k, val in prob.opts.items() if k != "t_hint"})
+    if branch.model == "continuous":
+        opts.update(variant=prob.variant, fd_step=prob.fd_step)
+    for k in ("tol", "locate_tol", "method"):
+        if branch.settings.get(k) is not None:
+            opts[k] = branch.settings[k]
+    opts.update(kw)
+    return continue_gait(prob.base, branch.parameter, stop, start=g, **opts)
 
 
 # --- branch switching -------------------------------------------------------------------------

@@ -8,6 +8,8 @@ Illinois method (`locate`); the method is described in `pdw.analysis.continuatio
 """
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from . import testfunctions as TF
@@ -138,7 +140,9 @@ def locate(engine, a, b, name, locate_tol, max_iter=40) -> Location:
     The crossing is *located* when (i) the final bracket is narrower than ``locate_tol`` in
     the parameter coordinate mu and (ii) the test function at the returned point is at most
     `SLOPE_FACTOR` times its secant slope over the detection step times the final bracket in
-    arclength (it vanishes continuously there). Otherwise (the corrector failed inside the
+    arclength (it vanishes continuously there), or, where the test function is at its noise
+    floor (finite-difference multipliers), its natural residual (`TestFunction.residual`, e.g.
+    |mu + 1| of the critical multiplier) is within the test's ``tol`` (1e-3). Otherwise (the corrector failed inside the
     bracket, the iterations ran out, or the function jumps) it is only *detected*, between
     ``bracket`` (parameter values), and ``why`` says which."""
     lo, hi = 0.0, b.ds
@@ -187,7 +191,11 @@ def locate(engine, a, b, name, locate_tol, max_iter=40) -> Location:
     residual = f_best / allowed if allowed > 0 else (0.0 if f_best == 0 else np.inf)
     if not why and width >= locate_tol:
         why = "the bracket is %.3g wide (locate_tol %.3g)" % (width, locate_tol)
-    if not why and residual > 1.0:
+    natural = None
+    tf = engine.owner.get(name)
+    if tf is not None and residual > 1.0:
+        natural = tf.residual(engine, best, name)
+    if not why and residual > 1.0 and not (natural is not None and natural <= tf.tol):
         why = ("the test function jumps across the bracket (|f| = %.3g at the best point, "
                "%.3g x what its slope allows): a kink or discontinuity, not a crossing"
                % (f_best, residual))
@@ -225,6 +233,14 @@ def check_crossings(engine, a, b, index, locate_tol, detect=None):
         reason, eigvec = d
         bif = _bifurcation(engine, tf.kind, loc, index, reason, eigvec)
         bif.details["test"] = name
+        check = getattr(engine.prob, "crosscheck", None)
+        if check is not None and tf.kind in ("fold", "period_doubling", "neimark_sacker"):
+            diff, note = check(loc.point.x[:-1], engine.mu(loc.point.x), loc.point.mult)
+            bif.details["fd_check"] = diff
+            if note:
+                warnings.warn("%s at %s = %.8g: %s" % (tf.kind, engine.prob.parameter,
+                                                      bif.value, note), stacklevel=3)
+                bif.details["fd_check_note"] = note
         out.append(bif)
     out.sort(key=lambda f: (f.mu - engine.mu(a.x)) * np.sign(engine.mu(b.x) - engine.mu(a.x)))
     return out

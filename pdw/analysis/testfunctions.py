@@ -56,6 +56,15 @@ class TestFunction:
         """(reason, eigenvector or None) at the located point; None rejects the crossing."""
         return "%s through 0" % name, None
 
+    #: the largest natural residual (`residual`) of a located point
+    tol = 1e-3
+
+    def residual(self, engine: Any, pt: Any, name: str) -> float | None:
+        """The distance from the special point in the test's natural measure (e.g. |mu + 1|
+        of the critical multiplier), accepted up to `tol` where the test function itself is
+        at its noise floor (finite-difference multipliers); None: no such measure."""
+        return None
+
 
 class Fold(TestFunction):
     """A turning point (saddle-node): the branch reverses in the parameter; a multiplier at +1."""
@@ -79,6 +88,9 @@ class PeriodDoubling(TestFunction):
     def values(self, engine, pt):
         return {"period_doubling": float(np.real(np.prod(pt.mult + 1.0)))}
 
+    def residual(self, engine, pt, name):
+        return float(np.min(np.abs(pt.mult + 1.0)))
+
     def describe(self, engine, pt, name):
         m = pt.mult
         j = int(np.argmin(np.abs(m + 1.0)))
@@ -91,6 +103,10 @@ class NeimarkSacker(TestFunction):
     """A complex pair of multipliers through the unit circle (a neutral saddle is rejected)."""
 
     kind, label = "neimark_sacker", "NS"
+
+    def residual(self, engine, pt, name):
+        cx = [v for v in pt.mult if abs(v.imag) > 1e-8]
+        return float(min(abs(abs(v) - 1.0) for v in cx)) if cx else None
 
     def values(self, engine, pt):
         m = pt.mult

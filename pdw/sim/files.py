@@ -147,6 +147,23 @@ def _check(arrays, meta):
         features=tuple(features), contact=contact)
 
 
+#: readers of the other pdw file formats, by their ``meta["format"]`` (registered by the
+#: layers above: ``"pdw-branch-1"``, `pdw.analysis.continuation.load_branch`)
+LOADERS: dict = {}
+
+
+def _other_format(path):
+    """The registered reader of an ``.npz`` file of another pdw format, or None."""
+    if not str(path).endswith(".npz") or not LOADERS:
+        return None
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            fmt = json.loads(str(z["meta"])).get("format") if "meta" in z.files else None
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile, json.JSONDecodeError):
+        return None
+    return LOADERS.get(fmt)
+
+
 def load(path: str | os.PathLike) -> Result:
     """Read a Result written by `Result.save`.
 
@@ -167,7 +184,13 @@ def load(path: str | os.PathLike) -> Result:
     pdw.InvalidInputError
         The file is missing, unreadable (truncated, not a zip/NetCDF file, pickled objects),
         not a pdw result, or a field is malformed (the message names it).
+
+    A branch file (`pdw.Branch.save`) is read by its registered reader (`LOADERS`) and gives a
+    `pdw.Branch`.
     """
+    other = _other_format(path)
+    if other is not None:
+        return other(path)
     try:
         arrays, meta = _io.read(path)
     except InvalidInputError:
