@@ -25,7 +25,9 @@ find_gait               period-one gait of the continuous model: Newton shooting
                         pdw.cell_mapping)
 continue_gait, Branch   continuation of gaits in one parameter: branches, Floquet multipliers,
                         folds, period doublings, Neimark-Sacker, ends (pdw.analysis.continuation;
-                        ``pdw continue``)
+                        ``pdw continue``); Branch.save / pdw.load
+continue_bifurcation    folds and period doublings followed in a second parameter (minimally
+                        augmented; pdw.analysis.codim2): a BifurcationCurve
 sweep                   parameter studies from TOML files: run_study, load_study (``pdw sweep``)
 examples                the scenes and studies shipped with pdw (``pdw run --list-examples``)
 Progress                the progress bar of long jobs (``progress=`` of sweeps, cell maps, basins,
@@ -38,6 +40,7 @@ import sys as _sys
 from . import examples  # package data: the shipped scenes and studies
 from .analysis import cell_mapping, hybrid, limit_cycle
 from .analysis.branch import Bifurcation, Branch
+from .analysis.codim2 import BifurcationCurve, continue_bifurcation
 from .analysis.continuation import continue_gait
 from .analysis.gait_types import Gait
 from .analysis.limit_cycle import find_gait
@@ -93,6 +96,7 @@ __all__ = [
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait", "Scene", "run",
     "limit_cycle", "cell_mapping", "find_gait", "sweep",
     "StepSizeWarning", "StepSizeError", "examples", "continue_gait", "Branch", "Bifurcation",
+    "continue_bifurcation", "BifurcationCurve",
     "ode_function", "OdeFunction", "load", "RecordBuffer",
     "Contact", "Progress",
 ]

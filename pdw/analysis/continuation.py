@@ -42,7 +42,6 @@ from typing import Callable, Literal, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..core import checks
 from ..core.errors import InvalidInputError
 from ..core.params import Params
 from ..core.progress import Progress, progress_bar
@@ -51,41 +50,11 @@ from . import hybrid as H
 from . import limit_cycle as LC
 from . import testfunctions as TF
 from .branch import BRANCH_FORMAT, Bifurcation, Branch
-from .continuation_engine import Engine, Point, check_crossings, tests
+from .continuation_engine import Engine, Point, _check_options, _explain, check_crossings, label_points, tests
 from .gait_maps import ContinuousProblem, HybridProblem
 from .gait_types import Gait, GaitNotFoundError
 
 MODELS = ("continuous", "hybrid")
-METHODS = ("pseudo_arclength", "natural")
-
-
-def _check_options(o: dict) -> dict:
-    """Range-check the continuation's options (those present in ``o``; None = the default),
-    each error naming its option and allowed range; returns them normalised."""
-    out = dict(o)
-    if "method" in o and o["method"] not in METHODS:
-        raise InvalidInputError("method must be 'pseudo_arclength' or 'natural', got %r"
-                                % (o["method"],))
-    for k in ("step", "step_min", "step_max", "tol", "locate_tol", "stall_length"):
-        if o.get(k) is not None:
-            out[k] = checks.positive(k, o[k])
-    if o.get("fd_step") is not None:
-        out["fd_step"] = checks.number("fd_step", o["fd_step"], lo=0.0, lo_open=True, hi=0.1)
-    if o.get("step_min") is not None and o.get("step_max") is not None \
-            and out["step_min"] > out["step_max"]:
-        raise InvalidInputError("step_min (%r) must not exceed step_max (%r)"
-                                % (o["step_min"], o["step_max"]))
-    for k, lo in (("max_points", 2), ("max_newton", 1), ("period", 1), ("stall_points", 2)):
-        if o.get(k) is not None:
-            out[k] = checks.count(k, o[k], lo=lo, hi=10 ** 7)
-    if o.get("workers") is not None:
-        out["workers"] = checks.count("workers", o["workers"], lo=1, hi=4096)
-    for k in ("stop", "value"):
-        if o.get(k) is not None:
-            out[k] = checks.number(k, o[k])
-    if o.get("at") is not None:
-        out["at"] = [checks.number("at[%d]" % i, v) for i, v in enumerate(o["at"])]
-    return out
 
 
 # --- the driver -------------------------------------------------------------------------------
@@ -290,6 +259,9 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
         ref = np.append(np.asarray(dz, dtype=float), dmu / scale)
     pts = [Point(first, ev, eng.tangent(ev, ref), 0, 0.0)]
     pts[0].tests = tests(eng, pts[0])
+    accept = getattr(prob, "accept", None)          # a problem's hook on accepted points
+    if accept is not None:
+        accept(pts[0])
     bifs: list = []
     advances: list = []            # the arclength of every accepted step
     last_failure = "none: Newton needed >= 5 iterations"
@@ -355,6 +327,8 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
                     extra.tests = tests(eng, extra)
                     pts.append(extra)
         pts.append(b)
+        if accept is not None:
+            accept(b)
         if u < -1e-9 and not eng.natural:
             folds = [f for f in bifs if f.kind == "fold"]
             stop_reason = ("the branch returned past the start value (after the fold at "
@@ -381,27 +355,6 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
                         step_max=step_max, start_value=float(value), stop=float(stop),
                         options=dict(getattr(prob, "opts", {})), origin=origin,
                         **(settings or {})))
-
-
-def _explain(prob, why) -> str:
-    """A step-map failure, with the option that caused it where known (the hybrid map's
-    ``min_step_angle``: a strike is only armed at a step angle at least that large)."""
-    why = str(why)
-    if getattr(prob, "model", "") == "hybrid" and ("no_strike" in why or "fell" in why):
-        ang = getattr(prob, "last_step_angle", None)
-        lim = prob.opts.get("min_step_angle", 0.0)
-        if ang is not None and ang < 1.1 * lim:
-            return ("%s: the step angle at heel strike (%.4g rad at the last gait) reaches the "
-                    "option min_step_angle = %g rad, below which a strike is not armed"
-                    % (why, ang, lim))
-    return why
-
-
-def label_points(bifs) -> None:
-    """AUTO-style labels: the type (LP, PD, NS, BP, EP, UZ) and a running number along the
-    branch, in branch order (``Bifurcation.label``, e.g. "PD1", "LP2")."""
-    for k, f in enumerate(sorted(bifs, key=lambda f: f.index), start=1):
-        f.label = "%s%d" % (f.type_label, k)
 
 
 def _branch(eng, pts, bifs, stop_reason, prob, wall, settings) -> Branch:
@@ -467,7 +420,8 @@ def load_branch(path: str | os.PathLike) -> Branch:
             eigenvector=None if d["eigenvector"] is None else np.array(d["eigenvector"]),
             multipliers=m, located=d["located"],
             bracket=None if d["bracket"] is None else tuple(d["bracket"]),
-            location_note=d["location_note"], label=d["label"]))
+            location_note=d["location_note"], label=d["label"],
+            details={} if prob is None else {"problem": prob}))
     settings = meta["settings"]
     if isinstance(settings.get("origin"), list):
         settings["origin"] = (settings["origin"][0], np.array(settings["origin"][1]))

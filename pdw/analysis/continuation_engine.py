@@ -12,6 +12,8 @@ import warnings
 
 import numpy as np
 
+from ..core import checks
+from ..core.errors import InvalidInputError
 from . import testfunctions as TF
 from .branch import Bifurcation
 from .gait_maps import Evaluation
@@ -209,7 +211,8 @@ def _bifurcation(engine, kind, loc, index, reason, eigvec=None):
     return Bifurcation(kind=kind, value=engine.value(pt.x), gait=gait, index=index,
                        tolerance=loc.width, reason=reason, z=pt.x[:-1].copy(),
                        mu=engine.mu(pt.x), tangent=pt.tangent.copy(), eigenvector=eigvec,
-                       multipliers=pt.mult.copy(), details={"orbit": pt.ev.info["orbit"]},
+                       multipliers=pt.mult.copy(),
+                       details={"orbit": pt.ev.info["orbit"], "problem": prob},
                        located=loc.located, bracket=loc.bracket,
                        location_note=loc.why)
 
@@ -244,3 +247,58 @@ def check_crossings(engine, a, b, index, locate_tol, detect=None):
         out.append(bif)
     out.sort(key=lambda f: (f.mu - engine.mu(a.x)) * np.sign(engine.mu(b.x) - engine.mu(a.x)))
     return out
+
+
+# --- options, labels, reasons -----------------------------------------------------------------
+
+METHODS = ("pseudo_arclength", "natural")
+
+
+def _check_options(o: dict) -> dict:
+    """Range-check the continuation's options (those present in ``o``; None = the default),
+    each error naming its option and allowed range; returns them normalised."""
+    out = dict(o)
+    if "method" in o and o["method"] not in METHODS:
+        raise InvalidInputError("method must be 'pseudo_arclength' or 'natural', got %r"
+                                % (o["method"],))
+    for k in ("step", "step_min", "step_max", "tol", "locate_tol", "stall_length"):
+        if o.get(k) is not None:
+            out[k] = checks.positive(k, o[k])
+    if o.get("fd_step") is not None:
+        out["fd_step"] = checks.number("fd_step", o["fd_step"], lo=0.0, lo_open=True, hi=0.1)
+    if o.get("step_min") is not None and o.get("step_max") is not None \
+            and out["step_min"] > out["step_max"]:
+        raise InvalidInputError("step_min (%r) must not exceed step_max (%r)"
+                                % (o["step_min"], o["step_max"]))
+    for k, lo in (("max_points", 2), ("max_newton", 1), ("period", 1), ("stall_points", 2)):
+        if o.get(k) is not None:
+            out[k] = checks.count(k, o[k], lo=lo, hi=10 ** 7)
+    if o.get("workers") is not None:
+        out["workers"] = checks.count("workers", o["workers"], lo=1, hi=4096)
+    for k in ("stop", "value"):
+        if o.get(k) is not None:
+            out[k] = checks.number(k, o[k])
+    if o.get("at") is not None:
+        out["at"] = [checks.number("at[%d]" % i, v) for i, v in enumerate(o["at"])]
+    return out
+
+
+def label_points(bifs) -> None:
+    """AUTO-style labels: the type (LP, PD, NS, BP, EP, UZ) and a running number along the
+    branch, in branch order (``Bifurcation.label``, e.g. "PD1", "LP2")."""
+    for k, f in enumerate(sorted(bifs, key=lambda f: f.index), start=1):
+        f.label = "%s%d" % (f.type_label, k)
+
+
+def _explain(prob, why) -> str:
+    """A step-map failure, with the option that caused it where known (the hybrid map's
+    ``min_step_angle``: a strike is only armed at a step angle at least that large)."""
+    why = str(why)
+    if getattr(prob, "model", "") == "hybrid" and ("no_strike" in why or "fell" in why):
+        ang = getattr(prob, "last_step_angle", None)
+        lim = prob.opts.get("min_step_angle", 0.0)
+        if ang is not None and ang < 1.1 * lim:
+            return ("%s: the step angle at heel strike (%.4g rad at the last gait) reaches the "
+                    "option min_step_angle = %g rad, below which a strike is not armed"
+                    % (why, ang, lim))
+    return why
