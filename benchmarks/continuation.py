@@ -10,6 +10,7 @@ and docs/figures/continuation_*.png.
     python benchmarks/continuation.py fig11     # Fig. 11 (k_n): continuation vs the sweep
     python benchmarks/continuation.py simplest_limit  # simplest walker's doubling, m_l/m_h -> 0
     python benchmarks/continuation.py kelvin_voigt    # Kelvin-Voigt's d_n branch (docs/contact_laws.md)
+    python benchmarks/continuation.py codim2    # compass doubling curve in (slope, c): CPU time
 """
 from __future__ import annotations
 
@@ -273,6 +274,25 @@ def part_kelvin_voigt():
         say("  d_n = %.6f  multipliers %s" % (v, np.round(m[:3], 4)))
 
 
+def part_codim2(rounds=3):
+    from pdw.analysis.codim2 import continue_bifurcation
+    say("== compass gait: the period-doubling curve in (gamma, c), c 0.5 -> 0.7 (hybrid) ==")
+    say("load average before: %s" % (os.getloadavg(),))
+    b = continue_gait(H.compass_gait_params(), "gamma", 5.0 * DEG, model="hybrid")
+    pd = b.of_kind("period_doubling")[0]
+    for r in range(rounds):
+        t0 = time.process_time()
+        cv = continue_bifurcation(pd, "c", 0.7)
+        cpu = time.process_time() - t0
+        say("round %d: %d points, gamma %.4f -> %.4f deg, c %.3f -> %.3f, %d map evaluations, "
+            "%.2f s CPU (%.2f s wall); stop: %s"
+            % (r, len(cv), cv.values[0, 0] / DEG, cv.values[-1, 0] / DEG, cv.values[0, 1],
+               cv.values[-1, 1], cv.n_maps, cpu, cv.wall_time, cv.stop_reason))
+    for v in cv.values[::3]:
+        say("  gamma = %.6f deg  c = %.6f  (b/a = %.4f)" % (v[0] / DEG, v[1], v[1] / (1 - v[1])))
+    say("load average after: %s" % (os.getloadavg(),))
+
+
 if __name__ == "__main__":
     parts = sys.argv[1:] or ["hybrid"]
     for part in parts:
@@ -281,7 +301,8 @@ if __name__ == "__main__":
         {"hybrid": part_hybrid, "hybrid_paper": part_hybrid_paper, "gamma": part_gamma,
          "dhip": part_dhip, "rigid": part_rigid,
          "rigid_paper": part_rigid_paper, "fig11": part_fig11,
-         "simplest_limit": part_simplest_limit, "kelvin_voigt": part_kelvin_voigt}[part]()
+         "simplest_limit": part_simplest_limit, "kelvin_voigt": part_kelvin_voigt,
+         "codim2": part_codim2}[part]()
         say("(%s: %.1f s wall; python benchmarks/continuation.py %s)"
             % (part, time.perf_counter() - t0, part))
         RESULTS.mkdir(exist_ok=True)

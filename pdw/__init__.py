@@ -26,6 +26,8 @@ find_gait               period-one gait of the continuous model: Newton shooting
 continue_gait, Branch   continuation of gaits in one parameter: branches, Floquet multipliers,
                         folds, period doublings, Neimark-Sacker, ends (pdw.analysis.continuation;
                         ``pdw continue``); Branch.save / pdw.load
+plot_branches, plot_curves   bifurcation diagrams (units on both axes, AUTO labels) and
+                        two-parameter curves (pdw.present.plots_continuation)
 continue_bifurcation    folds and period doublings followed in a second parameter (minimally
                         augmented; pdw.analysis.codim2): a BifurcationCurve
 sweep                   parameter studies from TOML files: run_study, load_study (``pdw sweep``)
@@ -71,6 +73,7 @@ from .core.model import (
 from .core.ode import OdeFunction, ode_function
 from .core.params import X0_DISTURBED, X0_PAPER, Params
 from .core.progress import Progress
+from .present.plots_continuation import plot_branches, plot_curves
 from .sim import scene
 from .sim.batch import BatchResult, simulate_batch
 from .sim.buffers import RecordBuffer
@@ -96,7 +99,7 @@ __all__ = [
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait", "Scene", "run",
     "limit_cycle", "cell_mapping", "find_gait", "sweep",
     "StepSizeWarning", "StepSizeError", "examples", "continue_gait", "Branch", "Bifurcation",
-    "continue_bifurcation", "BifurcationCurve",
+    "continue_bifurcation", "BifurcationCurve", "plot_branches", "plot_curves",
     "ode_function", "OdeFunction", "load", "RecordBuffer",
     "Contact", "Progress",
 ]

@@ -84,3 +84,23 @@ def test_labels_run_along_the_branch():
     labels = [f.label for f in sorted(b.bifurcations, key=lambda f: f.index)]
     assert labels[0] == "LP1"
     assert [int(x[2:]) for x in labels] == list(range(1, len(labels) + 1))
+
+
+def test_branch_plot_overlays_in_distinct_colours_with_units_and_labels(short):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    b2 = continue_gait(COMPASS, "gamma", 5.0 * DEG, model="hybrid")
+    ax = short.plot(b2, y="step_length", x_scale=180 / np.pi)
+    colours = {ln.get_color() for ln in ax.lines if ln.get_marker() in ("None", "")}
+    assert colours == {"C0", "C1"}
+    assert ax.get_xlabel() == "gamma [deg]" and ax.get_ylabel() == "step length [m]"
+    assert "PD1" in [t.get_text() for t in ax.texts]
+    # a third branch drawn on the same axes later takes the next colour
+    short.plot(ax=ax, y="step_length", x_scale=180 / np.pi)
+    assert "C2" in {ln.get_color() for ln in ax.lines}
+    ax2 = pdw.plot_branches([short], y="z0")
+    assert "theta_st" in ax2.get_ylabel() and "[rad]" in ax2.get_ylabel()
+    with pytest.raises(pdw.InvalidInputError, match="y must be"):
+        pdw.plot_branches([short], y="nope")
+    plt.close("all")

@@ -284,13 +284,15 @@ class Branch:
             json.dump({**self.summary(), **extra}, fh, indent=2, default=_jsonable)
         return path
 
-    def plot(self, ax=None, y="step_length", **kw):
-        """Bifurcation diagram of this branch: `pdw.present.plots_continuation.plot_branches`,
-        looked up when called (a convenience; the analysis layer does not import the present
-        layer's plotting code)."""
+    def plot(self, *others: "Branch", ax=None, y="step_length", **kw):
+        """Bifurcation diagram of this branch and ``others`` overlaid, one colour each (also
+        across calls on the same ``ax``), with units on both axes and ``y`` a named quantity
+        (step_length, period, double_support, max_multiplier, speed, z0):
+        `pdw.plot_branches`, looked up when called (the analysis layer does not import the
+        present layer's plotting code)."""
         import importlib
         plots = importlib.import_module("pdw.present.plots_continuation")
-        return plots.plot_branches([self], ax=ax, y=y, **kw)
+        return plots.plot_branches([self, *others], ax=ax, y=y, **kw)
 
 
 #: the ``meta["format"]`` of a branch file (`Branch.save`)

@@ -314,7 +314,8 @@ class ContinuousProblem(_Problem):
         if diff > self.CHECK_TOL:
             return diff, ("finite-difference multipliers depend on the step: fd_step %g and "
                           "%g differ by %.3g (largest %s against %s): a kink of the step map "
-                          "near this point" % (self.fd_step, h, diff,
+                          "within a few steps of this point, or strong curvature; the "
+                          "multipliers are uncertain to that amount" % (self.fd_step, h, diff,
                                                 np.round(ref[0], 4), np.round(m[0], 4)))
         return diff, ""
 
