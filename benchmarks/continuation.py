@@ -11,6 +11,7 @@ and docs/figures/continuation_*.png.
     python benchmarks/continuation.py simplest_limit  # simplest walker's doubling, m_l/m_h -> 0
     python benchmarks/continuation.py kelvin_voigt    # Kelvin-Voigt's d_n branch (docs/contact_laws.md)
     python benchmarks/continuation.py codim2    # compass doubling curve in (slope, c): CPU time
+    python benchmarks/continuation.py chaos     # orbit diagram, Lyapunov exponents, Feigenbaum
 """
 from __future__ import annotations
 
@@ -293,6 +294,51 @@ def part_codim2(rounds=3):
     say("load average after: %s" % (os.getloadavg(),))
 
 
+def part_chaos():
+    from pdw.analysis import chaos
+    C = H.compass_gait_params()
+    say("== compass gait: orbit diagram 4 -> 5.3 deg, 1000 slopes x 200 steps (keep 100) ==")
+    say("load average before: %s" % (os.getloadavg(),))
+    t0, c0 = time.perf_counter(), time.process_time()
+    od = chaos.orbit_diagram(C, "gamma", np.linspace(4.0, 5.3, 1000) * DEG, n_steps=200,
+                             keep=100, workers=2)
+    say("orbit diagram: %.1f s wall, %.1f s CPU (2 threads); the walker falls at %d slopes, "
+        "from %.4f deg" % (time.perf_counter() - t0, time.process_time() - c0,
+                           od["fell"].sum(), od["values"][od["fell"]].min() / DEG
+                           if od["fell"].any() else np.nan))
+    s0 = H.find_gait(C.replace(gamma=4.5 * DEG)).state
+    lam = []
+    for g in np.arange(4.0, 5.21, 0.05):
+        r = chaos.lyapunov(C.replace(gamma=g * DEG), n_steps=2000, n_transient=300, start=s0)
+        lam.append((g, r["exponent"]))
+        say("  gamma = %.2f deg: largest Lyapunov exponent %+.4f per step" % (g, r["exponent"]))
+    bs = follow_cascade(C, "gamma", 5.3 * DEG, depth=3, model="hybrid", step=0.05 * DEG)
+    pds = [b.of_kind("period_doubling")[0].value / DEG for b in bs if b.of_kind(
+        "period_doubling")]
+    say("located cascade: %s deg; Feigenbaum ratios %s (delta = 4.6692)"
+        % (", ".join("%.5f" % v for v in pds),
+           ", ".join("%.3f" % d for d in chaos.feigenbaum_ratios(pds))))
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True, layout="constrained",
+                                  height_ratios=(3, 1.3))
+    x = np.repeat(od["values"] / DEG, od["theta"].shape[1])
+    ax.plot(x, od["theta"].ravel(), ",", color="k", alpha=0.6)
+    for v in pds:
+        ax.axvline(v, color="C3", lw=0.6, ls=":")
+    ax.set_ylabel("stance leg angle theta_st after heel strike [rad]")
+    ax.set_title("Compass gait: orbit diagram (1000 slopes x last 100 of 200 steps)")
+    g, lv = np.array(lam).T
+    ax2.plot(g, lv, "o-", ms=3)
+    ax2.axhline(0, color="k", lw=0.6)
+    ax2.set_ylabel("Lyapunov exp. [1/step]")
+    ax2.set_xlabel("gamma [deg]")
+    fig.savefig(FIGS / "continuation_orbit_diagram.png", dpi=150)
+    say("wrote docs/figures/continuation_orbit_diagram.png")
+    say("load average after: %s" % (os.getloadavg(),))
+
+
 if __name__ == "__main__":
     parts = sys.argv[1:] or ["hybrid"]
     for part in parts:
@@ -302,7 +348,7 @@ if __name__ == "__main__":
          "dhip": part_dhip, "rigid": part_rigid,
          "rigid_paper": part_rigid_paper, "fig11": part_fig11,
          "simplest_limit": part_simplest_limit, "kelvin_voigt": part_kelvin_voigt,
-         "codim2": part_codim2}[part]()
+         "codim2": part_codim2, "chaos": part_chaos}[part]()
         say("(%s: %.1f s wall; python benchmarks/continuation.py %s)"
             % (part, time.perf_counter() - t0, part))
         RESULTS.mkdir(exist_ok=True)

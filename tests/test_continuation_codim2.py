@@ -65,3 +65,67 @@ def test_bad_requests_are_refused(pd):
         continue_bifurcation(pd, "slope", 0.1)
     with pytest.raises(pdw.InvalidInputError, match="bifurcation"):
         continue_bifurcation("PD1", "c", 0.7)
+
+
+# --- d. criticality of period doublings ------------------------------------------------------
+
+class _Flip:
+    """z' = -(1 + a) z + c z^3 (period n composed): the fixed point 0 flips at a = 0; the
+    2-cycle +-x has c x^2 = a, so it exists for a > 0 (the unstable side) when c > 0
+    (supercritical) and for a < 0 when c < 0 (subcritical): the closed form the test uses."""
+
+    model, parameter, ADMISSIBLE = "map", "a", {}
+
+    def __init__(self, c, period=1):
+        self.c, self.period, self.dim, self.n_maps, self.opts = c, period, 1, 0, {}
+
+    def value(self, mu):
+        return float(mu)
+
+    def coord(self, v):
+        return float(v)
+
+    def evaluate(self, z, mu, jac=True):
+        from pdw.analysis.gait_maps import Evaluation
+        x, d, dl = float(z[0]), 1.0, 0.0
+        for _ in range(self.period):
+            self.n_maps += 1
+            dl = -(1 + mu) * dl - x + 3 * self.c * x * x * dl
+            d *= -(1 + mu) + 3 * self.c * x * x
+            x = -(1 + mu) * x + self.c * x ** 3
+        info = {"period": 1.0, "step_length": 1.0, "double_support": 0.0,
+                "state": np.array([x]), "orbit": np.array([z])}
+        return Evaluation(True, "ok", np.array([x]), np.array([[d]]), np.array([dl]), info, {})
+
+    def gait(self, z, mu, ev, mult):
+        return pdw.Gait(state=np.asarray(z), period=1.0, step_length=1.0, double_support=0.0,
+                        multipliers=mult, model="map")
+
+
+@pytest.mark.parametrize("c, expected", [(1.0, "supercritical"), (-1.0, "subcritical")])
+def test_criticality_of_a_flip_from_the_period_two_branch(c, expected):
+    from pdw.analysis.continuation import run_continuation
+    b = run_continuation(_Flip(c), [0.0], -0.5, 0.5, tol=1e-12)
+    (pd,) = b.of_kind("period_doubling")
+    assert abs(pd.value) < 1e-6
+    cr = b.criticality(pd, amplitude=0.05)
+    assert cr["criticality"] == expected
+    x = float(cr["gait"].state[0])
+    assert abs(c * x * x - cr["value"]) < 1e-8            # on the closed-form 2-cycle
+
+
+def test_compass_gait_first_doubling_is_supercritical(pd):
+    """Independently, by a long walk: 0.02 deg above the doubling the walker started on the
+    period-1 gait settles on a small period-2 orbit (supercritical: it stays near), not away."""
+    b = continue_gait(COMPASS, "gamma", 5.0 * DEG, model="hybrid")
+    cr = b.criticality(b.of_kind("period_doubling")[0])
+    assert cr["criticality"] == "supercritical" and cr["stable"]
+    P = COMPASS.replace(gamma=pd.value + 0.02 * DEG)
+    y = H.find_gait(P).state + np.array([1e-4, -1e-4, 0.0, 0.0])
+    zs = []
+    for _ in range(3000):
+        y = H.step_map(y, P)
+        zs.append(y[0])
+    a, b2 = zs[-2], zs[-1]
+    assert abs(a - b2) > 1e-5 and abs(a - b2) < 0.02            # a small 2-cycle ...
+    assert abs(zs[-3] - b2) < 1e-9                               # ... that repeats

@@ -198,6 +198,13 @@ class Branch:
             raise InvalidInputError("this branch cannot be extended (no problem attached)")
         return self.extender(self, stop, **kw)
 
+    def criticality(self, bifurcation: Bifurcation, **kw: Any) -> dict:
+        """Super- or subcritical, for a period doubling of this branch, from the direction of
+        the period-2n branch: `pdw.analysis.continuation.criticality`."""
+        import importlib
+        return importlib.import_module("pdw.analysis.continuation").criticality(
+            self, bifurcation, **kw)
+
     # --- files ------------------------------------------------------------------------------------
 
     ARRAYS = ("values", "period", "step_length", "double_support", "multipliers", "stable",

@@ -29,6 +29,12 @@ bifurcation x* = (z*, u*) is found by Newton's method on P^{2n} in the hyperplan
 w . (x - x*) = a, w the critical eigenvector (v, 0) made orthogonal to the period-n tangent,
 which the period-n branch does not cross (it stays near w . (x - x*) = 0) and the period-2n
 branch, tangent to (v, 0), does.
+
+Why this module is long (about 560 lines): the driver (`continue_gait`, `run_continuation`),
+branch switching and criticality (`switch_branch`, `criticality`, `follow_cascade`) and the
+branch files (`load_branch`, `extend_branch`) all rebuild problems with `_problem` and hand
+themselves to `Branch` as its switch/extend hooks; split into sibling modules they would
+import each other (an import cycle, which the architecture forbids).
 """
 from __future__ import annotations
 
@@ -514,6 +520,34 @@ def switch_branch(branch, bifurcation, amplitude=0.005, max_tries=6) -> Gait:
         a *= 0.5
     raise GaitNotFoundError("no period-%d gait found next to the period doubling at %s = %.8g: "
                             "%s" % (prob.period, p1.parameter, bifurcation.value, why))
+
+
+def criticality(branch, bifurcation, amplitude=0.005) -> dict:
+    """Super- or subcritical, for a period doubling of ``branch``, from the direction of the
+    period-2n branch born there (`switch_branch`): it lies on the side where the period-n
+    gait is unstable (supercritical: a small period-2n gait takes over) or on the stable side
+    (subcritical: the period-2n gait coexists with the stable period-n one, unstable, and
+    there is no small gait beyond).
+
+    Returns
+    -------
+    dict
+        ``criticality`` ("supercritical" or "subcritical"), ``value`` (the period-2n gait's
+        parameter), ``offset`` (its distance from the doubling, signed towards the unstable
+        side of the period-n branch), ``stable`` (of the period-2n gait) and ``gait``.
+    """
+    if bifurcation.kind != "period_doubling":
+        raise InvalidInputError("criticality needs a period_doubling, got %r" % bifurcation.kind)
+    i = bifurcation.index
+    va, vb = branch.values[i], branch.values[min(i + 1, len(branch) - 1)]
+    # the side of the doubling on which the period-n gait's flip multiplier is outside
+    ma = np.min(np.real(branch.multipliers[i]))
+    unstable_dir = np.sign(vb - va) if ma > -1.0 else -np.sign(vb - va)
+    g = switch_branch(branch, bifurcation, amplitude=amplitude)
+    off = (g.details["value"] - bifurcation.value) * unstable_dir
+    return {"criticality": "supercritical" if off > 0 else "subcritical",
+            "value": g.details["value"], "offset": float(off), "stable": bool(g.stable),
+            "gait": g}
 
 
 def follow_cascade(params, parameter, stop, depth=2, **kw) -> list:

@@ -30,7 +30,7 @@ import os
 
 import numpy as np
 
-from ..core import _hybrid
+from ..core import _hybrid  # type: ignore[attr-defined]  # compiled, no stub
 from ..core.errors import InvalidInputError
 from ..core.model import parameter_vector
 from ..core.params import Params

@@ -51,14 +51,10 @@ import numpy as np
 from .. import examples
 from ..analysis.branch import _jsonable
 from ..analysis.continuation import continue_gait, follow_cascade
+from ..core import _toml
 from ..core.contact import Contact
 from ..core.errors import InvalidInputError
 from ..core.params import Params
-
-try:
-    import tomllib
-except ImportError:                                    # pragma: no cover - Python < 3.11
-    import tomli as tomllib
 
 KEYS = {"name", "title", "model", "preset", "variant", "parameter", "stop", "start", "params",
         "couple", "continuation", "contact", "plot"}
@@ -85,8 +81,8 @@ def preset(name, **overrides) -> Params:
 def load_spec(path) -> dict:
     text = pathlib.Path(path).read_text()
     try:
-        spec = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
+        spec = _toml.loads(text)
+    except _toml.TOMLDecodeError as e:
         raise InvalidInputError("%s: not valid TOML: %s" % (path, e)) from None
     bad = set(spec) - KEYS
     if bad:
