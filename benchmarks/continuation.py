@@ -30,7 +30,7 @@ import pdw  # noqa: E402
 from pdw import hybrid as H  # noqa: E402
 from pdw.analysis.continuation import continue_gait, follow_cascade  # noqa: E402
 from pdw.present.cli_continue import preset  # noqa: E402
-from pdw.present.plots_continuation import plot_branches  # noqa: E402
+from pdw.present.plots_continuation import plot_branches, plot_curves  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
 FIGS = ROOT / "docs" / "figures"
@@ -46,8 +46,12 @@ def say(*a):
 
 def _bifs(b, scale=1.0, unit=""):
     for f in b.bifurcations:
-        say("  %-16s at %s = %.10g%s (bracket %.2g): %s"
-            % (f.kind, b.parameter, f.value * scale, unit, f.tolerance * scale, f.reason))
+        if not f.located:
+            say("  " + f.describe())
+            continue
+        say("  %s %-16s at %s = %.10g%s (bracket %.2g): %s"
+            % (f.label, f.kind, b.parameter, f.value * scale, unit, f.tolerance * scale,
+               f.reason))
 
 
 def _branch_line(b):
@@ -291,7 +295,26 @@ def part_codim2(rounds=3):
                cv.values[-1, 1], cv.n_maps, cpu, cv.wall_time, cv.stop_reason))
     for v in cv.values[::3]:
         say("  gamma = %.6f deg  c = %.6f  (b/a = %.4f)" % (v[0] / DEG, v[1], v[1] / (1 - v[1])))
+    lo = continue_bifurcation(pd, "c", 0.35)
+    say("towards c = 0.35: %d points, %s" % (len(lo), lo.stop_reason))
+    mh = [continue_bifurcation(pd, "m_h", s) for s in (5.0, 20.0)]
+    for m in mh:
+        say("in m_h (m_l = 5): gamma %.4f -> %.4f deg for m_h %.2f -> %.2f; %s"
+            % (m.values[0, 0] / DEG, m.values[-1, 0] / DEG, m.values[0, 1], m.values[-1, 1],
+               m.stop_reason))
     say("load average after: %s" % (os.getloadavg(),))
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(9, 3.8), layout="constrained")
+    plot_curves([lo, cv], ax=a1, y_scale=1 / DEG, labels=["from c = 0.5 down", "up"])
+    a1.set_ylabel("gamma [deg]")
+    a1.set_title("compass gait: its first period doubling in (c, gamma)", fontsize=9)
+    plot_curves(mh, ax=a2, y_scale=1 / DEG, labels=["from m_h = 10 down", "up"])
+    a2.set_ylabel("gamma [deg]")
+    a2.set_xlabel("m_h [kg] (m_l = 5 kg)")
+    fig.savefig(FIGS / "continuation_codim2.png", dpi=150)
+    say("wrote docs/figures/continuation_codim2.png")
 
 
 def part_chaos():

@@ -129,3 +129,32 @@ def test_compass_gait_first_doubling_is_supercritical(pd):
     a, b2 = zs[-2], zs[-1]
     assert abs(a - b2) > 1e-5 and abs(a - b2) < 0.02            # a small 2-cycle ...
     assert abs(zs[-3] - b2) < 1e-9                               # ... that repeats
+
+
+# --- b. branch points ----------------------------------------------------------------------------
+
+class _Pitchfork(_Flip):
+    """z' = z + a z - z^3: the branch z = 0 for every a, crossed at a = 0 by z^2 = a."""
+
+    def evaluate(self, z, mu, jac=True):
+        from pdw.analysis.gait_maps import Evaluation
+        x = float(z[0])
+        self.n_maps += 1
+        info = {"period": 1.0, "step_length": 1.0, "double_support": 0.0,
+                "state": np.array([x]), "orbit": np.array([z])}
+        return Evaluation(True, "ok", np.array([x + mu * x - x ** 3]),
+                          np.array([[1 + mu - 3 * x * x]]), np.array([x]), info, {})
+
+
+def test_branch_point_located_and_switched_onto_the_crossing_branch():
+    from pdw.analysis.continuation import run_continuation
+    b = run_continuation(_Pitchfork(0.0), [0.0], -0.5, 0.5, tol=1e-12,
+                         detect=("fold", "branch_point"))
+    (bp,) = b.of_kind("branch_point")
+    assert bp.located and abs(bp.value) < 1e-6 and bp.label == "BP1"
+    assert not b.of_kind("fold")
+    g = b.switch(bp, amplitude=0.05)
+    x, a = float(g.state[0]), g.details["value"]
+    assert abs(x) > 1e-3 and abs(x * x - a) < 1e-10             # on z^2 = a
+    b2 = run_continuation(_Pitchfork(0.0), [x], a, 0.5, tol=1e-12)
+    assert b2.values[-1] == pytest.approx(0.5) and abs(b2.z[-1, 0] ** 2 - 0.5) < 1e-10

@@ -480,9 +480,11 @@ def switch_branch(branch, bifurcation, amplitude=0.005, max_tries=6) -> Gait:
     ``details["value"]`` (its parameter) and ``details["direction"]`` (the branch's direction
     away from the bifurcation), so ``continue_gait(..., period=2n, start=gait)`` follows it.
     """
+    if bifurcation.kind == "branch_point":
+        return _switch_at_branch_point(branch, bifurcation, amplitude)
     if bifurcation.kind != "period_doubling":
-        raise InvalidInputError("switch needs a period_doubling bifurcation, got %r"
-                                % bifurcation.kind)
+        raise InvalidInputError("switch needs a period_doubling or branch_point bifurcation, "
+                                "got %r" % bifurcation.kind)
     p1 = branch.problem
     s = branch.settings
     prob = copy.copy(p1)
@@ -520,6 +522,40 @@ def switch_branch(branch, bifurcation, amplitude=0.005, max_tries=6) -> Gait:
         a *= 0.5
     raise GaitNotFoundError("no period-%d gait found next to the period doubling at %s = %.8g: "
                             "%s" % (prob.period, p1.parameter, bifurcation.value, why))
+
+
+def _switch_at_branch_point(branch, bif, amplitude) -> Gait:
+    """The first point of the other branch through a simple branch point x*: DG there has a
+    two-dimensional null space; its direction t2 orthogonal to this branch's tangent is the
+    other branch's tangent. Newton from x* + a t2 bordered by t2 (a halved on failure)."""
+    s = branch.settings
+    prob = branch.problem
+    eng = Engine(prob, s["mu0"], s["scale"], s["tol"], 12, False)
+    x_star = np.append(bif.z, (bif.mu - s["mu0"]) / s["scale"])
+    ev = eng.evaluate(x_star)
+    if not ev.ok:
+        raise GaitNotFoundError("the branch point does not evaluate: %s" % ev.status)
+    _, _, Vt = np.linalg.svd(eng.dG(ev))
+    t1 = np.asarray(bif.tangent, dtype=float)
+    N = Vt[-2:]                                # the two smallest right singular vectors
+    p = N @ t1                                 # t1 in that basis; t2 is the orthogonal one
+    t2 = N.T @ np.array([-p[1], p[0]])
+    t2 = t2 - (t2 @ t1) * t1
+    t2 /= np.linalg.norm(t2)
+    a, why = float(amplitude), "not tried"
+    for _ in range(8):
+        x, ev2, _ = eng.correct(x_star + a * t2, t2)
+        if x is not None:
+            m = np.linalg.eigvals(ev2.M)
+            gait = prob.gait(x[:-1], eng.mu(x), ev2, m[np.argsort(-np.abs(m))])
+            d = x - x_star
+            gait.details.update(value=eng.value(x), direction=(d[:-1], d[-1] * s["scale"]),
+                                switched_from=bif.as_dict())
+            return gait
+        why = ev2
+        a *= 0.5
+    raise GaitNotFoundError("no point of the crossing branch next to the branch point at "
+                            "%s = %.8g: %s" % (prob.parameter, bif.value, why))
 
 
 def criticality(branch, bifurcation, amplitude=0.005) -> dict:
