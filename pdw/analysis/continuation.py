@@ -52,11 +52,21 @@ from ..core.errors import InvalidInputError
 from ..core.params import Params
 from ..core.progress import Progress, progress_bar
 from ..sim import files as _files
+from . import extension as X
 from . import hybrid as H
 from . import limit_cycle as LC
 from . import testfunctions as TF
 from .branch import BRANCH_FORMAT, Bifurcation, Branch
-from .continuation_engine import Engine, Point, _check_options, _explain, check_crossings, label_points, tests
+from .continuation_engine import (
+    METHODS,
+    Engine,
+    Point,
+    _check_options,
+    _explain,
+    check_crossings,
+    label_points,
+    tests,
+)
 from .gait_maps import ContinuousProblem, HybridProblem
 from .gait_types import Gait, GaitNotFoundError
 
@@ -222,13 +232,15 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
                      step=None, step_min=None, step_max=None, tol=1e-10, locate_tol=None,
                      detect=TF.DEFAULT_DETECT, max_newton=8,
                      direction=None, origin=None, settings=None, t0=None, at=(),
-                     progress=False, events=(), stall_points=8, stall_length=1e-3) -> Branch:
+                     progress=False, events=(), stall_points=8, stall_length=1e-3,
+                     step_control=None) -> Branch:
     """The continuation proper, on any problem object (`pdw.analysis.gait_maps`: ``dim``, ``evaluate``,
     ``coord``/``value``, ``gait``, ``ADMISSIBLE``, ...), from the fixed point z0 at ``value``
     towards ``stop``; the arguments as in `continue_gait` (``direction``: (dz, dmu) to orient
     the first tangent; ``origin``: where a switched branch was born, for plots; ``at``:
     parameter values where a point is also computed, by a natural correction, whenever the
-    branch passes them)."""
+    branch passes them; ``method``: "pseudo_arclength", "natural" or a predictor object,
+    ``step_control``: a `pdw.analysis.extension.StepControl`, both extension points)."""
     t0 = time.perf_counter() if t0 is None else t0
     o = _check_options(dict(method=method, step=step, step_min=step_min, step_max=step_max,
                             tol=tol, locate_tol=locate_tol, max_points=max_points,
@@ -243,13 +255,15 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
     scale = mu_stop - mu0          # signed: u runs from 0 to 1
     if hasattr(prob, "lam_rel"):
         prob.lam_step = prob.lam_rel * max(abs(mu0), abs(scale))
-    eng = Engine(prob, mu0, scale, tol, max_newton, method == "natural", functions)
+    predictor = X.PREDICTORS[method]() if isinstance(method, str) else method
+    eng = Engine(prob, mu0, scale, tol, max_newton, False, functions, predictor)
     step_min = 1e-6 if step_min is None else step_min
     step_max = 0.1 if step_max is None else step_max
-    if step_min > step_max:
-        raise InvalidInputError("step_min (%r) must not exceed step_max (%r)"
-                                % (step_min, step_max))
-    ds = min(max(abs(step / scale), step_min), step_max) if step else min(0.02, step_max)
+    if step_control is None:
+        step_control = X.StepControl(abs(step / scale) if step else 0.02, step_min, step_max)
+    ctl = step_control
+    step_min, step_max = ctl.step_min, ctl.step_max
+    ds = ctl.first
     locate_tol = 1e-6 * abs(scale) if locate_tol is None else locate_tol
     x0 = np.append(np.asarray(z0, dtype=float), 0.0)
     e = np.zeros(prob.dim + 1)
@@ -291,8 +305,9 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
                 break
         if b is None:
             last_failure = str(why)
-            ds *= 0.5
-            if ds < step_min:
+            nds = ctl.failed(ds)
+            if nds is None:
+                ds *= 0.5
                 beyond = eng.value(a.x + 2 * ds * a.tangent)
                 bifs.append(Bifurcation(
                     kind="end", value=eng.value(a.x), gait=None, index=len(pts) - 1,
@@ -304,6 +319,7 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
                     "step down to step_min = %g" % step_min))
                 stop_reason = "end of the family: %s" % _explain(prob, why)
                 break
+            ds = nds
             continue
         b.tests = tests(eng, b)
         found = check_crossings(eng, a, b, len(pts) - 1, locate_tol)
@@ -349,15 +365,13 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
                            "for ever smaller steps (last failure: %s)"
                            % (stall_points, sum(recent), stall_length, last_failure))
             break
-        if its <= 2:
-            ds = min(ds * 1.5, step_max)
-        elif its >= 5:
-            ds = max(ds * 0.7, step_min)
+        ds = ctl.accepted(ds, its)
     bar.update(len(pts) - seen)
     bar.close()
     label_points(bifs)
     return _branch(eng, pts, bifs, stop_reason, prob, time.perf_counter() - t0,
-                   dict(method=method, tol=tol, locate_tol=locate_tol, step_min=step_min,
+                   dict(method=method if isinstance(method, str) else type(method).__name__,
+                        tol=tol, locate_tol=locate_tol, step_min=step_min,
                         step_max=step_max, start_value=float(value), stop=float(stop),
                         options=dict(getattr(prob, "opts", {})), origin=origin,
                         **(settings or {})))
@@ -465,6 +479,8 @@ def extend_branch(branch: Branch, stop: float, **kw) -> Branch:
     for k in ("tol", "locate_tol", "method"):
         if branch.settings.get(k) is not None:
             opts[k] = branch.settings[k]
+    if opts.get("method") not in METHODS:       # a custom predictor is not saved
+        opts.pop("method", None)
     opts.update(kw)
     return continue_gait(prob.base, branch.parameter, stop, start=g, **opts)
 

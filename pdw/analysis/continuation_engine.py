@@ -14,6 +14,7 @@ import numpy as np
 
 from ..core import checks
 from ..core.errors import InvalidInputError
+from . import extension as X
 from . import testfunctions as TF
 from .branch import Bifurcation
 from .gait_maps import Evaluation
@@ -32,9 +33,14 @@ class Point:
 class Engine:
     """Predictor-corrector machinery on one problem, in the scaled coordinates x = (z, u)."""
 
-    def __init__(self, prob, mu0, scale, tol, max_newton, natural, functions=None):
+    def __init__(self, prob, mu0, scale, tol, max_newton, natural, functions=None,
+                 predictor=None):
         self.prob, self.mu0, self.scale = prob, mu0, scale
-        self.tol, self.max_newton, self.natural = tol, max_newton, natural
+        self.tol, self.max_newton = tol, max_newton
+        if predictor is None:
+            predictor = (X.NaturalPredictor if natural else X.TangentPredictor)()
+        self.predictor = predictor
+        self.natural = bool(getattr(predictor, "natural", False))
         self.n = prob.dim
         self.functions = list(TF.select(TF.DEFAULT_DETECT) if functions is None else functions)
         self.owner: dict = {}         # test-function name -> its TestFunction
@@ -91,16 +97,9 @@ class Engine:
         return None, last, self.max_newton
 
     def step_from(self, pt, ds):
-        """The next point at arclength ds from pt (natural: ds in u)."""
-        if self.natural:
-            e = np.zeros(self.n + 1)
-            e[-1] = 1.0
-            d = pt.tangent / pt.tangent[-1] if abs(pt.tangent[-1]) > 1e-12 else e
-            x_pred = pt.x + ds * d
-            c = e
-        else:
-            x_pred = pt.x + ds * pt.tangent
-            c = pt.tangent
+        """The next point at step ds from pt, predicted by ``self.predictor``
+        (`pdw.analysis.extension`)."""
+        x_pred, c = self.predictor.predict(self, pt, ds)
         x, ev, its = self.correct(x_pred, c)
         if x is None:
             return None, ev, its
@@ -258,7 +257,7 @@ def _check_options(o: dict) -> dict:
     """Range-check the continuation's options (those present in ``o``; None = the default),
     each error naming its option and allowed range; returns them normalised."""
     out = dict(o)
-    if "method" in o and o["method"] not in METHODS:
+    if "method" in o and isinstance(o["method"], str) and o["method"] not in METHODS:
         raise InvalidInputError("method must be 'pseudo_arclength' or 'natural', got %r"
                                 % (o["method"],))
     for k in ("step", "step_min", "step_max", "tol", "locate_tol", "stall_length"):
