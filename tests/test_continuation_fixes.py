@@ -173,3 +173,22 @@ def test_simplest_walker_limit_of_the_period_doubling():
     assert 8.0 < r < 12.0
     limit = g[1e-8] - (g[1e-7] - g[1e-8]) / 9.0
     assert abs(limit - 0.0150884) < 5e-8
+
+
+@pytest.mark.slow
+def test_kelvin_voigt_period_doubling_located_at_109_745_and_stall_stop():
+    """The Kelvin-Voigt ground's doubling (docs/contact_laws.md): from d_n = 109.5 with steps
+    of 0.1 it is located at 109.745 (the multiplier -1 to 1e-3; long walks: period 1 at 109.70,
+    period 2 at 109.75), the finite-difference cross-check flags the kink next to it, and the
+    branch beyond stops as stalled instead of crawling to max_points."""
+    from pdw.analysis.calibration import calibrate
+    P0 = pdw.Params.paper_steady()
+    kv = calibrate(P0).contacts["kelvin_voigt"]
+    with pytest.warns(UserWarning, match="depend on the step"):
+        b = continue_gait(P0.replace(k_n=kv.k, d_n=109.5), "d_n", 110.2, step=0.1,
+                          max_points=30, options=dict(contact=pdw.Contact("kelvin_voigt")),
+                          workers=2)
+    (pd,) = b.of_kind("period_doubling")
+    assert pd.located and 109.70 < pd.value < 109.75
+    assert np.min(np.abs(pd.multipliers + 1.0)) < 1e-3
+    assert b.stop_reason.startswith("stalled") and len(b) < 30
