@@ -8,6 +8,10 @@ and docs/figures/continuation_*.png.
     python benchmarks/continuation.py rigid     # k_n 1e5 -> 1e9, consistent, d_n ~ k_n^(4/3)
     python benchmarks/continuation.py rigid_paper  # the same in the paper variant: its end
     python benchmarks/continuation.py fig11     # Fig. 11 (k_n): continuation vs the sweep
+    python benchmarks/continuation.py simplest_limit  # simplest walker's doubling, m_l/m_h -> 0
+    python benchmarks/continuation.py kelvin_voigt    # Kelvin-Voigt's d_n branch (docs/contact_laws.md)
+    python benchmarks/continuation.py codim2    # compass doubling curve in (slope, c): CPU time
+    python benchmarks/continuation.py chaos     # orbit diagram, Lyapunov exponents, Feigenbaum
 """
 from __future__ import annotations
 
@@ -26,7 +30,7 @@ import pdw  # noqa: E402
 from pdw import hybrid as H  # noqa: E402
 from pdw.analysis.continuation import continue_gait, follow_cascade  # noqa: E402
 from pdw.present.cli_continue import preset  # noqa: E402
-from pdw.present.plots_continuation import plot_branches  # noqa: E402
+from pdw.present.plots_continuation import plot_branches, plot_curves  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
 FIGS = ROOT / "docs" / "figures"
@@ -42,8 +46,12 @@ def say(*a):
 
 def _bifs(b, scale=1.0, unit=""):
     for f in b.bifurcations:
-        say("  %-16s at %s = %.10g%s (bracket %.2g): %s"
-            % (f.kind, b.parameter, f.value * scale, unit, f.tolerance * scale, f.reason))
+        if not f.located:
+            say("  " + f.describe())
+            continue
+        say("  %s %-16s at %s = %.10g%s (bracket %.2g): %s"
+            % (f.label, f.kind, b.parameter, f.value * scale, unit, f.tolerance * scale,
+               f.reason))
 
 
 def _branch_line(b):
@@ -229,6 +237,131 @@ def part_fig11(rounds=2):
     say("load average after: %s" % (os.getloadavg(),))
 
 
+def _simplest(gamma, m_l):
+    return pdw.Params(l=1.0, c=1.0, w=0.0, r=0.0, J_l=0.0, m_h=1.0, m_l=m_l, k_hip=0.0,
+                      d_hip=0.0, gamma=gamma, g=1.0)
+
+
+def part_simplest_limit():
+    say("== simplest walker: first period doubling against m_l/m_h (hybrid, locate_tol 1e-10) ==")
+    vals = {}
+    for m in (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8):
+        b = continue_gait(_simplest(0.009, m), "gamma", 0.02, model="hybrid", locate_tol=1e-10)
+        pd = b.of_kind("period_doubling")[0]
+        vals[m] = pd.value
+        say("m_l/m_h = %.0e: gamma_PD = %.10f (located %s, bracket %.1e), %.2f s"
+            % (m, pd.value, pd.located, pd.tolerance, b.wall_time))
+    g7, g8 = vals[1e-7], vals[1e-8]
+    say("linear extrapolation to m_l/m_h = 0 from 1e-7 and 1e-8: gamma_PD = %.10f"
+        % (g8 - (g7 - g8) * 1e-8 / (1e-7 - 1e-8)))
+
+
+def part_kelvin_voigt():
+    from pdw.analysis.calibration import calibrate
+    P0 = pdw.Params.paper_steady()
+    kv = calibrate(P0).contacts["kelvin_voigt"]
+    say("== Kelvin-Voigt (k = %.6g, d = %.6g): continued in d_n down to 10 ==" % (kv.k, kv.d))
+    b = continue_gait(P0.replace(k_n=kv.k, d_n=kv.d), "d_n", 10.0, step=5.0, max_points=40,
+                      options=dict(contact=pdw.Contact("kelvin_voigt")), workers=2)
+    _branch_line(b)
+    for f in b.bifurcations:
+        say("  " + f.describe())
+    say("== the same from d_n = 109.5 up, step 0.1 (the period doubling, located) ==")
+    b = continue_gait(P0.replace(k_n=kv.k, d_n=109.5), "d_n", 110.2, step=0.1, max_points=30,
+                      options=dict(contact=pdw.Contact("kelvin_voigt")), workers=2)
+    _branch_line(b)
+    for f in b.bifurcations:
+        say("  " + f.describe())
+        say("    multipliers %s; finite-difference cross-check (fd_step x10): %.3g %s"
+            % (np.round(f.multipliers[:3], 5), f.details.get("fd_check", np.nan),
+               f.details.get("fd_check_note", "")))
+    for v, m in zip(b.values, b.multipliers):
+        say("  d_n = %.6f  multipliers %s" % (v, np.round(m[:3], 4)))
+
+
+def part_codim2(rounds=3):
+    from pdw.analysis.codim2 import continue_bifurcation
+    say("== compass gait: the period-doubling curve in (gamma, c), c 0.5 -> 0.7 (hybrid) ==")
+    say("load average before: %s" % (os.getloadavg(),))
+    b = continue_gait(H.compass_gait_params(), "gamma", 5.0 * DEG, model="hybrid")
+    pd = b.of_kind("period_doubling")[0]
+    for r in range(rounds):
+        t0 = time.process_time()
+        cv = continue_bifurcation(pd, "c", 0.7)
+        cpu = time.process_time() - t0
+        say("round %d: %d points, gamma %.4f -> %.4f deg, c %.3f -> %.3f, %d map evaluations, "
+            "%.2f s CPU (%.2f s wall); stop: %s"
+            % (r, len(cv), cv.values[0, 0] / DEG, cv.values[-1, 0] / DEG, cv.values[0, 1],
+               cv.values[-1, 1], cv.n_maps, cpu, cv.wall_time, cv.stop_reason))
+    for v in cv.values[::3]:
+        say("  gamma = %.6f deg  c = %.6f  (b/a = %.4f)" % (v[0] / DEG, v[1], v[1] / (1 - v[1])))
+    lo = continue_bifurcation(pd, "c", 0.35)
+    say("towards c = 0.35: %d points, %s" % (len(lo), lo.stop_reason))
+    mh = [continue_bifurcation(pd, "m_h", s) for s in (5.0, 20.0)]
+    for m in mh:
+        say("in m_h (m_l = 5): gamma %.4f -> %.4f deg for m_h %.2f -> %.2f; %s"
+            % (m.values[0, 0] / DEG, m.values[-1, 0] / DEG, m.values[0, 1], m.values[-1, 1],
+               m.stop_reason))
+    say("load average after: %s" % (os.getloadavg(),))
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(9, 3.8), layout="constrained")
+    plot_curves([lo, cv], ax=a1, y_scale=1 / DEG, labels=["from c = 0.5 down", "up"])
+    a1.set_ylabel("gamma [deg]")
+    a1.set_title("compass gait: its first period doubling in (c, gamma)", fontsize=9)
+    plot_curves(mh, ax=a2, y_scale=1 / DEG, labels=["from m_h = 10 down", "up"])
+    a2.set_ylabel("gamma [deg]")
+    a2.set_xlabel("m_h [kg] (m_l = 5 kg)")
+    fig.savefig(FIGS / "continuation_codim2.png", dpi=150)
+    say("wrote docs/figures/continuation_codim2.png")
+
+
+def part_chaos():
+    from pdw.analysis import chaos
+    C = H.compass_gait_params()
+    say("== compass gait: orbit diagram 4 -> 5.3 deg, 1000 slopes x 200 steps (keep 100) ==")
+    say("load average before: %s" % (os.getloadavg(),))
+    t0, c0 = time.perf_counter(), time.process_time()
+    od = chaos.orbit_diagram(C, "gamma", np.linspace(4.0, 5.3, 1000) * DEG, n_steps=200,
+                             keep=100, workers=2)
+    say("orbit diagram: %.1f s wall, %.1f s CPU (2 threads); the walker falls at %d slopes, "
+        "from %.4f deg" % (time.perf_counter() - t0, time.process_time() - c0,
+                           od["fell"].sum(), od["values"][od["fell"]].min() / DEG
+                           if od["fell"].any() else np.nan))
+    s0 = H.find_gait(C.replace(gamma=4.5 * DEG)).state
+    lam = []
+    for g in np.arange(4.0, 5.21, 0.05):
+        r = chaos.lyapunov(C.replace(gamma=g * DEG), n_steps=2000, n_transient=300, start=s0)
+        lam.append((g, r["exponent"]))
+        say("  gamma = %.2f deg: largest Lyapunov exponent %+.4f per step" % (g, r["exponent"]))
+    bs = follow_cascade(C, "gamma", 5.3 * DEG, depth=3, model="hybrid", step=0.05 * DEG)
+    pds = [b.of_kind("period_doubling")[0].value / DEG for b in bs if b.of_kind(
+        "period_doubling")]
+    say("located cascade: %s deg; Feigenbaum ratios %s (delta = 4.6692)"
+        % (", ".join("%.5f" % v for v in pds),
+           ", ".join("%.3f" % d for d in chaos.feigenbaum_ratios(pds))))
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True, layout="constrained",
+                                  height_ratios=(3, 1.3))
+    x = np.repeat(od["values"] / DEG, od["theta"].shape[1])
+    ax.plot(x, od["theta"].ravel(), ",", color="k", alpha=0.6)
+    for v in pds:
+        ax.axvline(v, color="C3", lw=0.6, ls=":")
+    ax.set_ylabel("stance leg angle theta_st after heel strike [rad]")
+    ax.set_title("Compass gait: orbit diagram (1000 slopes x last 100 of 200 steps)")
+    g, lv = np.array(lam).T
+    ax2.plot(g, lv, "o-", ms=3)
+    ax2.axhline(0, color="k", lw=0.6)
+    ax2.set_ylabel("Lyapunov exp. [1/step]")
+    ax2.set_xlabel("gamma [deg]")
+    fig.savefig(FIGS / "continuation_orbit_diagram.png", dpi=150)
+    say("wrote docs/figures/continuation_orbit_diagram.png")
+    say("load average after: %s" % (os.getloadavg(),))
+
+
 if __name__ == "__main__":
     parts = sys.argv[1:] or ["hybrid"]
     for part in parts:
@@ -236,7 +369,9 @@ if __name__ == "__main__":
         t0 = time.perf_counter()
         {"hybrid": part_hybrid, "hybrid_paper": part_hybrid_paper, "gamma": part_gamma,
          "dhip": part_dhip, "rigid": part_rigid,
-         "rigid_paper": part_rigid_paper, "fig11": part_fig11}[part]()
+         "rigid_paper": part_rigid_paper, "fig11": part_fig11,
+         "simplest_limit": part_simplest_limit, "kelvin_voigt": part_kelvin_voigt,
+         "codim2": part_codim2, "chaos": part_chaos}[part]()
         say("(%s: %.1f s wall; python benchmarks/continuation.py %s)"
             % (part, time.perf_counter() - t0, part))
         RESULTS.mkdir(exist_ok=True)

@@ -25,7 +25,11 @@ find_gait               period-one gait of the continuous model: Newton shooting
                         pdw.cell_mapping)
 continue_gait, Branch   continuation of gaits in one parameter: branches, Floquet multipliers,
                         folds, period doublings, Neimark-Sacker, ends (pdw.analysis.continuation;
-                        ``pdw continue``)
+                        ``pdw continue``); Branch.save / pdw.load
+plot_branches, plot_curves   bifurcation diagrams (units on both axes, AUTO labels) and
+                        two-parameter curves (pdw.present.plots_continuation)
+continue_bifurcation    folds and period doublings followed in a second parameter (minimally
+                        augmented; pdw.analysis.codim2): a BifurcationCurve
 sweep                   parameter studies from TOML files: run_study, load_study (``pdw sweep``)
 examples                the scenes and studies shipped with pdw (``pdw run --list-examples``)
 Progress                the progress bar of long jobs (``progress=`` of sweeps, cell maps, basins,
@@ -39,6 +43,7 @@ import sys as _sys
 from . import examples  # package data: the shipped scenes and studies
 from .analysis import cell_mapping, hybrid, limit_cycle
 from .analysis.branch import Bifurcation, Branch
+from .analysis.codim2 import BifurcationCurve, continue_bifurcation
 from .analysis.continuation import continue_gait
 from .analysis.gait_types import Gait, GaitNotFoundError
 from .analysis.limit_cycle import find_gait
@@ -69,6 +74,7 @@ from .core.model import (
 from .core.ode import OdeFunction, ode_function
 from .core.params import X0_DISTURBED, X0_PAPER, Params
 from .core.progress import Progress
+from .present.plots_continuation import plot_branches, plot_curves
 from .sim import scene
 from .sim.batch import BatchResult, simulate_batch
 from .sim.buffers import RecordBuffer
@@ -95,6 +101,7 @@ __all__ = [
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait", "Scene", "run",
     "limit_cycle", "cell_mapping", "find_gait", "sweep",
     "StepSizeWarning", "StepSizeError", "examples", "continue_gait", "Branch", "Bifurcation",
+    "continue_bifurcation", "BifurcationCurve", "plot_branches", "plot_curves",
     "ode_function", "OdeFunction", "load", "load_sweep", "RecordBuffer",
     "Contact", "Progress", "GaitNotFoundError",
 ]

@@ -13,15 +13,17 @@ from __future__ import annotations
 import csv
 import json
 import os
+import time
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from ..core.errors import InvalidInputError
 from .gait_types import Gait
+from .testfunctions import KINDS, LABELS
 
-#: bifurcation kinds
-KINDS = ("fold", "period_doubling", "neimark_sacker", "end")
+__all__ = ["Bifurcation", "Branch", "KINDS", "LABELS"]
 
 
 @dataclass(eq=False)
@@ -49,6 +51,16 @@ class Bifurcation:
     z, mu, tangent, eigenvector, multipliers : ndarray
         Section point, internal parameter coordinate, unit tangent (z, u) of the branch,
         the critical eigenvector (real part, for a period doubling), multipliers.
+    located : bool
+        True when the final bracket is within ``locate_tol`` and the test function vanishes
+        continuously there (`pdw.analysis.continuation_engine.locate`). False: it was only
+        *detected* between ``bracket[0]`` and ``bracket[1]``, ``value`` is just the best point
+        found, and ``location_note`` says why the location failed.
+    bracket : tuple of float
+        The final bracket (parameter values, ascending).
+    label : str
+        AUTO-style label: type (LP, PD, NS, BP, EP, UZ) and running number on its branch,
+        e.g. ``"PD1"`` (set by the continuation).
     """
 
     kind: str
@@ -63,16 +75,38 @@ class Bifurcation:
     eigenvector: Any = None
     multipliers: Any = None
     details: dict = field(default_factory=dict)
+    located: bool = True
+    bracket: Any = None
+    location_note: str = ""
+    label: str = ""
+
+    @property
+    def type_label(self) -> str:
+        """AUTO's two-letter type of this kind (`LABELS`)."""
+        return LABELS.get(self.kind, "UZ")
+
+    def describe(self) -> str:
+        """One line: label, kind, where (located value +- bracket, or the bracket when only
+        detected) and why."""
+        head = "%s %s" % (self.label or self.type_label, self.kind)
+        if self.located:
+            return "%s at %.8g (+-%.2g): %s" % (head, self.value, self.tolerance, self.reason)
+        lo, hi = self.bracket if self.bracket is not None else (self.value, self.value)
+        return ("%s DETECTED, NOT LOCATED: between %.8g and %.8g (%s); %s"
+                % (head, lo, hi, self.location_note, self.reason))
 
     def __repr__(self):
-        return "Bifurcation(%s at %.8g (+-%.2g), %s)" % (self.kind, self.value, self.tolerance,
-                                                        self.reason)
+        return "Bifurcation(%s)" % self.describe()
 
     def as_dict(self) -> dict:
-        """JSON-able fields: kind, value, tolerance, index, reason, z (or None), and the
-        multipliers as ``multipliers_re`` and ``multipliers_im`` lists."""
+        """JSON-able fields: kind, label, value, tolerance, located, bracket, location_note,
+        index, reason, z (or None), and the multipliers as ``multipliers_re`` and
+        ``multipliers_im`` lists."""
         m = np.zeros(0) if self.multipliers is None else np.asarray(self.multipliers)
-        return {"kind": self.kind, "value": self.value, "tolerance": self.tolerance,
+        return {"kind": self.kind, "label": self.label, "value": self.value,
+                "tolerance": self.tolerance, "located": bool(self.located),
+                "bracket": None if self.bracket is None else [float(v) for v in self.bracket],
+                "location_note": self.location_note,
                 "index": self.index, "reason": self.reason,
                 "z": None if self.z is None else np.asarray(self.z).tolist(),
                 "multipliers_re": [float(np.real(v)) for v in m],
@@ -117,6 +151,8 @@ class Branch:
     settings: dict = field(default_factory=dict)
     problem: Any = field(default=None, repr=False)
     switcher: Any = field(default=None, repr=False)
+    extender: Any = field(default=None, repr=False)
+    provenance: dict = field(default_factory=dict)
 
     def __len__(self):
         return len(self.values)
@@ -151,6 +187,64 @@ class Branch:
             ``pdw.continue_gait(..., period=2n, start=gait)`` follow its branch.
         """
         return self.switcher(self, bifurcation, amplitude=amplitude, **kw)
+
+    def extend(self, stop: float, **kw: Any) -> "Branch":
+        """Continue this branch beyond its last point towards ``stop`` (also for a branch read
+        back by `pdw.load`): the new branch starts at the last point, in the direction the
+        branch was going. ``**kw``: `pdw.continue_gait`'s options (the saved model, variant,
+        contact, period and parameter coordinate are reused; a branch continued with
+        ``params_of`` needs it again). See `pdw.analysis.continuation.extend_branch`."""
+        if self.extender is None:
+            raise InvalidInputError("this branch cannot be extended (no problem attached)")
+        return self.extender(self, stop, **kw)
+
+    def criticality(self, bifurcation: Bifurcation, **kw: Any) -> dict:
+        """Super- or subcritical, for a period doubling of this branch, from the direction of
+        the period-2n branch: `pdw.analysis.continuation.criticality`."""
+        import importlib
+        return importlib.import_module("pdw.analysis.continuation").criticality(
+            self, bifurcation, **kw)
+
+    # --- files ------------------------------------------------------------------------------------
+
+    ARRAYS = ("values", "period", "step_length", "double_support", "multipliers", "stable",
+              "state", "z", "orbit", "tangents", "step_size", "newton_iterations")
+
+    def save(self, path: str | os.PathLike) -> str | os.PathLike:
+        """Write the branch to ``path`` (``.npz``: its arrays, and as JSON its settings,
+        bifurcations, the problem (base parameters, model, variant, contact, period, parameter
+        coordinate) and provenance: pdw version, input hash, source revision, time). `pdw.load`
+        reads it back; the loaded branch can be extended (`extend`) and switched at its period
+        doublings (`switch`)."""
+        if not str(path).endswith(".npz"):
+            raise InvalidInputError("Branch.save: path must end in .npz, got %r" % str(path))
+        from ..core.provenance import provenance
+        arrays: dict[str, Any] = {k: np.asarray(getattr(self, k)) for k in self.ARRAYS}
+        prob = self.problem
+        problem = None
+        if prob is not None and getattr(prob, "base", None) is not None:
+            opts = {k: (v.as_dict() if hasattr(v, "as_dict") else v)
+                    for k, v in getattr(prob, "opts", {}).items()}
+            problem = {"params": prob.base.as_dict(), "parameter": prob.parameter,
+                       "model": prob.model, "period": prob.period, "log": prob.log,
+                       "variant": getattr(prob, "variant", "paper"),
+                       "fd_step": getattr(prob, "fd_step", 1e-5), "options": opts,
+                       "params_of": prob._of is not None}
+        bifs = []
+        for b in self.bifurcations:
+            d = b.as_dict()
+            d.update(mu=b.mu, tangent=_list(b.tangent), eigenvector=_list(b.eigenvector),
+                     origin=None)
+            bifs.append(d)
+        meta = {"format": BRANCH_FORMAT, "parameter": self.parameter, "model": self.model,
+                "period_n": self.period_n, "stop_reason": self.stop_reason,
+                "n_maps": self.n_maps, "wall_time": self.wall_time,
+                "settings": self.settings, "bifurcations": bifs, "problem": problem,
+                "provenance": {**provenance(), "written": time.strftime(
+                    "%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "history": self.provenance}}
+        arrays["meta"] = np.array(json.dumps(meta, default=_jsonable))
+        np.savez(path, **arrays)
+        return path
 
     # --- output -------------------------------------------------------------------------------
 
@@ -197,13 +291,23 @@ class Branch:
             json.dump({**self.summary(), **extra}, fh, indent=2, default=_jsonable)
         return path
 
-    def plot(self, ax=None, y="step_length", **kw):
-        """Bifurcation diagram of this branch: `pdw.present.plots_continuation.plot_branches`,
-        looked up when called (a convenience; the analysis layer does not import the present
-        layer's plotting code)."""
+    def plot(self, *others: "Branch", ax=None, y="step_length", **kw):
+        """Bifurcation diagram of this branch and ``others`` overlaid, one colour each (also
+        across calls on the same ``ax``), with units on both axes and ``y`` a named quantity
+        (step_length, period, double_support, max_multiplier, speed, z0):
+        `pdw.plot_branches`, looked up when called (the analysis layer does not import the
+        present layer's plotting code)."""
         import importlib
         plots = importlib.import_module("pdw.present.plots_continuation")
-        return plots.plot_branches([self], ax=ax, y=y, **kw)
+        return plots.plot_branches([self, *others], ax=ax, y=y, **kw)
+
+
+#: the ``meta["format"]`` of a branch file (`Branch.save`)
+BRANCH_FORMAT = "pdw-branch-1"
+
+
+def _list(a):
+    return None if a is None else np.asarray(a, dtype=float).tolist()
 
 
 def _jsonable(o):

@@ -8,8 +8,14 @@ Illinois method (`locate`); the method is described in `pdw.analysis.continuatio
 """
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
+from ..core import checks
+from ..core.errors import InvalidInputError
+from . import extension as X
+from . import testfunctions as TF
 from .branch import Bifurcation
 from .gait_maps import Evaluation
 
@@ -27,10 +33,17 @@ class Point:
 class Engine:
     """Predictor-corrector machinery on one problem, in the scaled coordinates x = (z, u)."""
 
-    def __init__(self, prob, mu0, scale, tol, max_newton, natural):
+    def __init__(self, prob, mu0, scale, tol, max_newton, natural, functions=None,
+                 predictor=None):
         self.prob, self.mu0, self.scale = prob, mu0, scale
-        self.tol, self.max_newton, self.natural = tol, max_newton, natural
+        self.tol, self.max_newton = tol, max_newton
+        if predictor is None:
+            predictor = (X.NaturalPredictor if natural else X.TangentPredictor)()
+        self.predictor = predictor
+        self.natural = bool(getattr(predictor, "natural", False))
         self.n = prob.dim
+        self.functions = list(TF.select(TF.DEFAULT_DETECT) if functions is None else functions)
+        self.owner: dict = {}         # test-function name -> its TestFunction
 
     def mu(self, x):
         return self.mu0 + x[-1] * self.scale
@@ -84,16 +97,9 @@ class Engine:
         return None, last, self.max_newton
 
     def step_from(self, pt, ds):
-        """The next point at arclength ds from pt (natural: ds in u)."""
-        if self.natural:
-            e = np.zeros(self.n + 1)
-            e[-1] = 1.0
-            d = pt.tangent / pt.tangent[-1] if abs(pt.tangent[-1]) > 1e-12 else e
-            x_pred = pt.x + ds * d
-            c = e
-        else:
-            x_pred = pt.x + ds * pt.tangent
-            c = pt.tangent
+        """The next point at step ds from pt, predicted by ``self.predictor``
+        (`pdw.analysis.extension`)."""
+        x_pred, c = self.predictor.predict(self, pt, ds)
         x, ev, its = self.correct(x_pred, c)
         if x is None:
             return None, ev, its
@@ -103,42 +109,67 @@ class Engine:
 
 # --- test functions ---------------------------------------------------------------------------
 
-def tests(engine, pt):
-    m = pt.mult
-    n = len(m)
-    ns = np.prod([m[j] * m[k] - 1.0 for j in range(n) for k in range(j + 1, n)])
-    t = {"period_doubling": float(np.real(np.prod(m + 1.0))),
-         "neimark_sacker": float(np.real(ns))}
-    if engine.natural:
-        t["fold"] = float(np.real(np.prod(m - 1.0)))
-    else:
-        t["fold"] = float(pt.tangent[-1])
-    for k, v in pt.ev.admissible.items():
-        t["end:" + k] = float(v)
-    return t
+def tests(engine, pt, functions=None):
+    """The values of every test function (`pdw.analysis.testfunctions`) at ``pt``: {name: f}."""
+    out = {}
+    for tf in (engine.functions if functions is None else functions):
+        for name, v in tf.values(engine, pt).items():
+            out[name] = v
+            engine.owner[name] = tf
+    return out
 
 
-def locate(engine, a, b, name, locate_tol, max_iter=40):
-    """Illinois on s in (0, b.ds) along a's predictor for the test ``name``: (the point there,
-    the width of the final bracket in the parameter coordinate mu)."""
+#: a located point's test function must be within this factor of what its secant slope over
+#: the detection step predicts for the final bracket (a jump of the test function, e.g. at a
+#: kink of the step map, fails this however narrow the bracket)
+SLOPE_FACTOR = 10.0
+
+
+class Location:
+    """The result of `locate`: the best point, the final bracket, whether it is located."""
+
+    __slots__ = ("point", "width", "bracket", "located", "why", "residual")
+
+    def __init__(self, point, width, bracket, located, why, residual):
+        self.point, self.width, self.bracket = point, width, bracket
+        self.located, self.why, self.residual = located, why, residual
+
+
+def locate(engine, a, b, name, locate_tol, max_iter=40) -> Location:
+    """Illinois on s in (0, b.ds) along a's predictor for the test ``name``.
+
+    The crossing is *located* when (i) the final bracket is narrower than ``locate_tol`` in
+    the parameter coordinate mu and (ii) the test function at the returned point is at most
+    `SLOPE_FACTOR` times its secant slope over the detection step times the final bracket in
+    arclength (it vanishes continuously there), or, where the test function is at its noise
+    floor (finite-difference multipliers), its natural residual (`TestFunction.residual`, e.g.
+    |mu + 1| of the critical multiplier) is within the test's ``tol`` (1e-3). Otherwise (the corrector failed inside the
+    bracket, the iterations ran out, or the function jumps) it is only *detected*, between
+    ``bracket`` (parameter values), and ``why`` says which."""
     lo, hi = 0.0, b.ds
-    flo, fhi = a.tests[name], b.tests[name]
+    fa0, fb0 = a.tests[name], b.tests[name]
+    flo, fhi = fa0, fb0
     p_lo, p_hi = a, b
     side = 0
+    why = ""
     for _ in range(max_iter):
         if abs(engine.mu(p_lo.x) - engine.mu(p_hi.x)) < locate_tol:
             break
         s = (lo * fhi - hi * flo) / (fhi - flo) if fhi != flo else 0.5 * (lo + hi)
         if not (lo < s < hi):
             s = 0.5 * (lo + hi)
-        pt, _, _ = engine.step_from(a, s)
+        pt, err, _ = engine.step_from(a, s)
         if pt is None:
             s = 0.5 * (lo + hi)
-            pt, _, _ = engine.step_from(a, s)
+            pt, err, _ = engine.step_from(a, s)
             if pt is None:
+                why = "the corrector fails inside the bracket (%s)" % err
                 break
         pt.tests = tests(engine, pt)
-        f = pt.tests[name]
+        f = pt.tests.get(name, np.nan)
+        if not np.isfinite(f):
+            why = "the test function is not finite inside the bracket"
+            break
         if np.sign(f) == np.sign(flo):
             lo, flo, p_lo = s, f, pt
             if side == -1:
@@ -149,55 +180,124 @@ def locate(engine, a, b, name, locate_tol, max_iter=40):
             if side == 1:
                 flo *= 0.5
             side = 1
-    best = p_lo if abs(p_lo.tests[name]) < abs(p_hi.tests[name]) else p_hi
-    return best, abs(engine.mu(p_lo.x) - engine.mu(p_hi.x))
+    else:
+        why = "no bracket below locate_tol in %d iterations" % max_iter
+    f_lo, f_hi = p_lo.tests[name], p_hi.tests[name]
+    best = p_lo if abs(f_lo) < abs(f_hi) else p_hi
+    width = abs(engine.mu(p_lo.x) - engine.mu(p_hi.x))
+    bracket = tuple(sorted((engine.value(p_lo.x), engine.value(p_hi.x))))
+    slope = abs(fb0 - fa0) / b.ds if b.ds > 0 else np.inf
+    allowed = SLOPE_FACTOR * slope * (hi - lo)
+    f_best = abs(best.tests[name])
+    residual = f_best / allowed if allowed > 0 else (0.0 if f_best == 0 else np.inf)
+    if not why and width >= locate_tol:
+        why = "the bracket is %.3g wide (locate_tol %.3g)" % (width, locate_tol)
+    natural = None
+    tf = engine.owner.get(name)
+    if tf is not None and residual > 1.0:
+        natural = tf.residual(engine, best, name)
+    if not why and residual > 1.0 and not (natural is not None and natural <= tf.tol):
+        why = ("the test function jumps across the bracket (|f| = %.3g at the best point, "
+               "%.3g x what its slope allows): a kink or discontinuity, not a crossing"
+               % (f_best, residual))
+    return Location(best, width, bracket, not why, why, residual)
 
 
-def _bifurcation(engine, kind, pt, index, width, reason, eigvec=None):
+def _bifurcation(engine, kind, loc, index, reason, eigvec=None):
     prob = engine.prob
+    pt = loc.point
     gait = prob.gait(pt.x[:-1], engine.mu(pt.x), pt.ev, pt.mult)
     return Bifurcation(kind=kind, value=engine.value(pt.x), gait=gait, index=index,
-                       tolerance=width, reason=reason, z=pt.x[:-1].copy(),
+                       tolerance=loc.width, reason=reason, z=pt.x[:-1].copy(),
                        mu=engine.mu(pt.x), tangent=pt.tangent.copy(), eigenvector=eigvec,
-                       multipliers=pt.mult.copy(), details={"orbit": pt.ev.info["orbit"]})
+                       multipliers=pt.mult.copy(),
+                       details={"orbit": pt.ev.info["orbit"], "problem": prob},
+                       located=loc.located, bracket=loc.bracket,
+                       location_note=loc.why)
 
 
-def check_crossings(engine, a, b, index, locate_tol, detect):
+def check_crossings(engine, a, b, index, locate_tol, detect=None):
+    """The special points between branch points a and b (index, index + 1): every sign change of
+    a test function of ``engine.functions`` (or of those whose kind is in ``detect``), each
+    located (`locate`) and described by its test function."""
     out = []
-    for name in a.tests:
-        kind = "end" if name.startswith("end:") else name
-        if kind not in detect:
+    for name, fa in a.tests.items():
+        tf = engine.owner.get(name)
+        if tf is None or (detect is not None and tf.kind not in detect):
             continue
-        fa = a.tests[name]
         fb = b.tests.get(name, fa)
-        if kind == "end":
-            crossed = fa > 0.0 >= fb
-        else:
-            crossed = np.sign(fa) != np.sign(fb) and fa != 0.0
-        if not crossed:
+        if not tf.crossed(name, fa, fb):
             continue
-        pt, width = locate(engine, a, b, name, locate_tol)
-        if kind == "end":
-            adm = name[4:]
-            out.append(_bifurcation(engine, "end", pt, index, width,
-                                    "%s -> 0: %s" % (adm, engine.prob.ADMISSIBLE.get(adm, adm))))
+        loc = locate(engine, a, b, name, locate_tol)
+        d = tf.describe(engine, loc.point, name)
+        if d is None:
             continue
-        m = pt.mult
-        if kind == "period_doubling":
-            j = int(np.argmin(np.abs(m + 1.0)))
-            w, V = np.linalg.eig(pt.ev.M)
-            v = np.real(V[:, int(np.argmin(np.abs(w - m[j])))])
-            out.append(_bifurcation(engine, kind, pt, index, width,
-                                    "a multiplier through -1 (%.6g)" % np.real(m[j]),
-                                    v / np.linalg.norm(v)))
-        elif kind == "neimark_sacker":
-            cx = [v for v in m if abs(v.imag) > 1e-8 and abs(abs(v) - 1.0) < 1e-3]
-            if cx:
-                out.append(_bifurcation(engine, kind, pt, index, width,
-                                        "a complex pair through the unit circle (|mu| = %.6g, "
-                                        "arg %.4g rad)" % (abs(cx[0]), abs(np.angle(cx[0])))))
-        else:
-            out.append(_bifurcation(engine, "fold", pt, index, width,
-                                    "turning point: the branch reverses in %s" % (
-                                        engine.prob.parameter)))
+        reason, eigvec = d
+        bif = _bifurcation(engine, tf.kind, loc, index, reason, eigvec)
+        bif.details["test"] = name
+        check = getattr(engine.prob, "crosscheck", None)
+        if check is not None and tf.kind in ("fold", "period_doubling", "neimark_sacker"):
+            diff, note = check(loc.point.x[:-1], engine.mu(loc.point.x), loc.point.mult)
+            bif.details["fd_check"] = diff
+            if note:
+                warnings.warn("%s at %s = %.8g: %s" % (tf.kind, engine.prob.parameter,
+                                                      bif.value, note), stacklevel=3)
+                bif.details["fd_check_note"] = note
+        out.append(bif)
+    out.sort(key=lambda f: (f.mu - engine.mu(a.x)) * np.sign(engine.mu(b.x) - engine.mu(a.x)))
     return out
+
+
+# --- options, labels, reasons -----------------------------------------------------------------
+
+METHODS = ("pseudo_arclength", "natural")
+
+
+def _check_options(o: dict) -> dict:
+    """Range-check the continuation's options (those present in ``o``; None = the default),
+    each error naming its option and allowed range; returns them normalised."""
+    out = dict(o)
+    if "method" in o and isinstance(o["method"], str) and o["method"] not in METHODS:
+        raise InvalidInputError("method must be 'pseudo_arclength' or 'natural', got %r"
+                                % (o["method"],))
+    for k in ("step", "step_min", "step_max", "tol", "locate_tol", "stall_length"):
+        if o.get(k) is not None:
+            out[k] = checks.positive(k, o[k])
+    if o.get("fd_step") is not None:
+        out["fd_step"] = checks.number("fd_step", o["fd_step"], lo=0.0, lo_open=True, hi=0.1)
+    if o.get("step_min") is not None and o.get("step_max") is not None \
+            and out["step_min"] > out["step_max"]:
+        raise InvalidInputError("step_min (%r) must not exceed step_max (%r)"
+                                % (o["step_min"], o["step_max"]))
+    for k, lo in (("max_points", 2), ("max_newton", 1), ("period", 1), ("stall_points", 2)):
+        if o.get(k) is not None:
+            out[k] = checks.count(k, o[k], lo=lo, hi=10 ** 7)
+    if o.get("workers") is not None:
+        out["workers"] = checks.count("workers", o["workers"], lo=1, hi=4096)
+    for k in ("stop", "value"):
+        if o.get(k) is not None:
+            out[k] = checks.number(k, o[k])
+    if o.get("at") is not None:
+        out["at"] = [checks.number("at[%d]" % i, v) for i, v in enumerate(o["at"])]
+    return out
+
+
+def label_points(bifs) -> None:
+    """AUTO-style labels: the type (LP, PD, NS, BP, EP, UZ) and a running number along the
+    branch, in branch order (``Bifurcation.label``, e.g. "PD1", "LP2")."""
+    for k, f in enumerate(sorted(bifs, key=lambda f: f.index), start=1):
+        f.label = "%s%d" % (f.type_label, k)
+
+
+def _explain(prob, why) -> str:
+    """A step-map failure, with the option that caused it where known (the hybrid map's
+    ``min_step_angle``: a strike is only armed at a step angle at least that large)."""
+    why = str(why)
+    if getattr(prob, "model", "") == "hybrid" and ("no_strike" in why or "fell" in why):
+        ang = getattr(prob, "last_step_angle", None)
+        lim = prob.opts.get("min_step_angle", 0.0)
+        if ang is not None and ang < 1.1 * lim:
+            return ("%s: the step angle at heel strike (%.4g rad at the last gait) reaches the "
+                    "option min_step_angle = %g rad, below which a strike is not armed"
+                    % (why, ang, lim))
+    return why

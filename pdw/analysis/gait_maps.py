@@ -30,7 +30,7 @@ import os
 
 import numpy as np
 
-from ..core import _hybrid
+from ..core import _hybrid  # type: ignore[attr-defined]  # compiled, no stub
 from ..core.errors import InvalidInputError
 from ..core.model import parameter_vector
 from ..core.params import Params
@@ -160,6 +160,7 @@ class HybridProblem(_Problem):
         if isinstance(out, str):
             return Evaluation(False, out)
         y, DP, steps = out
+        self.last_step_angle = float(min(s["y_minus"][1] - s["y_minus"][0] for s in steps))
         Pz = y[list(H._SECTION)]
         M = P_lam = None
         if jac:
@@ -285,6 +286,38 @@ class ContinuousProblem(_Problem):
                "swing_period": min(s["swing_period"] for s in steps),
                "event_sequence": 0.5 - abs(info["n_events"] - self.ref_events)}
         return Evaluation(True, "ok", Pz, M, P_lam, info, adm)
+
+    #: the second difference step of the cross-check, a multiple of ``fd_step``
+    CHECK_FACTOR = 10.0
+    #: multipliers of the two steps differing by more than this are reported
+    CHECK_TOL = 1e-3
+
+    def crosscheck(self, z, mu, multipliers):
+        """The multipliers again from central differences with ``CHECK_FACTOR`` x ``fd_step``:
+        (largest difference to ``multipliers``, note or ""). A difference above
+        ``CHECK_TOL`` means the step map has a kink within a few difference steps of z (the
+        finite-difference multipliers then depend on the step), and the note says so."""
+        h = self.fd_step * self.CHECK_FACTOR
+        E = np.eye(self.dim) * h
+        z = np.asarray(z, dtype=float)
+        outs = self._run([(z + e, mu) for e in E] + [(z - e, mu) for e in E])
+        self.n_maps += self.period * 2 * self.dim
+        if any(o[0] is None for o in outs):
+            return np.inf, ("the step map fails within %g of the point: the multipliers "
+                            "are not checked" % h)
+        n = self.dim
+        M = np.column_stack([(outs[k][0] - outs[n + k][0]) / (2 * h) for k in range(n)])
+        m = np.linalg.eigvals(M)
+        m = m[np.argsort(-np.abs(m))]
+        ref = np.asarray(multipliers)
+        diff = float(np.max(np.abs(np.sort_complex(m) - np.sort_complex(ref))))
+        if diff > self.CHECK_TOL:
+            return diff, ("finite-difference multipliers depend on the step: fd_step %g and "
+                          "%g differ by %.3g (largest %s against %s): a kink of the step map "
+                          "within a few steps of this point, or strong curvature; the "
+                          "multipliers are uncertain to that amount" % (self.fd_step, h, diff,
+                                                np.round(ref[0], 4), np.round(m[0], 4)))
+        return diff, ""
 
     def gait(self, z, mu, ev, multipliers) -> Gait:
         return Gait(state=ev.info["state"], period=ev.info["period"],

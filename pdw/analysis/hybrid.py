@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core import _hybrid, _layout, checks
+from ..core import _hybrid, _layout, checks  # type: ignore[attr-defined]  # compiled, no stub
 from ..core.errors import (
     FellError,
     InvalidInputError,

@@ -74,7 +74,7 @@ def section_names(contact=None) -> tuple:
     None for the default): `SECTION`, then ``"z1_um"`` with LuGre friction, then ``"v_in1"``
     with the lankarani_nikravesh and flores normal laws (module docstring; units in `UNITS`)."""
     c = Contact.coerce(contact)
-    extra = ("z1_um",) if c.friction == "lugre" else ()
+    extra: tuple[str, ...] = ("z1_um",) if c.friction == "lugre" else ()
     if uses_approach_speeds(c):
         extra += ("v_in1",)
     return SECTION + extra

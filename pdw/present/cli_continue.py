@@ -55,14 +55,10 @@ import numpy as np
 from .. import examples
 from ..analysis.branch import _jsonable
 from ..analysis.continuation import continue_gait, follow_cascade
+from ..core import _toml
 from ..core.contact import Contact
 from ..core.errors import InvalidInputError
 from . import continue_spec, deps
-
-try:
-    import tomllib
-except ImportError:                                    # pragma: no cover - Python < 3.11
-    import tomli as tomllib
 
 KEYS, CONTINUATION_KEYS = continue_spec.KEYS, continue_spec.CONTINUATION_KEYS
 preset = continue_spec.preset
@@ -76,8 +72,8 @@ def load_spec(path) -> dict:
     except OSError as e:
         raise InvalidInputError("cannot read continuation file %s: %s" % (path, e)) from None
     try:
-        spec = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
+        spec = _toml.loads(text)
+    except _toml.TOMLDecodeError as e:
         raise InvalidInputError("%s: not valid TOML: %s" % (path, e)) from None
     spec = continue_spec.check_spec(spec, str(path))
     spec["_source"], spec["_path"] = text, str(path)
@@ -190,8 +186,7 @@ def cli_main(args):
               % (b.period_n, len(b), b.parameter, b.values.min(), b.values.max(), b.n_maps,
                  b.wall_time, b.stop_reason))
         for f in b.bifurcations:
-            print("  %-16s at %s = %.10g (+- %.2g): %s" % (f.kind, b.parameter, f.value,
-                                                            f.tolerance, f.reason))
+            print("  " + f.describe())
     for p in paths.values():
         print("wrote %s" % p)
     return 0

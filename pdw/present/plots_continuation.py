@@ -1,15 +1,53 @@
 """Bifurcation diagrams of continued branches (`pdw.branch.Branch`, docs/continuation.md).
 
-Stable parts solid, unstable dashed, one colour per period; bifurcations marked: period doubling
-(circle), fold (square), Neimark-Sacker (diamond), end of the family (cross).
+Stable parts solid, unstable dashed, one colour per branch; bifurcations marked and labelled
+(AUTO-style, e.g. PD1): period doubling (circle), fold (square), Neimark-Sacker (diamond),
+branch point (triangle), end of the family (cross), user event (star); a bifurcation that was
+only detected, not located, is drawn hollow grey with its bracket as a horizontal bar. Both
+axes carry units; y is a named quantity (`QUANTITIES`). `plot_curves` draws two-parameter
+curves (`pdw.continue_bifurcation`).
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
+from ..core.params import Params
+
 MARKERS = {"period_doubling": ("o", "period doubling"), "fold": ("s", "fold"),
-           "neimark_sacker": ("D", "Neimark-Sacker"), "end": ("X", "end of the family")}
-QUANTITIES = ("step_length", "period", "double_support", "max_multiplier", "z0", "speed")
+           "neimark_sacker": ("D", "Neimark-Sacker"), "end": ("X", "end of the family"),
+           "branch_point": ("^", "branch point"), "event": ("*", "user event")}
+#: y quantities: (axis name, unit). ``z0`` is the first section coordinate (every point of a
+#: period-n orbit), named by the model's section.
+QUANTITIES = {"step_length": ("step length", "m"), "period": ("period of the cycle", "s"),
+              "double_support": ("double support", "s"),
+              "max_multiplier": ("largest |Floquet multiplier|", "-"), "speed": ("speed", "m/s"),
+              "z0": ("first section coordinate", "rad")}
+_Z0 = {"hybrid": "stance leg angle theta_st after heel strike",
+       "continuous": "trailing leg angle theta1 at touch-down"}
+
+
+def _unit(parameter):
+    f = {f.name: f for f in dataclasses.fields(Params)}.get(parameter)
+    return f.metadata.get("unit", "") if f is not None else ""
+
+
+def x_axis_label(parameter, x_scale=1.0):
+    """'gamma [deg]' (x_scale 180/pi on gamma), 'd_n [N s/m^2.5]', 'k_n [N/m^1.5 x 1e-05]'."""
+    u = _unit(parameter)
+    if u == "rad" and abs(x_scale - 180 / np.pi) < 1e-9:
+        return "%s [deg]" % parameter
+    if x_scale != 1.0:
+        return "%s [%s x %g]" % (parameter, u or "-", x_scale)
+    return "%s [%s]" % (parameter, u or "-")
+
+
+def y_axis_label(y, model=""):
+    name, unit = QUANTITIES[y]
+    if y == "z0":
+        name = _Z0.get(model, name)
+    return "%s [%s]" % (name, unit)
 
 
 def _quantity(branch, y, k=0):
@@ -21,7 +59,8 @@ def _quantity(branch, y, k=0):
         return branch.step_length * branch.period_n / branch.period
     if y in ("step_length", "period", "double_support"):
         return getattr(branch, y)
-    raise ValueError("y must be one of %s, got %r" % (", ".join(QUANTITIES), y))
+    from ..core.errors import InvalidInputError
+    raise InvalidInputError("y must be one of %s, got %r" % (", ".join(QUANTITIES), y))
 
 
 def _bif_y(branch, bif, y):
@@ -43,30 +82,41 @@ def _bif_y(branch, bif, y):
 
 
 def plot_branches(branches, ax=None, y="step_length", x_scale=1.0, x_label=None, title=None,
-                  path=None):
+                  path=None, labels=None):
     """Draw branches on ``ax`` (a new figure if None) and return the axes.
 
     Parameters
     ----------
     branches : list of Branch
+        Overlaid, one colour each (C0, C1, ...).
     y : str
-        One of `QUANTITIES` (``z0``: the first section coordinate; ``max_multiplier``: the
-        largest Floquet multiplier's modulus).
+        One of `QUANTITIES`: step_length [m], period [s], double_support [s],
+        max_multiplier [-], speed [m/s], z0 (the first section coordinate [rad]; every point
+        of a period-n orbit).
     x_scale : float
-        Multiply the parameter by this on the axis (e.g. 180/pi for degrees).
+        Multiply the parameter by this on the axis (180/pi: degrees for an angle).
+    x_label : str, optional
+        Default: the parameter with its unit (`x_axis_label`).
+    labels : list of str, optional
+        Legend entries, one per branch (default "period n").
     path : str or Path, optional
         Save the figure there (PNG, 150 dpi).
     """
     import matplotlib
+    if y not in QUANTITIES:
+        from ..core.errors import InvalidInputError
+        raise InvalidInputError("y must be one of %s, got %r" % (", ".join(QUANTITIES), y))
     if ax is None:
         matplotlib.use("Agg", force=False)
         import matplotlib.pyplot as plt
         fig, ax = plt.subplots(figsize=(7, 4.2), layout="constrained")
-    colours = {}
     seen = set()
-    for br in branches:
-        c = colours.setdefault(br.period_n, "C%d" % len(colours))
+    j0 = getattr(ax, "_pdw_branches", 0)     # branches already drawn here: the next colours
+    for j, br in enumerate(branches):
+        c = "C%d" % ((j0 + j) % 10)
+        name = labels[j] if labels is not None else "period %d" % br.period_n
         origin = br.settings.get("origin")
+        named = False
         # y = z0 draws every point of a period-n orbit (the diagram's n curves)
         for k in range(br.period_n if y == "z0" else 1):
             x = br.values * x_scale
@@ -81,21 +131,55 @@ def plot_branches(branches, ax=None, y="step_length", x_scale=1.0, x_label=None,
             for i in range(1, len(x) + 1):
                 if i == len(x) or stable[i] != stable[start]:
                     seg = slice(start, min(i + 1, len(x)))
-                    lab = "period %d" % br.period_n if br.period_n not in seen else None
-                    seen.add(br.period_n)
                     ax.plot(x[seg], q[seg], "-" if stable[start] else "--", color=c, lw=1.4,
-                            label=lab)
+                            label=None if named else name)
+                    named = True
                     start = i
         for b in br.bifurcations:
-            mk, name = MARKERS[b.kind]
-            lab = name if ("bif", b.kind) not in seen else None
-            seen.add(("bif", b.kind))
-            ax.plot([b.value * x_scale], [_bif_y(br, b, y)], mk, color="k", mfc="w", ms=7,
-                    label=lab, zorder=5)
+            mk, bname = MARKERS.get(b.kind, ("*", b.kind))
+            located = getattr(b, "located", True)
+            key = ("bif", b.kind, located)
+            lab = None if key in seen else (bname if located else bname + " (not located)")
+            seen.add(key)
+            yb = _bif_y(br, b, y)
+            if not located and b.bracket is not None:
+                ax.plot([b.bracket[0] * x_scale, b.bracket[1] * x_scale], [yb, yb], "-",
+                        color="0.5", lw=3, alpha=0.5, zorder=4)
+            ax.plot([b.value * x_scale], [yb], mk, color="k" if located else "0.5", mfc="w",
+                    ms=7, label=lab, zorder=5)
+            if getattr(b, "label", ""):
+                ax.annotate(b.label, (b.value * x_scale, yb), textcoords="offset points",
+                            xytext=(4, 5), fontsize=7)
         if br.settings.get("log"):
             ax.set_xscale("log")
-    ax.set_xlabel(x_label or (branches[0].parameter if branches else ""))
-    ax.set_ylabel(y.replace("_", " "))
+    ax._pdw_branches = j0 + len(branches)
+    ax.set_xlabel(x_label or (x_axis_label(branches[0].parameter, x_scale) if branches else ""))
+    ax.set_ylabel(y_axis_label(y, branches[0].model if branches else ""))
+    if title:
+        ax.set_title(title)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    if path is not None:
+        ax.figure.savefig(path, dpi=150)
+    return ax
+
+
+def plot_curves(curves, ax=None, x_scale=1.0, y_scale=1.0, labels=None, title=None,
+                path=None):
+    """Two-parameter curves (`pdw.BifurcationCurve`): the second parameter on x, the first
+    (the bifurcation's own) on y, with units, one colour each; returns the axes."""
+    import matplotlib
+    if ax is None:
+        matplotlib.use("Agg", force=False)
+        import matplotlib.pyplot as plt
+        fig, ax = plt.subplots(figsize=(6, 4.2), layout="constrained")
+    for j, cv in enumerate(curves):
+        name = labels[j] if labels is not None else "%s curve" % cv.kind.replace("_", " ")
+        ax.plot(cv.values[:, 1] * x_scale, cv.values[:, 0] * y_scale, "-", color="C%d" % j,
+                lw=1.6, label=name)
+    if curves:
+        ax.set_xlabel(x_axis_label(curves[0].parameters[1], x_scale))
+        ax.set_ylabel(x_axis_label(curves[0].parameters[0], y_scale))
     if title:
         ax.set_title(title)
     ax.legend(fontsize=8)

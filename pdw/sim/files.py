@@ -104,6 +104,12 @@ def register(tag: str, cls: type, to_file, from_file, *, to_xarray=None) -> Kind
     return kind
 
 
+#: readers of whole files by their ``meta["format"]`` tag, for kinds whose reader opens the file
+#: itself (registered by the layers above: ``"pdw-branch-1"``,
+#: `pdw.analysis.continuation.load_branch`)
+LOADERS: dict[str, Callable[[pathlib.Path], Any]] = {}
+
+
 def register_suffix(suffix: str, reader: Callable[[pathlib.Path], Any]):
     """``load(path)`` of a file ending in ``suffix`` (".csv") calls ``reader(path)``."""
     _SUFFIXES[suffix.lower()] = reader
@@ -234,6 +240,8 @@ def load(path: str | os.PathLike):
         return reader(path)
     arrays, meta = read(path)
     tag = meta.get("format")
+    if isinstance(tag, str) and tag in LOADERS:
+        return LOADERS[tag](path)
     kind = _KINDS.get(tag) if isinstance(tag, str) else None
     if kind is None:
         raise InvalidInputError("%s is not a pdw result or another file of a kind pdw writes "

@@ -1,0 +1,293 @@
+"""Two-parameter continuation of folds and period doublings of gaits (docs/continuation.md).
+
+A fold (a multiplier at +1) or a period doubling (a multiplier at -1) of the period-n map P is
+one equation more than a gait: it is followed in a second parameter lambda2 as the solution
+curve of the *minimally augmented* system (Govaerts 2000; BifurcationKit's codim-2
+continuation), with unknowns x = (z, mu1) and the continuation parameter mu2:
+
+    F(z, mu1; mu2) = ( P(z; mu1, mu2) - z ,  sigma(z, mu1, mu2) ) = 0,
+
+where A = M + s I (s = +1 period doubling, -1 fold; M = dP/dz) and sigma is the last component
+of the solution of the bordered system
+
+    [ A    a ] [ v     ]   [ 0 ]
+    [ b^T  0 ] [ sigma ] = [ 1 ],
+
+a and b being approximate null vectors of A^T and A (refreshed after every accepted point, so
+the bordered matrix stays regular). sigma vanishes exactly where A is singular. Its
+derivatives are d sigma / dx_k = -w^T (dA/dx_k) v, with w from the transposed system, and
+dA/dx_k = dM/dx_k is a central difference of the model's exact (hybrid) or finite-difference
+(continuous) M.
+
+`AugmentedProblem` presents F as a step map, P~(x) = x + F(x), with M~ = I + dF/dx and
+dP~/dmu2 = dF/dmu2, so the *unchanged* one-parameter engine (`run_continuation`) follows it.
+`continue_bifurcation` returns a `BifurcationCurve` whose ``values`` are (N, 2): the first
+(the bifurcation's own) and the second parameter.
+"""
+from __future__ import annotations
+
+import copy
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..core.errors import InvalidInputError
+from ..core.params import Params
+from .branch import Bifurcation
+from .gait_maps import Evaluation
+
+#: the bifurcation kinds a curve can follow, and the sign s of A = M + s I
+SIGNS = {"period_doubling": 1.0, "fold": -1.0}
+
+
+def _null_vectors(A):
+    U, _, Vt = np.linalg.svd(A)
+    return U[:, -1].copy(), Vt[-1].copy()
+
+
+class AugmentedProblem:
+    """The minimally augmented system of a fold / period doubling of ``prob`` (a one-parameter
+    problem of `pdw.analysis.gait_maps`, whose parameter is the bifurcation's) in the second
+    parameter ``parameter2``, as a problem of the continuation engine (module docstring)."""
+
+    ADMISSIBLE: dict = {}
+    lam_rel = 1e-6
+
+    def __init__(self, prob, kind, parameter2, z, mu1, h=1e-6):
+        if kind not in SIGNS:
+            raise InvalidInputError("continue_bifurcation follows %s, got a %r"
+                                    % (" and ".join(SIGNS), kind))
+        if parameter2 not in Params.__dataclass_fields__:
+            raise InvalidInputError("parameter must be a Params field (%s), got %r"
+                                    % (", ".join(Params.__dataclass_fields__), parameter2))
+        if parameter2 == prob.parameter:
+            raise InvalidInputError("parameter must differ from the bifurcation's own "
+                                    "parameter %r" % parameter2)
+        if getattr(prob, "_of", None) is not None:
+            raise InvalidInputError("continue_bifurcation: a branch continued with params_of "
+                                    "is not supported")
+        self.p1 = copy.copy(prob)
+        self.p2 = copy.copy(prob)
+        self.p2.parameter, self.p2.log = parameter2, False
+        self.base = prob.base
+        self.kind, self.s = kind, SIGNS[kind]
+        self.parameter, self.parameter1 = parameter2, prob.parameter
+        self.model = prob.model
+        self.period = prob.period
+        self.dim = prob.dim + 1
+        self.h = float(h)
+        self.ADMISSIBLE = dict(getattr(prob, "ADMISSIBLE", {}))
+        self.n_maps = 0
+        self.lam_step = 1e-6
+        self.opts = dict(getattr(prob, "opts", {}))
+        ev = self._base_eval(np.asarray(z, dtype=float), mu1, getattr(prob.base, parameter2))
+        if not ev.ok:
+            raise InvalidInputError("the bifurcation's gait does not evaluate: %s" % ev.status)
+        self.a, self.b = _null_vectors(ev.M + self.s * np.eye(prob.dim))
+
+    # the parameter coordinate of lambda2 (linear)
+    def value(self, mu):
+        return float(mu)
+
+    def coord(self, value):
+        return float(value)
+
+    def params_at(self, mu2, mu1):
+        return self.p1.params_at(mu1).replace(**{self.parameter: float(mu2)})
+
+    def _base_eval(self, z, mu1, mu2, jac=True) -> Evaluation:
+        try:
+            self.p1.base = self.base.replace(**{self.parameter: float(mu2)})
+        except ValueError as e:
+            return Evaluation(False, "invalid parameter: %s = %r: %s" % (self.parameter, mu2, e))
+        n0 = self.p1.n_maps
+        ev = self.p1.evaluate(z, mu1, jac)
+        self.n_maps += self.p1.n_maps - n0
+        return ev
+
+    def _sigma(self, M):
+        n = len(M)
+        A = M + self.s * np.eye(n)
+        K = np.zeros((n + 1, n + 1))
+        K[:n, :n], K[:n, n], K[n, :n] = A, self.a, self.b
+        rhs = np.zeros(n + 1)
+        rhs[-1] = 1.0
+        vs = np.linalg.solve(K, rhs)
+        ws = np.linalg.solve(K.T, rhs)
+        return vs[-1], vs[:n], ws[:n]
+
+    def evaluate(self, x, mu2, jac=True) -> Evaluation:
+        z, mu1 = np.asarray(x[:-1], dtype=float), float(x[-1])
+        ev = self._base_eval(z, mu1, mu2, True)
+        if not ev.ok:
+            return Evaluation(False, ev.status)
+        try:
+            sigma, v, w = self._sigma(ev.M)
+        except np.linalg.LinAlgError:
+            return Evaluation(False, "singular bordered matrix")
+        n = len(z)
+        F = np.concatenate([ev.Pz - z, [sigma]])
+        Mt = Pt = None
+        if jac:
+            # P_mu2 by a central difference in lambda2
+            h2 = self.lam_step
+            e_hi = self._base_eval(z, mu1, mu2 + h2, True)
+            e_lo = self._base_eval(z, mu1, mu2 - h2, True)
+            if not (e_hi.ok and e_lo.ok):
+                return Evaluation(False, "parameter derivative: %s"
+                                  % (e_hi.status if not e_hi.ok else e_lo.status))
+            P_mu2 = (e_hi.Pz - e_lo.Pz) / (2 * h2)
+            dM_mu2 = (e_hi.M - e_lo.M) / (2 * h2)
+            # d sigma / dz_k and d sigma / d mu1 from central differences of M
+            ds = np.zeros(n + 1)
+            for k in range(n + 1):
+                d = np.zeros(n + 1)
+                d[k] = self.h
+                lo = self._base_eval(z - d[:n], mu1 - d[n], mu2, True)
+                hi = self._base_eval(z + d[:n], mu1 + d[n], mu2, True)
+                if not (lo.ok and hi.ok):
+                    return Evaluation(False, "second derivative: %s"
+                                      % (hi.status if not hi.ok else lo.status))
+                ds[k] = -w @ ((hi.M - lo.M) / (2 * self.h)) @ v
+            J = np.zeros((n + 1, n + 1))
+            J[:n, :n] = ev.M - np.eye(n)
+            J[:n, n] = ev.P_lam
+            J[n, :] = ds
+            Mt = np.eye(n + 1) + J
+            Pt = np.concatenate([P_mu2, [-w @ dM_mu2 @ v]])
+        m = np.linalg.eigvals(ev.M)
+        info = dict(ev.info, base_multipliers=m[np.argsort(-np.abs(m))], sigma=sigma,
+                    value1=self.p1.value(mu1), M=ev.M)
+        return Evaluation(True, "ok", x + F, Mt, Pt, info, dict(ev.admissible))
+
+    def accept(self, pt) -> None:
+        """Refresh the border vectors a, b at an accepted point (BifurcationKit's
+        ``update_minaug_every_step``), called by the engine."""
+        M = pt.ev.info.get("M")
+        if M is not None:
+            self.a, self.b = _null_vectors(M + self.s * np.eye(len(M)))
+
+    def gait(self, x, mu2, ev, multipliers):
+        g = self.p1.gait(np.asarray(x[:-1]), float(x[-1]), ev,
+                         ev.info.get("base_multipliers", multipliers))
+        return g
+
+
+@dataclass(eq=False)
+class BifurcationCurve:
+    """A fold or period-doubling curve in two parameters (`continue_bifurcation`).
+
+    Attributes
+    ----------
+    kind : str
+        "fold" or "period_doubling".
+    parameters : tuple of str
+        (the bifurcation's own parameter, the second parameter).
+    values : ndarray (N, 2)
+        The two parameters along the curve.
+    z : ndarray (N, dim)
+        The gait's section coordinates at each point.
+    multipliers : ndarray (N, dim)
+        The gait's Floquet multipliers (one at -1 / +1 along the curve), by modulus.
+    step_length, period : ndarray (N,)
+        [m], [s] of the gait along the curve.
+    branch : Branch
+        The engine's branch of the augmented problem (its ``z`` is (z, mu1)).
+    stop_reason : str
+    """
+
+    kind: str
+    parameters: tuple
+    values: np.ndarray
+    z: np.ndarray
+    multipliers: np.ndarray
+    step_length: np.ndarray
+    period: np.ndarray
+    stop_reason: str
+    branch: Any = field(repr=False)
+    wall_time: float = 0.0
+    n_maps: int = 0
+
+    def __len__(self):
+        return len(self.values)
+
+    def __repr__(self):
+        return ("BifurcationCurve(%s in (%s, %s), %d points, %s in [%.6g, %.6g], %s in "
+                "[%.6g, %.6g], stop: %s)" % (
+                    self.kind, *self.parameters, len(self), self.parameters[0],
+                    self.values[:, 0].min(), self.values[:, 0].max(), self.parameters[1],
+                    self.values[:, 1].min(), self.values[:, 1].max(), self.stop_reason))
+
+    def at(self, value2: float) -> float:
+        """The first parameter on the curve at ``value2`` of the second (linear interpolation
+        between the two nearest points; the curve must pass ``value2``)."""
+        v = self.values
+        for i in range(len(v) - 1):
+            lo, hi = v[i, 1], v[i + 1, 1]
+            if min(lo, hi) <= value2 <= max(lo, hi) and hi != lo:
+                w = (value2 - lo) / (hi - lo)
+                return float(v[i, 0] + w * (v[i + 1, 0] - v[i, 0]))
+        raise InvalidInputError("the curve does not pass %s = %r" % (self.parameters[1], value2))
+
+
+def continue_bifurcation(bifurcation: Bifurcation, parameter: str, stop: float, *,
+                         step: float | None = None, max_points: int = 200,
+                         tol: float = 1e-9, max_newton: int = 10, fd_step: float = 1e-6,
+                         **kw: Any) -> BifurcationCurve:
+    """Follow a located fold or period doubling of a branch in a second parameter.
+
+    Parameters
+    ----------
+    bifurcation : Bifurcation
+        A located ``fold`` or ``period_doubling`` of a `pdw.continue_gait` branch (it carries
+        its problem: model, period, options).
+    parameter : str
+        The second parameter (a `pdw.Params` field other than the branch's).
+    stop : float
+        Continue until ``parameter`` reaches ``stop`` (or ``max_points``, or the curve ends).
+    step : float, optional
+        First step in ``parameter`` (default 1/50 of the range).
+    tol : float
+        Newton tolerance on max |(P^n(z) - z, sigma)| (default 1e-9).
+    fd_step : float
+        Difference step of the second derivatives dM/dx (default 1e-6: M is exact for the
+        hybrid model; use about 1e-4 with the continuous model's finite-difference M).
+    **kw
+        `run_continuation`'s other options (``max_newton``, ``step_max``, ``at``, ...).
+
+    Returns
+    -------
+    BifurcationCurve
+        ``values`` (N, 2): the bifurcation's parameter and ``parameter``.
+    """
+    from .continuation import run_continuation
+    t0 = time.perf_counter()
+    if not isinstance(bifurcation, Bifurcation):
+        raise InvalidInputError("bifurcation must be a pdw.Bifurcation, got %s"
+                                % type(bifurcation).__name__)
+    prob = bifurcation.details.get("problem")
+    if prob is None:
+        raise InvalidInputError("the bifurcation carries no problem (a bifurcation of a "
+                                "continue_gait branch is needed)")
+    if not bifurcation.located:
+        raise InvalidInputError("the %s was only detected, not located (%s): locate it "
+                                "first" % (bifurcation.kind, bifurcation.location_note))
+    aug = AugmentedProblem(prob, bifurcation.kind, parameter, bifurcation.z, bifurcation.mu,
+                           h=fd_step)
+    x0 = np.append(np.asarray(bifurcation.z, dtype=float), bifurcation.mu)
+    b = run_continuation(aug, x0, getattr(prob.base, parameter), stop, step=step,
+                         max_points=max_points, tol=tol, max_newton=max_newton,
+                         detect=("end",), **kw)
+    vals = np.column_stack([[prob.value(m) for m in b.z[:, -1]], b.values])
+    mult = []
+    for x, mu2 in zip(b.z, b.values):
+        ev = aug._base_eval(x[:-1], x[-1], mu2, True)
+        m = np.linalg.eigvals(ev.M) if ev.ok else np.full(prob.dim, np.nan)
+        mult.append(m[np.argsort(-np.abs(m))])
+    return BifurcationCurve(kind=bifurcation.kind, parameters=(prob.parameter, parameter),
+                            values=vals, z=b.z[:, :-1].copy(), multipliers=np.array(mult),
+                            step_length=b.step_length, period=b.period,
+                            stop_reason=b.stop_reason, branch=b,
+                            wall_time=time.perf_counter() - t0, n_maps=aug.n_maps)
