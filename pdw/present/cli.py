@@ -112,9 +112,10 @@ def walk_scene(args) -> Scene:
     scene = Scene.load(args.scene) if args.scene else Scene(name="typical gait")
     top = {k: getattr(args, k) for k in ("preset", "variant") if getattr(args, k) is not None}
     integrator = {k: v for k, v in (("method", args.method), ("dt", args.dt)) if v is not None}
-    stop = {"on_failure": "return", **({"t_end": args.t_end} if args.t_end is not None else {})}
+    stop = {"t_end": args.t_end} if args.t_end is not None else {}
     record = {"every": args.record_every} if args.record_every is not None else {}
-    return scene.replace(**top, integrator=integrator, stop=stop, record=record)
+    return scene.replace(**top, integrator=integrator, stop=stop, record=record,
+                         limits={"on_failure": "return"})
 
 
 def _walk(args):
