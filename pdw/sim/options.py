@@ -117,6 +117,12 @@ def _coerce(value, kind, key):
     def bad():
         return _err(key, "must be %s, got %r" % (KINDS[kind], value))
 
+    tv = type(value)
+    if kind in ("float", "float?") and (tv is float or tv is int):
+        return float(value)
+    if (kind in ("int", "int?") and tv is int) or (kind == "bool" and tv is bool) \
+            or (kind in ("str", "str?") and tv is str):
+        return value
     if isinstance(value, np.ndarray) and value.ndim == 0:
         value = value[()]
     if value is None and kind.endswith("?"):
@@ -176,17 +182,28 @@ def _coerce(value, kind, key):
     raise AssertionError(kind)
 
 
+_SCHEMAS: dict = {}
+
+
+def _schema(cls):
+    """(name, key, kind, check) of each field of an options class (computed once)."""
+    out = _SCHEMAS.get(cls)
+    if out is None:
+        out = _SCHEMAS[cls] = tuple(
+            (f.name, "%s.%s" % (cls.SECTION, f.name) if cls.SECTION else f.name,
+             f.metadata["kind"], f.metadata["check"]) for f in dataclasses.fields(cls))
+    return out
+
+
 class _Section:
     """A table of options: typed, checked fields; from and to plain dicts (TOML tables)."""
 
     SECTION = ""
 
     def __post_init__(self):
-        for f in dataclasses.fields(self):  # type: ignore[arg-type]
-            key = "%s.%s" % (self.SECTION, f.name) if self.SECTION else f.name
-            value = getattr(self, f.name)
-            kind = f.metadata["kind"]
-            types = _section_types()
+        types = _section_types()
+        for name, key, kind, check in _schema(type(self)):
+            value = getattr(self, name)
             if kind in types:
                 value = types[kind].from_dict(value) if isinstance(value, dict) else value
                 if not isinstance(value, types[kind]):
@@ -194,11 +211,10 @@ class _Section:
                                % (types[kind].__name__, value))
             else:
                 value = _coerce(value, kind, key)
-                check = f.metadata["check"]
                 problem = check(value) if (check is not None and value is not None) else None
                 if problem:
                     raise _err(key, "%s, got %r" % (problem, value))
-            object.__setattr__(self, f.name, value)
+            object.__setattr__(self, name, value)
         self._check()
 
     def _check(self):
