@@ -132,8 +132,9 @@ class BatchResult:
         lines = ["<pdw.BatchResult: %d walker%s, %s variant, %s, t_end = %.6g s, engine %s"
                  % (n, "" if n == 1 else "s", self.variant, how, self.t_end, self.engine),
                  "  status: %s" % status,
-                 "  per walker: status, stop_reason, t_final, n_steps, failure_*, n_touch_down, "
-                 "n_lift_off, n_gait_steps; %s; steps(i)" % arrays]
+                 "  per walker (N,): status, stop_reason, t_final, n_steps, n_touch_down, "
+                 "n_lift_off, n_gait_steps, failure_*",
+                 "  %s; steps(i), to_dataframe()" % arrays]
         if self.recorded:
             lines.append("  recorded: walkers %s" % ", ".join(map(str, sorted(self.recorded)[:8]))
                          + (", ..." if len(self.recorded) > 8 else ""))
