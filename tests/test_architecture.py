@@ -166,3 +166,93 @@ def test_old_positional_form_warns_and_works():
     assert b.stop_reason[0] == "steps"
     with pytest.raises(pdw.InvalidInputError, match="at most 17 positional"):
         pdw.simulate(pdw.X0_PAPER, 0.2, 1e-4, *([None] * 15))
+
+
+# --- the map of the house stays true (issue 25 part 2) ------------------------------------------
+
+def _map_entries():
+    """(package, entry) of every line of the map in docs/architecture.md: ("sim", "options"),
+    ("core", "_core.pyx"), ("core", "csrc/"), ("", "__init__.py"), ("", "examples/")."""
+    text = (ROOT / "docs" / "architecture.md").read_text()
+    block = text.split("## The picture", 1)[1].split("```")[1]
+    entries, package = [], None
+    for line in block.splitlines():
+        head = re.match(r"^ pdw\.(\w+)\s+\d", line)
+        if head:
+            package = head.group(1)
+            continue
+        top = re.match(r"^ pdw/(\S+)", line)
+        if top:
+            entries.append(("", top.group(1)))
+            continue
+        entry = re.match(r"^   (\S+)", line)
+        if entry and package:
+            entries.append((package, entry.group(1)))
+    return entries
+
+
+def _modules():
+    """(package, entry) of every module under pdw/, as the map names them."""
+    out = set()
+    for p in (ROOT / "pdw").rglob("*"):
+        rel = p.relative_to(ROOT / "pdw")
+        if "__pycache__" in rel.parts or p.suffix not in (".py", ".pyx"):
+            continue
+        if len(rel.parts) == 1:
+            out.add(("", rel.name))
+        elif rel.parts[0] == "examples":
+            out.add(("", "examples/"))
+        elif len(rel.parts) == 2 and rel.name != "__init__.py":
+            out.add((rel.parts[0], rel.name if p.suffix == ".pyx" else p.stem))
+    return out
+
+
+def test_every_module_has_a_line_in_the_architecture_map_and_every_line_a_module():
+    entries = _map_entries()
+    listed = {e for e in entries if not e[1].endswith("/") or e[0] == ""}
+    modules = _modules()
+    assert not sorted(modules - listed), "modules without a line in docs/architecture.md"
+    assert not sorted(listed - modules), "lines of docs/architecture.md naming no module"
+    for package, entry in entries:
+        if entry.endswith("/"):
+            assert (ROOT / "pdw" / package / entry).is_dir(), entry
+    assert len(entries) == len(set(entries)), "a module listed twice"
+
+
+_DOTTED = re.compile(r"(?<![\w/.-])pdw(?:\.[A-Za-z_][A-Za-z0-9_]*)+")
+
+
+def _resolves(path):
+    """Does the dotted path name a module or an attribute of one?"""
+    import importlib
+    if path.startswith("pdw.__main__"):          # importing it would run the command line
+        return path == "pdw.__main__"
+    parts = path.split(".")
+    for i in range(len(parts), 0, -1):
+        try:
+            obj = importlib.import_module(".".join(parts[:i]))
+        except ImportError:
+            continue
+        for name in parts[i:]:
+            if not hasattr(obj, name):
+                return False
+            obj = getattr(obj, name)
+        return True
+    return False
+
+
+def test_every_dotted_pdw_path_in_docstrings_and_docs_resolves():
+    import ast
+    texts = []
+    for p in sorted((ROOT / "pdw").rglob("*.py")):
+        for node in ast.walk(ast.parse(p.read_text())):
+            if isinstance(node, (ast.Module, ast.FunctionDef, ast.AsyncFunctionDef,
+                                 ast.ClassDef)):
+                doc = ast.get_docstring(node, clean=False)
+                if doc:
+                    texts.append((p.relative_to(ROOT), doc))
+    texts += [(p.relative_to(ROOT), p.read_text()) for p in sorted((ROOT / "docs").glob("*.md"))]
+    texts.append((pathlib.Path("README.md"), (ROOT / "README.md").read_text()))
+    stale = sorted({(str(where), m.group(0).rstrip(".")) for where, text in texts
+                    for m in _DOTTED.finditer(text) if not _resolves(m.group(0).rstrip("."))})
+    assert not stale

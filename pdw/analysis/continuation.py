@@ -140,7 +140,7 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
     log : bool
         Continue in log(parameter) (for parameters spanning decades, e.g. k_n).
     detect : tuple of str
-        Which test functions to watch (`pdw.branch.KINDS`).
+        Which test functions to watch (`pdw.analysis.branch.KINDS`).
     max_newton : int
         Newton iterations of the corrector per point.
     executor, workers : concurrent.futures.Executor, int

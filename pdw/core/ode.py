@@ -2,7 +2,7 @@
 control loops): what PyDy's ``generate_ode_function`` gives its users.
 
 `ode_function` validates its inputs once and returns an `OdeFunction` (compiled,
-`pdw._core`): ``f(t, x)`` is f(x) of Eq. A.4 (MODEL.md section 3) with the support flags and
+`pdw.core._core`): ``f(t, x)`` is f(x) of Eq. A.4 (MODEL.md section 3) with the support flags and
 the tangential anchors held fixed, ``f.jac(t, x)`` its symbolic Jacobian, ``f.batch(X)`` the
 rows of an (N, 8) array in one compiled loop. The discrete state of MODEL.md sections 5-6
 (flags, arming, anchors) is *not* updated: integrate a stretch without flag changes, or use
@@ -62,7 +62,7 @@ def ode_function(params: Params | None = None, variant: str = "paper",
         Rolling coordinate s_i at the last touch-down of each foot [m] (only the
         ``consistent`` variant uses them), held fixed.
     features : iterable of str, optional
-        Force elements present (`pdw._layout.FEATURES`; default all), as in `pdw.simulate`.
+        Force elements present (`pdw.core._layout.FEATURES`; default all), as in `pdw.simulate`.
 
     Returns
     -------

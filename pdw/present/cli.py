@@ -1,7 +1,7 @@
 """Command line: ``pdw walk`` (the main job), ``pdw run`` (a scene) and ``pdw sweep`` (a study).
 
 ``pdw walk`` runs the paper's typical gait (Sec. 3.2: `Params.paper()`, x0 of
-`pdw.simulation.X0_PAPER`, 3.5 s, dt = 1e-4, the central difference method), prints the step
+`pdw.X0_PAPER`, 3.5 s, dt = 1e-4, the central difference method), prints the step
 table next to the paper's numbers, and writes the report, the step table, the run's metadata,
 the scene as run and the figures (Figs. 4-7 and an animated GIF) to an output folder. With
 ``--scene FILE`` the run starts from a `pdw.Scene` file (the same schema as ``pdw run``);

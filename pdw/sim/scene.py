@@ -195,7 +195,7 @@ class Scene(_Section):
     contact: ContactLaws = _f(ContactLaws(), "contact", "normal and friction contact laws")
     approach_speeds0: tuple | None = _f(None, "pair?", "approach speeds [m/s] of the feet "
                                         "that start in support (default max(-v_y, 0))")
-    ground: Any = _f(None, "object", "the ground under the walker (pdw.Ground; default the "
+    ground: Any = _f(None, "object", "the ground under the walker (a Ground; default the "
                      "paper's slope)")
 
     def __post_init__(self):

@@ -343,8 +343,8 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
         Approach speeds [m/s] (>= 0) of the feet that start in support (the damping of
         lankarani_nikravesh and flores); default max(-v_y(x0), 0) of each.
     ground : optional
-        The ground under the walker (`pdw.Ground`); None: the paper's slope. Not run by this
-        build yet: any other value is refused.
+        The ground under the walker (a Ground, pdw/core/ground.py); None: the paper's slope.
+        Not run by this build yet: any other value is refused.
     **_legacy
         The keywords of before (``record_every=``, ``rtol=``, ``stop_steps=``, ...) and the
         positional form ``simulate(x0, t_end, dt, params, variant, method, ...)``: they work
