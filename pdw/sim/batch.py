@@ -34,7 +34,10 @@ from .chunks import _plist, honest, record_subset, run_chunked
 from .gait import Steps, steps_from_rows
 from .simulation import _REASONS, _check_count, _check_positive
 
-_STATUS = {0: "interrupted", 1: "walked", 2: "fell", 3: "diverged", 5: "diverged", 6: "periodic"}
+#: A walker's loop status (layout STATUS) -> its BatchResult status (running: interrupted).
+_STATUS = {_layout.STATUS.index(c): s for c, s in (
+    ("running", "interrupted"), ("done", "walked"), ("fell", "fell"), ("diverged", "diverged"),
+    ("singular", "diverged"), ("periodic", "periodic"))}
 _STOP = {i: ("t_end" if i == 0 else name) for i, name in enumerate(_layout.STOP)}
 LANES = 8
 """Default lanes per block (walkers advanced in lockstep by one thread)."""

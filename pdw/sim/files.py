@@ -19,11 +19,12 @@ from ..core.integrators import METHODS
 from ..core.params import Params
 from . import io as _io
 from .gait import Steps
+from .options import Outcome
 from .simulation import Event, Result
 
-#: statuses and stop reasons a saved Result can carry
-STATUSES = ("walked", "periodic", "fell", "diverged", "no_steps", "interrupted")
-STOP_REASONS = ("t_end", "steps", "periodic") + STATUSES
+#: statuses and stop reasons a saved Result can carry: the readings of `Outcome`
+STATUSES = tuple(dict.fromkeys(o.status for o in Outcome))
+STOP_REASONS = tuple(o.stop_reason for o in Outcome)
 
 
 class _Bad(Exception):

@@ -50,16 +50,8 @@ class SceneLike(Protocol):
     def simulate_kwargs(self) -> dict: ...
 
 _STATUS = {i: s for i, s in enumerate(_layout.STATUS)}
-_REASONS = {
-    0: "none",
-    1: "a non-finite value (NaN or infinity) appeared in the state",
-    2: "a velocity exceeded max_speed (runaway state)",
-    3: "the hip dropped below fall_hip_height",
-    4: "a foot sank deeper than fall_depth below the ground",
-    5: "the step's linear system was singular",
-    6: "the adaptive step size underflowed (the error test never passed)",
-    7: "the step budget (max_steps) was used up before t_end",
-}
+#: Why a loop failed: PDW_REASON_* -> message (generated: derive/layout.py REASON).
+_REASONS = dict(enumerate(_layout.REASON_TEXT))
 #: Smallest step [s] (a smaller one makes the step matrices singular in double precision).
 DT_MIN = _opt.DT_MIN
 #: Runaway bounds checked on every recorded and the final state of a run that reached its end:
@@ -586,7 +578,8 @@ def _result(raw, params, variant, method, dt, t_end, wall, on_failure,
     if res.status == "diverged" and on_failure == "raise":
         cls = SingularSystemError if status == "singular" else DivergedError
         advice = ("Check the masses and inertias (Params) and dt." if status == "singular" else
-                  "Raise max_steps, or loosen rtol/atol." if raw["failure"]["reason"] == 7 else
+                  "Raise max_steps, or loosen rtol/atol."
+                  if raw["failure"]["reason"] == _layout.REASON.index("budget") else
                   "Try a smaller dt or a stiff method.")
         raise cls("simulation diverged at t = %.6g s (step %d, dt = %g, method %s): %s; "
                   "last good state %s. %s"

@@ -27,15 +27,8 @@ typedef struct pdw_failure {
     int reason;         /* PDW_REASON_* */
 } pdw_failure;
 
-enum {
-    PDW_REASON_NONE = 0,
-    PDW_REASON_NONFINITE = 1,     /* a NaN or infinity in the new state */
-    PDW_REASON_SPEED = 2,         /* a velocity above max_speed */
-    PDW_REASON_HIP_LOW = 3,       /* hip below fall_hip_height */
-    PDW_REASON_FOOT_DEEP = 4,     /* a foot deeper than fall_depth below the ground */
-    PDW_REASON_SINGULAR = 5,      /* singular step matrix */
-    PDW_REASON_STEP_SIZE = 6      /* adaptive step size underflow (error test never passed) */
-};
+/* PDW_REASON_*: generated from derive/layout.py's REASON (pdw_model.h), with the messages
+ * pdw/core/_layout.py's REASON_TEXT gives Python. */
 
 /* Online gait analysis (docs/model.md section 8): the per-step descriptors of pdw/sim/gait.py, computed
  * as the events happen, in O(1) memory: the latest touch-down and lift-off of each leg, counts,
@@ -63,9 +56,6 @@ enum { PDW_STATUS_RECORDS_FULL = 64 };
  * returns it at a point where it resumes exactly (like PDW_STATUS_EVENTS_FULL); _core.run takes
  * the GIL, checks for signals (Ctrl-C) and the step budget, and calls advance again. */
 enum { PDW_STATUS_POLL = 65 };
-
-/* Why an adaptive loop stopped beyond pdw_failure's PDW_REASON_*: the step budget. */
-enum { PDW_REASON_BUDGET = 7 };
 
 /* The options a loop reads: pdw.sim.options' Integrator, Record, Stop and Limits as C (plus
  * n_steps and the fixed t_end, derived from them). Filled once before a run (pdw/core/_core.pyx
