@@ -21,7 +21,7 @@ from typing import Any, Literal, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..core import _batch, _layout, checks, interrupt
+from ..core import _batch, _layout, checks, interrupt  # type: ignore[attr-defined]
 from ..core.errors import InvalidInputError
 from ..core.integrators import METHODS
 from ..core.integrators import get as _method_info
@@ -324,7 +324,7 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
         try:
             return run_chunked(simulate_batch, kw, executor, chunk_size, progress=bar)
         finally:
-            if progress is True:
+            if progress is True and bar is not None:
                 bar.close()
     rtol, atol, h_max, event_tol, max_steps, check_step = (
         it.rtol, it.atol, it.h_max, it.event_tol, it.max_steps, it.check_step)
@@ -414,7 +414,7 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
             unstarted = np.isnan(out["t_final"])
             out["x_final"][unstarted] = x[unstarted]
             out["t_final"][unstarted] = 0.0
-            e.result = _result(out, dt, t_stop, method, variant)
+            e.result = _result(out, dt, t_stop, method, variant)  # type: ignore[attr-defined]
             raise
     res = _result(out, dt, t_stop, method, variant)
     honest(res, x, plist if len(plist) == n else plist[0])

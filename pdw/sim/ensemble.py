@@ -209,7 +209,8 @@ def simulate_many(x0: ArrayLike, t_end: float | None = None, dt: float | None = 
               executor=executor, chunk_size=chunk_size, record=record,
               record_every=record_every)
     if plain_model(features, contact) and supports(settled.method, kw["variant"]):
-        batch_only = {k: v for k, v in (("lanes", lanes), ("vector", vector)) if v is not None}
+        batch_only: dict[str, Any] = {k: v for k, v in (("lanes", lanes), ("vector", vector))
+                                      if v is not None}
         out = simulate_batch(x0, **kw, **batch_only, progress=progress)
         out.engine = "batch"
     else:
