@@ -256,3 +256,23 @@ def test_every_dotted_pdw_path_in_docstrings_and_docs_resolves():
     stale = sorted({(str(where), m.group(0).rstrip(".")) for where, text in texts
                     for m in _DOTTED.finditer(text) if not _resolves(m.group(0).rstrip("."))})
     assert not stale
+
+
+def test_the_c_loops_only_read_their_options():
+    """pdw_run_opts (pdw_sim.h) is filled before a run and read by the loops: the only writes
+    to it in the hand-written C are the ensemble's lane set-up (load_walker, start,
+    pdw_batch_start_method in pdw_batch.c)."""
+    setup = ("load_walker", "start", "pdw_batch_start_method")
+    writes = []
+    for p in sorted((ROOT / "pdw" / "core" / "csrc").glob("*")):
+        if p.suffix not in (".c", ".h", ".inc"):
+            continue
+        fn = None
+        for n, line in enumerate(p.read_text().splitlines(), 1):
+            head = re.match(r"^(?:static |inline |const )*[a-z_]+[ *]+([a-z_0-9]+)\(", line)
+            if head:
+                fn = head.group(1)
+            if re.search(r"(->|\.)opt(\.[a-z_]+)?\s*=[^=]", line) and \
+                    not (p.name == "pdw_batch.c" and fn in setup):
+                writes.append("%s:%d (%s): %s" % (p.name, n, fn, line.strip()))
+    assert not writes
