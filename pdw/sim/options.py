@@ -593,24 +593,25 @@ class Settled(NamedTuple):
     t_end: float
     plain: dict
 
-    def ran(self, checked: bool = False) -> tuple:
+    def ran(self, checked: tuple | None = None) -> tuple:
         """(Integrator, Stop) with the method, dt and t_end run: what a run reports, and what
-        one call passes on to another without giving a value twice. ``checked``: method, dt
-        and t_end were validated already (the copies are then made without checking again)."""
+        one call passes on to another without giving a value twice. ``checked``: (method, dt,
+        t_end) as validated by the run (the copies are then made without checking again)."""
         it, st = self.integrator, self.stop
-        new = _with if checked else dataclasses.replace
-        if it.method != self.method or it.dt != self.dt:
-            it = new(it, method=self.method, dt=float(self.dt))
-        if st.t_end != self.t_end:
-            st = new(st, t_end=float(self.t_end))
+        method, dt, t_end = (self.method, self.dt, self.t_end) if checked is None else checked
+        new = dataclasses.replace if checked is None else _with
+        if it.method != method or it.dt != dt:
+            it = new(it, method=method, dt=float(dt))
+        if st.t_end != t_end:
+            st = new(st, t_end=float(t_end))
         return it, st
 
 
 def _with(obj, **changes):
     """A copy of an option object with already validated field values (no checks)."""
     new = object.__new__(type(obj))
-    for f in dataclasses.fields(obj):
-        object.__setattr__(new, f.name, changes.get(f.name, getattr(obj, f.name)))
+    new.__dict__.update(obj.__dict__)
+    new.__dict__.update(changes)
     return new
 
 

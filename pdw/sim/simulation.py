@@ -481,7 +481,7 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
     res = _result(raw, params, variant, method, dt, t_end, wall, on_failure, feats,
                   bool(record_events), energies, x)
     res.contact = contact
-    res.integrator, res.stop = settled._replace(method=method, dt=dt, t_end=t_end).ran(True)
+    res.integrator, res.stop = settled.ran((method, dt, t_end))
     res.record, res.limits = rec, lim
     if t_eval is not None or dense_output:
         res = _dense.attach(res, t_eval, dense_output, params, variant, feats,
