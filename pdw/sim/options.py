@@ -371,6 +371,26 @@ class Limits(_Section):
                          _one_of(ON_FAILURE))
 
 
+_TYPES = {"str": "str", "str?": "str, optional", "float": "float", "float?": "float, optional",
+          "int": "int", "int?": "int, optional", "bool": "bool", "times?": "array_like, optional",
+          "pair?": "(float, float), optional", "object": "object, optional"}
+
+
+def _document(cls):
+    """Append a numpydoc Parameters section made from the fields' metadata to the docstring."""
+    lines = ["", "    Parameters", "    ----------"]
+    for f in dataclasses.fields(cls):
+        lines.append("    %s : %s" % (f.name, _TYPES.get(f.metadata["kind"], f.metadata["kind"])))
+        lines.append("        %s (default %r)." % (f.metadata["doc"][0].upper() + f.metadata["doc"][1:],
+                                                   f.default))
+    cls.__doc__ = (cls.__doc__ or "").rstrip() + "\n" + "\n".join(lines) + "\n"
+    return cls
+
+
+for _cls in (Integrator, Record, Stop, Limits):
+    _document(_cls)
+
+
 def _moved_to_limits(init):
     def __init__(self, *args, **kwargs):
         moved = sorted(k for k in kwargs if k in MOVED_TO_LIMITS)
