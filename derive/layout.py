@@ -94,6 +94,18 @@ STATUS = (
     "singular",     # the step's linear system was singular
     "periodic",     # stopped because successive steps agree (gait converged)
 )
+# Why a time loop failed (pdw_failure.reason, PDW_REASON_*), with the message a Result and a
+# DivergedError carry (pdw.Result.failure["reason"]).
+REASON = (
+    ("none", "none"),
+    ("nonfinite", "a non-finite value (NaN or infinity) appeared in the state"),
+    ("speed", "a velocity exceeded max_speed (runaway state)"),
+    ("hip_low", "the hip dropped below fall_hip_height"),
+    ("foot_deep", "a foot sank deeper than fall_depth below the ground"),
+    ("singular", "the step's linear system was singular"),
+    ("step_size", "the adaptive step size underflowed (the error test never passed)"),
+    ("budget", "the step budget (max_steps) was used up before t_end"),
+)
 # Which stop condition of a scene ended a run before t_end (pdw_sim.stop_reason).
 STOP = (
     "none",         # none did: the run reached t_end, or failed

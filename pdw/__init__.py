@@ -14,6 +14,10 @@ mass_matrix             M(q) of Eq. 2
 contact_forces          contact kinematics and forces of both feet (Eqs. 3-11)
 energies                kinetic and potential energies
 simulate, Result        one compiled simulation (support flags, events, status)
+Integrator, Record,     the options of a run, each named once (pdw.sim.options): how it is
+Stop, Limits            integrated, what it records, when it stops, when it fell or diverged;
+                        taken by simulate, simulate_batch, simulate_many and Scene alike
+Outcome                 how a run ended (Result.outcome; status and stop_reason derive from it)
 simulate_batch          N walkers in one call, W lanes in lockstep (docs/ensemble.md): BatchResult
 simulate_many           N walkers: the batch engine when it runs the method, else pdw.simulate
 Contact                 the normal and friction contact laws of a run (docs/contact_laws.md)
@@ -81,6 +85,7 @@ from .sim.buffers import RecordBuffer
 from .sim.ensemble import simulate_many
 from .sim.files import load
 from .sim.gait import Steps, steps
+from .sim.options import Integrator, Limits, Outcome, Record, Stop
 from .sim.scene import Scene, run
 from .sim.simulation import Event, Result, simulate
 from .studies import sweep
@@ -103,5 +108,6 @@ __all__ = [
     "StepSizeWarning", "StepSizeError", "examples", "continue_gait", "Branch", "Bifurcation",
     "continue_bifurcation", "BifurcationCurve", "plot_branches", "plot_curves",
     "ode_function", "OdeFunction", "load", "load_sweep", "RecordBuffer",
-    "Contact", "Progress", "GaitNotFoundError",
+    "Contact", "Progress", "GaitNotFoundError", "Integrator", "Record", "Stop", "Limits",
+    "Outcome",
 ]

@@ -1,5 +1,6 @@
 """The package's shape: the public API of before the layers, readable reprs, module sizes."""
 import pathlib
+import re
 import subprocess
 import sys
 
@@ -88,3 +89,215 @@ def test_gait_not_found_error_is_public():
     from pdw.analysis.gait_types import GaitNotFoundError
     assert pdw.GaitNotFoundError is GaitNotFoundError and "GaitNotFoundError" in pdw.__all__
     assert issubclass(pdw.GaitNotFoundError, pdw.PdwError)
+
+
+# --- every option named once (issue 25): the spellings of before, pinned -----------------------
+
+#: simulate's parameters as they were before the option objects (31; the first 17 positional).
+SIMULATE_BEFORE = ("x0", "t_end", "dt", "params", "variant", "method", "flags0", "record_every",
+                   "record_forces", "on_failure", "fall_hip_height", "fall_depth", "max_speed",
+                   "rtol", "atol", "h_max", "event_tol", "features", "record_events",
+                   "record_energies", "stop_steps", "periodic_steps", "periodic_tol",
+                   "check_step", "t_eval", "dense_output", "out", "max_steps", "contact",
+                   "approach_speeds0", "stop_touch_down")
+#: simulate_batch's parameters before (the first 22 positional).
+BATCH_BEFORE = ("x0", "t_end", "dt", "params", "variant", "method", "flags0", "threads", "lanes",
+                "vector", "stop_steps", "periodic_steps", "periodic_tol", "fall_hip_height",
+                "fall_depth", "max_speed", "check_step", "rtol", "atol", "h_max", "event_tol",
+                "max_steps", "executor", "chunk_size", "record", "record_every",
+                "stop_touch_down")
+#: One value of each old keyword, off its default, on a short run where it matters.
+LEGACY_VALUES = {
+    "rtol": 1e-7, "atol": 1e-9, "h_max": 2e-3, "event_tol": 1e-8, "max_steps": 10 ** 6,
+    "check_step": "off", "record_every": 2, "record_forces": False, "record_events": False,
+    "record_energies": True, "t_eval": (0.01, 0.02), "dense_output": True, "out": "buffer",
+    "stop_steps": 1, "periodic_steps": 3, "periodic_tol": 1e-2, "stop_touch_down": 1,
+    "fall_hip_height": 0.3, "fall_depth": 0.1, "max_speed": 500.0, "on_failure": "return",
+}
+#: Where each old keyword lives now (the table pdw.sim.options.LEGACY must equal).
+LEGACY_PLACES = {
+    "rtol": ("integrator", "rtol"), "atol": ("integrator", "atol"),
+    "h_max": ("integrator", "h_max"), "event_tol": ("integrator", "event_tol"),
+    "max_steps": ("integrator", "max_steps"), "check_step": ("integrator", "check_step"),
+    "record_every": ("record", "every"), "record_forces": ("record", "forces"),
+    "record_events": ("record", "events"), "record_energies": ("record", "energies"),
+    "t_eval": ("record", "t_eval"), "dense_output": ("record", "dense_output"),
+    "out": ("record", "out"), "stop_steps": ("stop", "steps"),
+    "periodic_steps": ("stop", "periodic_steps"), "periodic_tol": ("stop", "periodic_tol"),
+    "stop_touch_down": ("stop", "touch_down"), "fall_hip_height": ("limits", "fall_hip_height"),
+    "fall_depth": ("limits", "fall_depth"), "max_speed": ("limits", "max_speed"),
+    "on_failure": ("limits", "on_failure"),
+}
+
+
+def test_every_old_keyword_of_simulate_is_still_accepted():
+    """Each parameter of before is a parameter now or a line of the one mapping table."""
+    import inspect
+
+    from pdw.sim.options import LEGACY, POSITIONAL
+    now = inspect.signature(pdw.simulate).parameters
+    assert all(n in now or n in LEGACY for n in SIMULATE_BEFORE)
+    assert all(n in inspect.signature(pdw.simulate_batch).parameters or n in LEGACY
+               for n in BATCH_BEFORE)
+    assert POSITIONAL["simulate"] == SIMULATE_BEFORE[3:17]
+    assert POSITIONAL["simulate_batch"] == BATCH_BEFORE[3:22]
+    assert set(LEGACY_VALUES) == set(LEGACY) and LEGACY == LEGACY_PLACES
+
+
+def test_only_x0_t_end_dt_are_positional():
+    import inspect
+    for fn in (pdw.simulate, pdw.simulate_batch, pdw.simulate_many):
+        kinds = [(p.name, p.kind) for p in inspect.signature(fn).parameters.values()]
+        pos = [n for n, k in kinds if k == inspect.Parameter.POSITIONAL_OR_KEYWORD]
+        assert pos == ["x0", "t_end", "dt"], fn
+
+
+@pytest.mark.parametrize("old", sorted(LEGACY_VALUES))
+def test_old_keyword_warns_and_maps_to_its_field(old):
+    """simulate(old=v) warns naming the new spelling, runs exactly as the option object with
+    that field, and the Result reports the field set (the mapping old -> (object, field))."""
+    from pdw.sim.options import OPTION_SECTIONS, new_spelling
+    section, name = LEGACY_PLACES[old]
+    value = LEGACY_VALUES[old]
+    if value == "buffer":
+        value = pdw.RecordBuffer()
+    method = "rodas4" if section == "integrator" and old != "check_step" else "cdm"
+    kw = dict(t_end=0.3, params=pdw.Params.paper(), method=method)
+    with pytest.warns(DeprecationWarning, match=r"%s\(%s=\.\.\.\) is deprecated; write %s"
+                      % ("simulate", old, re.escape(new_spelling(old).split("(")[0]))):
+        r_old = pdw.simulate(**kw, **{old: value})
+    fields = {"periodic": True, "periodic_steps": value} if old == "periodic_steps" else \
+        {name: value}
+    r_new = pdw.simulate(**kw, **{section: OPTION_SECTIONS[section](**fields)})
+    got = getattr(getattr(r_old, section), name)
+    assert got == (tuple(value) if isinstance(value, tuple) else value)
+    if old == "periodic_steps":
+        assert r_old.stop.periodic
+    for a in ("t", "x", "x_final", "Fn"):
+        assert np.array_equal(getattr(r_old, a), getattr(r_new, a)), a
+    assert (r_old.status, r_old.stop_reason, r_old.n_steps) == \
+        (r_new.status, r_new.stop_reason, r_new.n_steps)
+
+
+def test_old_positional_form_warns_and_works():
+    """issue 26 item 13: simulate(x0, 3.5, 1e-4, None, "paper", "rk4") is legal for one release."""
+    with pytest.warns(DeprecationWarning, match="passing method by position"):
+        r = pdw.simulate(pdw.X0_PAPER, 0.2, 1e-4, None, "paper", "rk4")
+    assert r.method == "rk4" and r.integrator.method == "rk4"
+    assert np.array_equal(r.x_final, pdw.simulate(pdw.X0_PAPER, 0.2, 1e-4, method="rk4").x_final)
+    with pytest.warns(DeprecationWarning, match="passing stop_steps by position"):
+        b = pdw.simulate_batch(np.array([pdw.X0_PAPER]), 2.0, 1e-4, None, "paper", "cdm",
+                               (0, 1), 1, 8, False, 1)
+    assert b.stop_reason[0] == "steps"
+    with pytest.raises(pdw.InvalidInputError, match="at most 17 positional"):
+        pdw.simulate(pdw.X0_PAPER, 0.2, 1e-4, *([None] * 15))
+
+
+# --- the map of the house stays true (issue 25 part 2) ------------------------------------------
+
+def _map_entries():
+    """(package, entry) of every line of the map in docs/architecture.md: ("sim", "options"),
+    ("core", "_core.pyx"), ("core", "csrc/"), ("", "__init__.py"), ("", "examples/")."""
+    text = (ROOT / "docs" / "architecture.md").read_text()
+    block = text.split("## The picture", 1)[1].split("```")[1]
+    entries, package = [], None
+    for line in block.splitlines():
+        head = re.match(r"^ pdw\.(\w+)\s+\d", line)
+        if head:
+            package = head.group(1)
+            continue
+        top = re.match(r"^ pdw/(\S+)", line)
+        if top:
+            entries.append(("", top.group(1)))
+            continue
+        entry = re.match(r"^   (\S+)", line)
+        if entry and package:
+            entries.append((package, entry.group(1)))
+    return entries
+
+
+def _modules():
+    """(package, entry) of every module under pdw/, as the map names them."""
+    out = set()
+    for p in (ROOT / "pdw").rglob("*"):
+        rel = p.relative_to(ROOT / "pdw")
+        if "__pycache__" in rel.parts or p.suffix not in (".py", ".pyx"):
+            continue
+        if len(rel.parts) == 1:
+            out.add(("", rel.name))
+        elif rel.parts[0] == "examples":
+            out.add(("", "examples/"))
+        elif len(rel.parts) == 2 and rel.name != "__init__.py":
+            out.add((rel.parts[0], rel.name if p.suffix == ".pyx" else p.stem))
+    return out
+
+
+def test_every_module_has_a_line_in_the_architecture_map_and_every_line_a_module():
+    entries = _map_entries()
+    listed = {e for e in entries if not e[1].endswith("/") or e[0] == ""}
+    modules = _modules()
+    assert not sorted(modules - listed), "modules without a line in docs/architecture.md"
+    assert not sorted(listed - modules), "lines of docs/architecture.md naming no module"
+    for package, entry in entries:
+        if entry.endswith("/"):
+            assert (ROOT / "pdw" / package / entry).is_dir(), entry
+    assert len(entries) == len(set(entries)), "a module listed twice"
+
+
+_DOTTED = re.compile(r"(?<![\w/.-])pdw(?:\.[A-Za-z_][A-Za-z0-9_]*)+")
+
+
+def _resolves(path):
+    """Does the dotted path name a module or an attribute of one?"""
+    import importlib
+    if path.startswith("pdw.__main__"):          # importing it would run the command line
+        return path == "pdw.__main__"
+    parts = path.split(".")
+    for i in range(len(parts), 0, -1):
+        try:
+            obj = importlib.import_module(".".join(parts[:i]))
+        except ImportError:
+            continue
+        for name in parts[i:]:
+            if not hasattr(obj, name):
+                return False
+            obj = getattr(obj, name)
+        return True
+    return False
+
+
+def test_every_dotted_pdw_path_in_docstrings_and_docs_resolves():
+    import ast
+    texts = []
+    for p in sorted((ROOT / "pdw").rglob("*.py")):
+        for node in ast.walk(ast.parse(p.read_text())):
+            if isinstance(node, (ast.Module, ast.FunctionDef, ast.AsyncFunctionDef,
+                                 ast.ClassDef)):
+                doc = ast.get_docstring(node, clean=False)
+                if doc:
+                    texts.append((p.relative_to(ROOT), doc))
+    texts += [(p.relative_to(ROOT), p.read_text()) for p in sorted((ROOT / "docs").glob("*.md"))]
+    texts.append((pathlib.Path("README.md"), (ROOT / "README.md").read_text()))
+    stale = sorted({(str(where), m.group(0).rstrip(".")) for where, text in texts
+                    for m in _DOTTED.finditer(text) if not _resolves(m.group(0).rstrip("."))})
+    assert not stale
+
+
+def test_the_c_loops_only_read_their_options():
+    """pdw_run_opts (pdw_sim.h) is filled before a run and read by the loops: the only writes
+    to it in the hand-written C are the ensemble's lane set-up (load_walker, start,
+    pdw_batch_start_method in pdw_batch.c)."""
+    setup = ("load_walker", "start", "pdw_batch_start_method")
+    writes = []
+    for p in sorted((ROOT / "pdw" / "core" / "csrc").glob("*")):
+        if p.suffix not in (".c", ".h", ".inc"):
+            continue
+        fn = None
+        for n, line in enumerate(p.read_text().splitlines(), 1):
+            head = re.match(r"^(?:static |inline |const )*[a-z_]+[ *]+([a-z_0-9]+)\(", line)
+            if head:
+                fn = head.group(1)
+            if re.search(r"(->|\.)opt(\.[a-z_]+)?\s*=[^=]", line) and \
+                    not (p.name == "pdw_batch.c" and fn in setup):
+                writes.append("%s:%d (%s): %s" % (p.name, n, fn, line.strip()))
+    assert not writes

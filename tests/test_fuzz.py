@@ -198,8 +198,8 @@ def test_model_functions_are_finite(P, s, variant):
                               "fall_depth"]),
        value=st.sampled_from([0.0, -1.0, math.nan, math.inf, -math.inf, "x", None]))
 def test_bad_numbers_raise_invalid_input_naming_the_field(field, value):
-    if value is None and field in ("h_max", "fall_depth"):
-        return                          # None is their default (no limit, l/4)
+    if value is None and field in ("h_max", "fall_depth", "dt", "t_end"):
+        return                          # None is their default (no limit, l/4, 1e-4, 3.5)
     with pytest.raises(InvalidInputError, match=field) as ei:
         pdw.simulate(**{"t_end": 0.01, field: value})
     assert isinstance(ei.value, PdwError)

@@ -13,7 +13,7 @@ from pdw import METHODS
 from pdw.core import _layout
 from pdw.present import cli
 from pdw.sim.gait import FIELDS
-from pdw.sim.scene import Forces, Integrator, Record, Scene, Stop
+from pdw.sim.scene import Forces, Integrator, Limits, Record, Scene, Stop
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 STEADY = pdw.Params.paper_steady()
@@ -231,8 +231,10 @@ def _odd_scene():
                  forces=Forces.only("normal_damping", "friction"),
                  record=Record.full(every=10),
                  stop=Stop(t_end=12.25, steps=7, periodic=True, periodic_steps=5,
-                           periodic_tol=1e-5, fall_hip_height=0.2, fall_depth=0.05,
-                           max_speed=50, on_failure="return"))
+                           periodic_tol=1e-5, touch_down=2),
+                 limits=Limits(fall_hip_height=0.2, fall_depth=0.05, max_speed=50,
+                               on_failure="return"),
+                 approach_speeds0=(0.0, 0.25))
 
 
 @pytest.mark.parametrize("scene", [Scene(), _odd_scene(),
@@ -290,7 +292,7 @@ def test_scene_replace_updates_tables():
     ('[integrator]\nmethod = "euler"\n', "'integrator.method'"),
     ("[integrator]\ndt = -1e-4\n", "'integrator.dt'"),
     ("[stop]\nperiodic_steps = 1\n", "'stop.periodic_steps'"),
-    ('[stop]\non_failure = "ignore"\n', "'stop.on_failure'"),
+    ('[limits]\non_failure = "ignore"\n', "'limits.on_failure'"),
     ("[record]\nevery = 0\nenergies = true\n", "'record.energies'"),
     ("[integrator]\ndt = 10.0\n", "'integrator.dt'"),
 ])

@@ -171,7 +171,8 @@ def test_step_above_the_limit_warns_with_the_limit_and_the_force():
     lim = SL.step_limit(pdw.Params.paper(), "cdm")
     dt = 2.5 * lim.dt_max
     with pytest.warns(StepSizeWarning) as rec:
-        pdw.simulate(dt=dt, record_every=0, on_failure="return")
+        pdw.simulate(dt=dt, record=pdw.Record(every=0),
+                     limits=pdw.Limits(on_failure="return"))
     w = rec[0].message
     assert w.dt == dt and w.limit == lim.dt_max and w.force == lim.force
     text = str(w)

@@ -36,8 +36,9 @@ MEASURED = sorted(k for k, v in EDGES.items() if v is not None)
 
 
 def _run(contact, method, dt, mode, variant="paper"):
-    return pdw.simulate(params=P, contact=contact, method=method, dt=dt, t_end=5 * dt,
-                        record_every=0, check_step=mode, on_failure="return", variant=variant)
+    return pdw.simulate(params=P, contact=contact, dt=dt, t_end=5 * dt, variant=variant,
+                        integrator=pdw.Integrator(method=method, check_step=mode),
+                        record=pdw.Record(every=0), limits=pdw.Limits(on_failure="return"))
 
 
 def test_every_law_and_method_measured():

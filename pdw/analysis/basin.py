@@ -31,6 +31,7 @@ from ..core.errors import InvalidInputError
 from ..core.params import Params
 from ..core.progress import progress_bar
 from ..sim.batch import simulate_batch
+from ..sim.options import Stop
 from . import cell_mapping as cmap
 from . import limit_cycle as lc
 
@@ -177,8 +178,9 @@ def basin(params=None, phi=(0.69, 0.81, 100), thetad2=(-3.2, -0.4, 100), *, t_en
                                 "with these params: give a reference section point")
     rest = cmap.rest_of(z_ref, p)
     A, B = np.linspace(a0, a1, int(na)), np.linspace(b0, b1, int(nb))
-    opts = dict(t_end=t_end, dt=dt, params=p, flags0=(1, 1), periodic_steps=periodic_steps,
-                periodic_tol=periodic_tol, lanes=lanes, vector=vector)
+    opts = dict(t_end=t_end, dt=dt, params=p, flags0=(1, 1), lanes=lanes, vector=vector,
+                stop=Stop(periodic=periodic_steps > 0, periodic_steps=periodic_steps or 4,
+                          periodic_tol=periodic_tol))
     ref = simulate_batch(lc.embed(z_ref, p)[None, :], threads=1, **opts)
     if ref.status[0] != "periodic":
         raise InvalidInputError("the reference point does not settle into a periodic gait "

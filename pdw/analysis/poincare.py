@@ -4,6 +4,7 @@ section, the map's definition and its use are described in `pdw.limit_cycle` (do
 """
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -11,9 +12,10 @@ import numpy as np
 from ..core.contact import Contact
 from ..core.errors import FellError, InvalidInputError, SimulationError
 from ..core.integrators import INTEGRATORS, METHODS
+from ..sim.options import Integrator, Record
 from ..sim.simulation import simulate
 from . import section as _section
-from .section import section_coordinates, section_names
+from .section import RETURN, section_coordinates, section_names
 
 #: Defaults of the step map used by `find_gait` (accurate) ...
 TIGHT = dict(rtol=1e-10, atol=1e-12, event_tol=1e-12)
@@ -23,6 +25,15 @@ TIGHT = dict(rtol=1e-10, atol=1e-12, event_tol=1e-12)
 LOOSE_LUGRE = dict(rtol=1e-8, atol=1e-10, event_tol=1e-12)
 
 STEP_STATUS = ("ok", "fell", "diverged", "no_touch_down", "flight", "bad_state")
+
+#: What a step records: every step's state (and the contact forces, or not).
+_RECORD = {False: Record(every=1, forces=False), True: Record(every=1, forces=True)}
+
+
+@functools.lru_cache(maxsize=32)
+def _integrator(method, rtol, atol, event_tol):
+    """The step's `Integrator` (made once per setting: the maps call `step` many times)."""
+    return Integrator(method=method, rtol=rtol, atol=atol, event_tol=event_tol)
 
 
 def expected_end(t_hint):
@@ -83,9 +94,9 @@ def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max
     ends = [min(t_first, t_max), t_max] if t_first < t_max else [t_max]
     for t_end in ends:
         t_end = max(t_end, 10 * dt)
-        res = simulate(x0, t_end=t_end, dt=dt, params=p, variant=variant, method=method,
-                       flags0=(1, 1), record_every=1, record_forces=record, on_failure="return",
-                       rtol=rtol, atol=atol, event_tol=event_tol, contact=contact,
+        res = simulate(x0, t_end, dt, params=p, variant=variant, flags0=(1, 1),
+                       integrator=_integrator(method, rtol, atol, event_tol),
+                       record=_RECORD[bool(record)], limits=RETURN, contact=contact,
                        approach_speeds0=v_in0)
         out["stats"] = dict(res.stats)
         lo = next((e for e in res.events if e.leg == 1 and e.kind == "lift_off"), None)

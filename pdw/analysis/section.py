@@ -43,8 +43,12 @@ from ..core.contact import LAW_PARAMETERS, Contact
 from ..core.errors import InvalidInputError
 from ..core.model import contact_forces
 from ..core.params import X0_DISTURBED, X0_PAPER, Params
+from ..sim.options import Integrator, Limits, Record
 from ..sim.simulation import simulate
 from .gait_types import Gait
+
+#: The step maps' runs return a divergence as a status (they judge it themselves).
+RETURN = Limits(on_failure="return")
 
 #: Mechanical section coordinates (legs relabelled: leg 2 has just touched down, leg 1 trails).
 SECTION = ("theta1", "theta2", "xd_o", "yd_o", "thetad1", "thetad2")
@@ -226,9 +230,9 @@ def settle(x0, params=None, variant="paper", method="rodas4", *, flags0=(0, 1), 
     the section point (`section_names` (contact)) of the last touch-down with both feet on the
     ground, or None if there was none."""
     p = _params(params)
-    res = simulate(x0, t_end=t_end, dt=1e-4, params=p, variant=variant, method=method,
-                   flags0=flags0, record_every=1, record_forces=False, on_failure="return",
-                   rtol=rtol, atol=atol, event_tol=event_tol, contact=contact,
+    res = simulate(x0, t_end, 1e-4, params=p, variant=variant, flags0=flags0,
+                   integrator=Integrator(method=method, rtol=rtol, atol=atol, event_tol=event_tol),
+                   record=Record(every=1, forces=False), limits=RETURN, contact=contact,
                    approach_speeds0=approach_speeds0)
     speeds = None
     if contact is not None and uses_approach_speeds(contact):

@@ -18,6 +18,7 @@ import numpy as np
 from ..core.errors import InvalidInputError
 from ..core.model import contact_forces, energies, rhs
 from ..core.params import Params
+from ..sim.options import Integrator, Limits, Record
 from ..sim.simulation import simulate
 from ..sim.stepsize import FIXED_STEP, _set_hip_height, step_limit, typical_start  # noqa: F401
 
@@ -33,10 +34,13 @@ TD_TOL_REL = 0.01
 ENERGY_TOL = 0.1
 
 
-def _sim(**kw):
-    kw.setdefault("on_failure", "return")
-    kw.setdefault("check_step", "off")
-    return simulate(**kw)
+def _sim(*, rtol=1e-6, atol=1e-8, h_max=None, method="cdm", dt=None, record_every=1,
+         record_forces=True, **kw):
+    """`simulate` with a divergence returned and no step-size check."""
+    return simulate(integrator=Integrator(method=method, dt=dt, rtol=rtol, atol=atol, h_max=h_max,
+                                          check_step="off"),
+                    record=Record(every=record_every, forces=record_forces),
+                    limits=Limits(on_failure="return"), **kw)
 
 
 def reference(params: Params, variant: str = "paper", t_end: float = 3.5, rtol: float = 1e-9,

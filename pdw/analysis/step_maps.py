@@ -32,6 +32,7 @@ from ..core.integrators import INTEGRATORS, METHODS
 from ..core.progress import progress_bar
 from ..sim.batch import simulate_batch
 from ..sim.ensemble import plain_model, supports
+from ..sim.options import Integrator, Stop
 from . import section as _section
 from .poincare import expected_end, step
 
@@ -98,10 +99,13 @@ def images(points, params, variant, method, options, *, threads=1):
     dt = options["dt"]
     threads = max(1, int(threads))
     lanes = min(MAX_LANES, max(8, math.ceil(len(idx) / threads)))
-    b = simulate_batch(x0[idx], t_end=first_window(options.get("t_hint"), options["t_max"], dt),
-                       dt=dt, params=[plist[i] for i in idx], variant=variant, method=method,
-                       flags0=(1, 1), threads=threads, lanes=lanes, rtol=options["rtol"],
-                       atol=options["atol"], event_tol=options["event_tol"], stop_touch_down=1)
+    b = simulate_batch(x0[idx], first_window(options.get("t_hint"), options["t_max"], dt), dt,
+                       params=[plist[i] for i in idx], variant=variant, flags0=(1, 1),
+                       threads=threads, lanes=lanes,
+                       integrator=Integrator(method=method, rtol=options["rtol"],
+                                             atol=options["atol"],
+                                             event_tol=options["event_tol"]),
+                       stop=Stop(touch_down=1))
     for j, i in enumerate(idx):
         if b.stop_reason[j] == "touch_down" and b.flags_final[j, 1] == 1:
             out[i] = _section.section_coordinates(b.x_final[j], 1, law, None)

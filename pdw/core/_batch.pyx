@@ -8,6 +8,7 @@ C-contiguous (typed memoryviews). `run_range` releases the GIL for the whole ran
 from cpython.exc cimport PyErr_CheckSignals
 from libc.math cimport INFINITY
 from libc.stdlib cimport malloc, free
+from libc.string cimport memset
 
 import threading
 
@@ -28,6 +29,23 @@ cdef extern from "pdw_model.h":
 
 
 cdef extern from "pdw_sim.h":
+    ctypedef struct pdw_run_opts:
+        double dt
+        long n_steps
+        double t_end
+        double rtol, atol
+        double h_max
+        double event_tol
+        long max_steps
+        long record_every
+        int record_events
+        long stop_steps
+        int stop_touch_down
+        int periodic_k
+        double periodic_tol
+        double fall_hip_height
+        double fall_depth
+        double max_speed
     ctypedef struct pdw_sim:
         int status
 
@@ -44,17 +62,8 @@ cdef extern from "pdw_batch.h":
         const int *flags0
         const double *fall_hip_height
         const double *fall_depth
-        double dt
-        long n_steps
-        double max_speed
-        long stop_steps
-        int periodic_k
-        int stop_touch_down
-        double periodic_tol
+        pdw_run_opts opt
         int method
-        double t_end
-        double rtol, atol, h_max, event_tol
-        long max_steps
         int *status
         int *stop_reason
         int *flags_final
@@ -259,20 +268,21 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     job.flags0 = &flags0[0, 0]
     job.fall_hip_height = &hip[0]
     job.fall_depth = &depth[0]
-    job.dt = dt
-    job.n_steps = n_steps
-    job.max_speed = max_speed
-    job.stop_steps = stop_steps
-    job.periodic_k = periodic_k
-    job.stop_touch_down = stop_touch_down
-    job.periodic_tol = periodic_tol
+    memset(&job.opt, 0, sizeof(pdw_run_opts))   # nothing recorded; fall limits per walker
+    job.opt.dt = dt
+    job.opt.n_steps = n_steps
+    job.opt.max_speed = max_speed
+    job.opt.stop_steps = stop_steps
+    job.opt.periodic_k = periodic_k
+    job.opt.stop_touch_down = stop_touch_down
+    job.opt.periodic_tol = periodic_tol
     job.method = method
-    job.t_end = t_end if t_end > 0 else n_steps * dt
-    job.rtol = rtol
-    job.atol = atol
-    job.h_max = h_max
-    job.event_tol = event_tol
-    job.max_steps = max_steps
+    job.opt.t_end = t_end if t_end > 0 else n_steps * dt
+    job.opt.rtol = rtol
+    job.opt.atol = atol
+    job.opt.h_max = h_max
+    job.opt.event_tol = event_tol
+    job.opt.max_steps = max_steps
     job.status = &status[0]
     job.stop_reason = &stop_reason[0]
     job.flags_final = &flags_final[0, 0]

@@ -69,27 +69,29 @@ cdef extern from "pdw_sim.h":
         long n_steps
         long n_touch_down, n_lift_off
         double ring[1][1]
-    ctypedef struct pdw_sim:
-        long poll_every
-        long max_steps
-        const pdw_kernel *kernel
-        int nx
-        double p[32]
+    ctypedef struct pdw_run_opts:
         double dt
         long n_steps
-        long record_every
-        double fall_hip_height
-        double fall_depth
-        double max_speed
         double t_end
         double rtol, atol
         double h_max
         double event_tol
+        long max_steps
+        long record_every
         int record_events
         long stop_steps
         int stop_touch_down
         int periodic_k
         double periodic_tol
+        double fall_hip_height
+        double fall_depth
+        double max_speed
+    ctypedef struct pdw_sim:
+        long poll_every
+        const pdw_kernel *kernel
+        int nx
+        double p[32]
+        pdw_run_opts opt
         double *rec_t
         double *rec_x
         int *rec_flags
@@ -477,20 +479,20 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     memset(&s, 0, sizeof(pdw_sim))
     s.kernel = _kernel(k)
     s.nx = nx
-    s.t_end = t_end if t_end > 0 else n_steps * dt   # adaptive methods end exactly at t_end
-    s.rtol = rtol
-    s.atol = atol
-    s.h_max = h_max if h_max > 0 else s.t_end
+    s.opt.t_end = t_end if t_end > 0 else n_steps * dt   # adaptive methods end exactly at t_end
+    s.opt.rtol = rtol
+    s.opt.atol = atol
+    s.opt.h_max = h_max if h_max > 0 else s.opt.t_end
     s.h = dt
-    s.event_tol = event_tol
+    s.opt.event_tol = event_tol if event_tol > 0 else 1e-9
     memcpy(s.p, &p[0], PDW_NP * sizeof(double))
-    s.dt = dt
-    s.n_steps = n_steps
-    s.record_every = record_every
-    s.fall_hip_height = fall_hip_height
-    s.fall_depth = fall_depth
-    s.max_speed = max_speed
-    s.max_steps = max_steps if pdw_methods[method].adaptive else 0
+    s.opt.dt = dt
+    s.opt.n_steps = n_steps
+    s.opt.record_every = record_every
+    s.opt.fall_hip_height = fall_hip_height
+    s.opt.fall_depth = fall_depth
+    s.opt.max_speed = max_speed
+    s.opt.max_steps = max_steps if pdw_methods[method].adaptive else 0
     s.poll_every = poll_every
     if buffers is not None and record_every > 0:
         # caller-owned record arrays (reused between runs: no fresh pages to fault in);
@@ -527,13 +529,13 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         if record_contact:
             s.rec_contact = &v_c[0, 0]
     s.rec_capacity = n_rec_cap
-    s.record_events = record_events
+    s.opt.record_events = record_events
     s.events = &v_e[0, 0] if record_events else NULL
     s.ev_capacity = events.shape[0] if record_events else 0
-    s.stop_steps = stop_steps
-    s.stop_touch_down = stop_touch_down
-    s.periodic_k = periodic_k
-    s.periodic_tol = periodic_tol
+    s.opt.stop_steps = stop_steps
+    s.opt.stop_touch_down = stop_touch_down
+    s.opt.periodic_k = periodic_k
+    s.opt.periodic_tol = periodic_tol
     pdw_gait_init(&s.gait)
     memcpy(s.x, &x0[0], nx * sizeof(double))
     flags0[0] = f1; flags0[1] = f2

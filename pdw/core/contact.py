@@ -285,7 +285,7 @@ class Contact:
 
     def vector(self, p: np.ndarray, features=None, params: Params | None = None) -> np.ndarray:
         """Fill the contact-law entries (`pdw.core._layout.CONTACT_PARAMS`) of a kernel parameter
-        vector ``p`` (from `pdw.model.parameter_vector`) in place; returns ``p``. Without the
+        vector ``p`` (from `pdw.core.model.parameter_vector`) in place; returns ``p``. Without the
         ``normal_damping`` feature, e = 1 (no damping). LuGre's unset Stribeck parameters come
         from ``params`` (default `Params.paper`)."""
         if self.friction == "lugre":

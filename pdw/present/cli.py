@@ -1,7 +1,7 @@
 """Command line: ``pdw walk`` (the main job), ``pdw run`` (a scene) and ``pdw sweep`` (a study).
 
 ``pdw walk`` runs the paper's typical gait (Sec. 3.2: `Params.paper()`, x0 of
-`pdw.simulation.X0_PAPER`, 3.5 s, dt = 1e-4, the central difference method), prints the step
+`pdw.X0_PAPER`, 3.5 s, dt = 1e-4, the central difference method), prints the step
 table next to the paper's numbers, and writes the report, the step table, the run's metadata,
 the scene as run and the figures (Figs. 4-7 and an animated GIF) to an output folder. With
 ``--scene FILE`` the run starts from a `pdw.Scene` file (the same schema as ``pdw run``);
@@ -107,9 +107,10 @@ def walk_scene(args) -> Scene:
     scene = Scene.load(args.scene) if args.scene else Scene(name="typical gait")
     top = {k: getattr(args, k) for k in ("preset", "variant") if getattr(args, k) is not None}
     integrator = {k: v for k, v in (("method", args.method), ("dt", args.dt)) if v is not None}
-    stop = {"on_failure": "return", **({"t_end": args.t_end} if args.t_end is not None else {})}
+    stop = {"t_end": args.t_end} if args.t_end is not None else {}
     record = {"every": args.record_every} if args.record_every is not None else {}
-    return scene.replace(**top, integrator=integrator, stop=stop, record=record)
+    return scene.replace(**top, integrator=integrator, stop=stop, record=record,
+                         limits={"on_failure": "return"})
 
 
 def _walk(args):

@@ -12,25 +12,34 @@ shared counter.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import pathlib
 from dataclasses import dataclass, field
+from typing import Any, Literal, Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-from ..core import _batch, _layout, checks, interrupt
+from ..core import _batch, _layout, checks, interrupt  # type: ignore[attr-defined]
 from ..core.errors import InvalidInputError
 from ..core.integrators import METHODS
 from ..core.integrators import get as _method_info
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
+from ..core.params import Params
+from ..core.progress import Progress, progress_bar
 from . import files as _files
+from . import options as _opt
 from . import stepsize as _stepsize
 from .chunks import _plist, check_record, honest, record_subset, run_chunked
 from .gait import Steps, steps_from_rows
 from .simulation import _REASONS, Event, Result, _check_count, _check_positive
 
-_STATUS = {0: "interrupted", 1: "walked", 2: "fell", 3: "diverged", 5: "diverged", 6: "periodic"}
+#: A walker's loop status (layout STATUS) -> its BatchResult status (running: interrupted).
+_STATUS = {_layout.STATUS.index(c): s for c, s in (
+    ("running", "interrupted"), ("done", "walked"), ("fell", "fell"), ("diverged", "diverged"),
+    ("singular", "diverged"), ("periodic", "periodic"))}
 _STOP = {i: ("t_end" if i == 0 else name) for i, name in enumerate(_layout.STOP)}
 LANES = 8
 """Default lanes per block (walkers advanced in lockstep by one thread)."""
@@ -114,6 +123,28 @@ class BatchResult:
     def __len__(self) -> int:
         return len(self.status)
 
+    def __repr__(self) -> str:
+        n = len(self)
+        how = self.method if self.method in ("dopri5", "rodas4") else \
+            "%s dt = %.3g s" % (self.method, self.dt)
+        names, counts = np.unique(np.asarray(self.status, dtype=str), return_counts=True)
+        order = np.argsort(-counts, kind="stable")
+        status = ", ".join("%d %s" % (counts[i], names[i]) for i in order) or "none"
+        arrays = ", ".join(
+            "%s %s" % (f.name, "x".join(map(str, getattr(self, f.name).shape)))
+            for f in dataclasses.fields(self) if isinstance(getattr(self, f.name), np.ndarray)
+            and getattr(self, f.name).ndim > 1)
+        lines = ["<pdw.BatchResult: %d walker%s, %s variant, %s, t_end = %.6g s, engine %s"
+                 % (n, "" if n == 1 else "s", self.variant, how, self.t_end, self.engine),
+                 "  status: %s" % status,
+                 "  per walker (N,): status, stop_reason, t_final, n_steps, n_touch_down, "
+                 "n_lift_off, n_gait_steps, failure_*",
+                 "  %s; steps(i), to_dataframe()" % arrays]
+        if self.recorded:
+            lines.append("  recorded: walkers %s" % ", ".join(map(str, sorted(self.recorded)[:8]))
+                         + (", ..." if len(self.recorded) > 8 else ""))
+        return "\n".join(lines) + ">"
+
     @property
     def walked(self) -> np.ndarray:
         """(N,) bool: did each walker keep walking to the end (t_end or a stop condition)?"""
@@ -185,29 +216,41 @@ def _flags(flags0, n):
     return np.ascontiguousarray(f, dtype=np.intc)
 
 
-def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
-                   flags0=(0, 1), threads=None, lanes=LANES, vector=False, stop_steps=0,
-                   periodic_steps=0, periodic_tol=1e-3, fall_hip_height=None, fall_depth=None,
-                   max_speed=1e3, check_step="warn", rtol=1e-6, atol=1e-8, h_max=None,
-                   event_tol=1e-9, max_steps=None, *, executor=None, chunk_size=None,
-                   record=None, record_every=1, stop_touch_down=0) -> BatchResult:
+def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None = None,
+                   *_positional, params: Params | Sequence[Params] | None = None,
+                   variant: Literal["paper", "consistent"] = "paper", method: str | None = None,
+                   integrator: _opt.Integrator | dict | None = None,
+                   stop: _opt.Stop | dict | None = None, limits: _opt.Limits | dict | None = None,
+                   flags0: ArrayLike = (0, 1), threads: int | None = None, lanes: int = LANES,
+                   vector: bool = False, executor: Any = None, chunk_size: int | None = None,
+                   record: Sequence[int] | None = None, record_every: int = 1,
+                   progress: bool | Progress = False, **_legacy) -> BatchResult:
     """Simulate N walkers at once: the result of `pdw.simulate` for each, without recording.
 
     Parameters
     ----------
     x0 : array (N, 8)
         Initial states, layout `pdw.STATE` [m, rad, m/s, rad/s].
-    t_end, dt : float
-        End time and step [s], as `simulate` (n_steps = round(t_end/dt)).
+    t_end, dt : float, optional
+        End time and step [s], as `simulate` (n_steps = round(t_end/dt); defaults
+        ``stop.t_end`` and ``integrator.dt``).
     params : Params or sequence of N Params, optional
         One parameter set for all walkers (default: the paper's) or one per walker.
     variant : {"paper", "consistent"}
-    method : {"cdm", "verlet", "rk4", "dopri5", "rodas4"}
-        "cdm" (the paper's central difference method, docs/model.md section 7) runs the lockstep
-        lane loop; every other method of `pdw.METHODS` runs per lane through the scalar
+    method : {"cdm", "verlet", "rk4", "dopri5", "rodas4"}, optional
+        The short form of ``integrator=Integrator(method=...)`` (default "cdm"). "cdm" (the
+        paper's central difference method, docs/model.md section 7) runs the lockstep lane
+        loop; every other method of `pdw.METHODS` runs per lane through the scalar
         integrator's C, one (accepted) step per lane per round: each lane keeps its own time,
         step size, accept/reject and event location, and every walker is bitwise its
         `simulate` run (docs/ensemble.md). For the adaptive methods dt is the first step.
+    integrator, stop, limits : pdw.Integrator, pdw.Stop, pdw.Limits, optional
+        As `simulate` (`pdw.sim.options`): the tolerances and step budget (of each walker),
+        the stop conditions, the fall and divergence bounds (``fall_hip_height`` and
+        ``fall_depth`` default to 0.5 l and 0.25 l of each walker's parameters). A divergence
+        is a status here (``"diverged"``), never an error (``limits.on_failure`` does not
+        apply); the end-of-run checks of `simulate` (runaway, ``"no_steps"``) are applied to
+        the final states (`pdw.sim.chunks.honest`).
     flags0 : (2,) or (N, 2) ints in {0, 1}
         Initial support flags of legs 1, 2.
     threads : int, optional
@@ -222,13 +265,6 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
         the adaptive step sequence (rodas4) turn those last bits into shifts of events, so final
         states then agree with `simulate` in outcome, not to 1e-12 (docs/ensemble.md). The
         results do not depend on the lane or thread a walker runs in.
-    stop_steps, periodic_steps, periodic_tol, fall_hip_height, fall_depth, max_speed, check_step
-    rtol, atol, h_max, event_tol, max_steps
-        As `simulate` (adaptive methods; max_steps is the budget of each walker).
-        As `simulate`; fall_hip_height and fall_depth default to 0.5 l and 0.25 l of each
-        walker's parameters. A divergence is a status here (``"diverged"``), never an error;
-        the end-of-run checks of `simulate` (runaway, ``"no_steps"``) are applied to the final
-        states (`pdw.sim.chunks.honest`).
     executor : concurrent.futures.Executor-like, optional
         Cut the batch into chunks of ``chunk_size`` consecutive walkers, each one task
         ``executor.submit`` (a thread or process pool, Dask's ``client.get_executor()``), the
@@ -245,9 +281,15 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
         bitwise path (``vector=False``) those runs are the lanes' arithmetic: same ``x_final``.
     record_every : int
         Sampling of the recorded walkers (every k-th step, >= 1).
-    stop_touch_down : {0, 1, 2}
-        As `simulate`: stop each walker at the first touch-down of leg 1 or 2 (``stop_reason``
-        ``"touch_down"``, ``x_final`` the event's state); 0: off.
+    progress : bool or Progress
+        A progress bar over the walkers (`pdw.core.progress`): True draws on stderr when it is
+        a terminal, a `Progress` of the caller's gets N added to its total. The batch then
+        runs in chunks (``chunk_size``, default N / 50 but at least one block per thread),
+        bitwise the unchunked batch.
+    **_legacy
+        The keywords of before (``rtol=``, ``stop_steps=``, ``max_speed=``, ...) and the
+        positional form: they work for one release, each with a `DeprecationWarning` naming
+        its new spelling (`pdw.sim.options.LEGACY`).
 
     Returns
     -------
@@ -261,21 +303,45 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
         thread): ``.result`` is the partial `BatchResult`, whose unfinished walkers have status
         ``"interrupted"`` and their state when stopped (or at t = 0 if never started).
     """
+    settled = _opt.settle(
+        "simulate_batch", _positional, _legacy, integrator=integrator, stop=stop,
+        limits=limits, method=method, dt=dt, t_end=t_end,
+        keywords=dict(params=(params, None), variant=(variant, "paper"), method=(method, None),
+                      flags0=(flags0, (0, 1)), threads=(threads, None), lanes=(lanes, LANES),
+                      vector=(vector, False)))
+    it, _, st, lim, method, dt, t_end, plain = settled
+    params = plain.get("params", params)
+    variant = plain.get("variant", variant)
+    flags0 = plain.get("flags0", flags0)
+    threads = plain.get("threads", threads)
+    lanes = plain.get("lanes", lanes)
+    vector = plain.get("vector", vector)
     x = _rows(x0)
     n = len(x)
     if record is not None:
         check_record(record, n)              # before the run, not after it
+    bar = None if progress is False or progress is None else \
+        progress_bar(progress, n, "simulate_batch")
+    if bar is not None and chunk_size is None:
+        chunk_size = max(lanes * ((os.cpu_count() or 1) if threads is None else int(threads)),
+                         math.ceil(n / 50), 1)
     if executor is not None or chunk_size is not None:
-        kw = dict(x0=x, t_end=t_end, dt=dt, params=params, variant=variant, method=method,
-                  flags0=flags0, threads=threads, lanes=lanes, vector=vector,
-                  stop_steps=stop_steps, periodic_steps=periodic_steps,
-                  periodic_tol=periodic_tol, fall_hip_height=fall_hip_height,
-                  fall_depth=fall_depth, max_speed=max_speed, check_step=check_step,
-                  rtol=rtol, atol=atol, h_max=h_max, event_tol=event_tol, max_steps=max_steps,
-                  record=record, record_every=record_every, stop_touch_down=stop_touch_down)
+        it_run, st_run = settled.ran()
+        kw = dict(x0=x, params=params, variant=variant, integrator=it_run, stop=st_run,
+                  limits=lim, flags0=flags0, threads=threads, lanes=lanes, vector=vector,
+                  record=record, record_every=record_every)
         if chunk_size is None:
             chunk_size = max(1, math.ceil(n / 8))
-        return run_chunked(simulate_batch, kw, executor, chunk_size)
+        try:
+            return run_chunked(simulate_batch, kw, executor, chunk_size, progress=bar)
+        finally:
+            if progress is True and bar is not None:
+                bar.close()
+    rtol, atol, h_max, event_tol, max_steps, check_step = (
+        it.rtol, it.atol, it.h_max, it.event_tol, it.max_steps, it.check_step)
+    stop_steps, periodic_steps, periodic_tol, stop_touch_down = (
+        st.steps, st.periodic_k, st.periodic_tol, st.touch_down)
+    fall_hip_height, fall_depth, max_speed = lim.fall_hip_height, lim.fall_depth, lim.max_speed
     t_end = _check_positive("t_end", t_end)
     dt = _check_positive("dt", dt)
     if dt > t_end:
@@ -359,19 +425,14 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
             unstarted = np.isnan(out["t_final"])
             out["x_final"][unstarted] = x[unstarted]
             out["t_final"][unstarted] = 0.0
-            e.result = _result(out, dt, t_stop, method, variant)
+            e.result = _result(out, dt, t_stop, method, variant)  # type: ignore[attr-defined]
             raise
     res = _result(out, dt, t_stop, method, variant)
     honest(res, x, plist if len(plist) == n else plist[0])
     if record is not None:
         res.recorded = record_subset(
             res, record, record_every, x, plist if len(plist) == n else plist[0], f0,
-            dict(t_end=t_end, dt=dt, variant=variant, method=method, stop_steps=stop_steps,
-                 periodic_steps=periodic_steps, periodic_tol=periodic_tol,
-                 fall_hip_height=fall_hip_height, fall_depth=fall_depth, max_speed=max_speed,
-                 check_step=check_step, rtol=rtol, atol=atol,
-                 h_max=None if h_max == 0.0 else h_max, event_tol=event_tol,
-                 max_steps=max_steps, stop_touch_down=stop_touch_down))
+            dict(zip(("integrator", "stop"), settled.ran()), variant=variant, limits=lim))
     return res
 
 

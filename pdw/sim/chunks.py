@@ -22,6 +22,7 @@ import numpy as np
 from ..core import checks
 from ..core.errors import InvalidInputError
 from ..core.params import Params
+from .options import Limits, Record
 from .simulation import NO_STEP_PERIODS, RUNAWAY_ANGLE, RUNAWAY_HIP, _check_count, simulate
 
 #: Keywords of `simulate_batch` that `pdw.simulate` does not take.
@@ -172,7 +173,8 @@ def check_record(record, n) -> list:
 def record_subset(b, record, record_every, x0, params, flags0, options) -> dict:
     """``{i: Result}``: walkers ``record`` run again through `pdw.simulate` with
     ``record_every`` (states, flags, forces and events recorded, ``on_failure="return"``),
-    with the batch's other inputs ``options`` (its keywords that `pdw.simulate` also takes)."""
+    with the batch's other inputs ``options`` (its keywords that `pdw.simulate` also takes:
+    variant, the option objects ``integrator``, ``stop``, ``limits``, features, contact)."""
     n = len(b)
     idx = check_record(record, n)
     every = _check_count("record_every", record_every)
@@ -181,5 +183,7 @@ def record_subset(b, record, record_every, x0, params, flags0, options) -> dict:
     plist = _plist(params, n)
     f0 = np.broadcast_to(np.asarray(flags0), (n, 2))
     kw = {k: v for k, v in options.items() if k not in _NOT_SIMULATE}
-    return {i: simulate(x0[i], params=plist[i], flags0=tuple(int(v) for v in f0[i]),
-                        record_every=every, on_failure="return", **kw) for i in idx}
+    kw["limits"] = (kw.get("limits") or Limits()).replace(on_failure="return")
+    kw["record"] = Record(every=every)
+    return {i: simulate(x0[i], params=plist[i], flags0=tuple(int(v) for v in f0[i]), **kw)
+            for i in idx}

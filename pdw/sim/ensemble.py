@@ -13,20 +13,26 @@
 """
 from __future__ import annotations
 
-import inspect
 import os
 from concurrent.futures import ThreadPoolExecutor
 from functools import lru_cache
+from typing import Any, Iterable, Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..core import _layout
 from ..core.contact import Contact
 from ..core.errors import InvalidInputError
 from ..core.model import STATE
+from ..core.params import Params
+from ..core.progress import Progress
+from . import options as _opt
 from .batch import BatchResult, _flags, _rows, simulate_batch
 from .chunks import _plist, record_subset, run_chunked
 from .simulation import _check_count, simulate
+
+_EVENTS_ONLY = _opt.Record(every=0, forces=False, events=True)
 
 
 @lru_cache(maxsize=None)
@@ -34,8 +40,8 @@ def supports(method, variant="paper") -> bool:
     """True if `simulate_batch` runs ``method`` (it refuses the others with
     `InvalidInputError`); asked with an empty batch, so nothing is simulated."""
     try:
-        simulate_batch(np.zeros((0, len(STATE))), t_end=1.0, dt=1e-4, variant=variant,
-                       method=method, check_step="off")
+        simulate_batch(np.zeros((0, len(STATE))), t_end=1.0, variant=variant,
+                       integrator=_opt.Integrator(method=method, dt=1e-4, check_step="off"))
     except InvalidInputError:
         return False
     return True
@@ -49,38 +55,50 @@ def plain_model(features=None, contact=None) -> bool:
     return contact is None or Contact.coerce(contact).is_default
 
 
-def scalar_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
-                 flags0=(0, 1), threads=None, stop_steps=0, periodic_steps=0, periodic_tol=1e-3,
-                 fall_hip_height=None, fall_depth=None, max_speed=1e3, check_step="warn", *,
-                 executor=None, chunk_size=None, record=None, record_every=1,
-                 **options) -> BatchResult:
+def scalar_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None = None,
+                 *_positional, params: Params | Sequence[Params] | None = None,
+                 variant: str = "paper", method: str | None = None,
+                 integrator: _opt.Integrator | dict | None = None,
+                 stop: _opt.Stop | dict | None = None, limits: _opt.Limits | dict | None = None,
+                 flags0: ArrayLike = (0, 1), threads: int | None = None, executor: Any = None,
+                 chunk_size: int | None = None, record: Sequence[int] | None = None,
+                 record_every: int = 1, features: Iterable[str] | None = None,
+                 contact: Contact | dict | str | None = None, **_legacy) -> BatchResult:
     """`simulate_batch`'s result computed walker by walker with `pdw.simulate`.
 
-    Parameters are those of `simulate_batch` (``lanes`` and ``vector`` do not apply); any
-    further ``options`` of `pdw.simulate` (``rtol``, ``atol``, ``event_tol``, ``h_max``,
-    ``features``, ``contact``) are passed on. ``threads`` (default os.cpu_count()) run walkers
-    in parallel (the compiled loop releases the GIL). Any method of `pdw.METHODS`.
+    Parameters are those of `simulate_batch` (``lanes`` and ``vector`` do not apply), and
+    `pdw.simulate`'s ``features`` and ``contact``. ``threads`` (default os.cpu_count()) run
+    walkers in parallel (the compiled loop releases the GIL). Any method of `pdw.METHODS`.
+    The keywords of before (``rtol=``, ``stop_steps=``, ...) work for one release, warning
+    (`pdw.sim.options.LEGACY`).
     """
+    settled = _opt.settle(
+        "scalar_batch", _positional, _legacy, integrator=integrator, stop=stop, limits=limits,
+        method=method, dt=dt, t_end=t_end,
+        keywords=dict(params=(params, None), variant=(variant, "paper"), method=(method, None),
+                      flags0=(flags0, (0, 1)), threads=(threads, None)))
+    plain = settled.plain
+    params = plain.get("params", params)
+    variant = plain.get("variant", variant)
+    flags0 = plain.get("flags0", flags0)
+    threads = plain.get("threads", threads)
+    it, st = settled.ran()
     x = _rows(x0)
     n = len(x)
     if executor is not None or chunk_size is not None:
-        kw = dict(x0=x, t_end=t_end, dt=dt, params=params, variant=variant, method=method,
-                  flags0=flags0, threads=threads, stop_steps=stop_steps,
-                  periodic_steps=periodic_steps, periodic_tol=periodic_tol,
-                  fall_hip_height=fall_hip_height, fall_depth=fall_depth, max_speed=max_speed,
-                  check_step=check_step, record=record, record_every=record_every, **options)
+        kw = dict(x0=x, params=params, variant=variant, integrator=it, stop=st,
+                  limits=settled.limits, flags0=flags0, threads=threads, record=record,
+                  record_every=record_every, features=features, contact=contact)
         return run_chunked(scalar_batch, kw, executor, chunk_size)
     f0 = _flags(flags0, n)
     plist = _plist(params, n)
-    kw = dict(t_end=t_end, dt=dt, variant=variant, method=method, stop_steps=stop_steps,
-              periodic_steps=periodic_steps, periodic_tol=periodic_tol,
-              fall_hip_height=fall_hip_height, fall_depth=fall_depth, max_speed=max_speed,
-              check_step=check_step, **options)
+    kw = dict(variant=variant, integrator=it, stop=st, limits=settled.limits,
+              features=features, contact=contact)
+    returned = settled.limits.replace(on_failure="return")
 
     def one(i):
         return simulate(x[i], params=plist[i], flags0=tuple(int(v) for v in f0[i]),
-                        record_every=0, record_forces=False, record_events=True,
-                        on_failure="return", **kw)
+                        record=_EVENTS_ONLY, **{**kw, "limits": returned})
 
     nt = (os.cpu_count() or 1) if threads is None else _check_count("threads", threads)
     if nt < 1:
@@ -90,7 +108,8 @@ def scalar_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method="c
     else:
         with ThreadPoolExecutor(min(nt, n)) as ex:
             results = list(ex.map(one, range(n)))
-    out = from_results(results, f0, dt=dt, t_end=t_end, method=method, variant=variant)
+    out = from_results(results, f0, dt=settled.dt, t_end=settled.t_end, method=settled.method,
+                       variant=variant)
     out.engine = "scalar"
     if record is not None:
         out.recorded = record_subset(out, record, record_every, x, plist, f0, kw)
@@ -143,22 +162,33 @@ def from_results(results, flags0, *, dt, t_end, method, variant) -> BatchResult:
         method=method, variant=variant)
 
 
-def simulate_many(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
-                  flags0=(0, 1), threads=None, *, executor=None, chunk_size=None, record=None,
-                  record_every=1, **options) -> BatchResult:
+def simulate_many(x0: ArrayLike, t_end: float | None = None, dt: float | None = None,
+                  *_positional, params: Params | Sequence[Params] | None = None,
+                  variant: str = "paper", method: str | None = None,
+                  integrator: _opt.Integrator | dict | None = None,
+                  stop: _opt.Stop | dict | None = None, limits: _opt.Limits | dict | None = None,
+                  flags0: ArrayLike = (0, 1), threads: int | None = None,
+                  lanes: int | None = None, vector: bool | None = None, executor: Any = None,
+                  chunk_size: int | None = None, record: Sequence[int] | None = None,
+                  record_every: int = 1, features: Iterable[str] | None = None,
+                  contact: Contact | dict | str | None = None,
+                  progress: bool | Progress = False, **_legacy) -> BatchResult:
     """N walkers: the batch engine when it runs ``method``, the scalar path otherwise.
 
     Parameters
     ----------
-    x0, t_end, dt, params, variant, method, flags0, threads
+    x0, t_end, dt, params, variant, method, integrator, stop, limits, flags0, threads
         As `simulate_batch` (``method``: any of `pdw.METHODS`).
+    lanes, vector, progress
+        As `simulate_batch` (the batch engine only).
     executor, chunk_size, record, record_every
         As `simulate_batch`.
-    options
-        Further options: those of `simulate_batch` (stop conditions, fall thresholds,
-        ``lanes``, ``vector``, ...) and, for the scalar path, any `pdw.simulate` option
-        (``rtol``, ``atol``, ``event_tol``, ``h_max``, ``features``, ``contact``). A non-default
-        force set or contact law also selects the scalar path (the batch engine has neither).
+    features, contact
+        As `pdw.simulate`. A non-default force set or contact law selects the scalar path
+        (the batch engine has neither).
+    **_legacy
+        The keywords of before (``rtol=``, ``stop_steps=``, ...) work for one release, warning
+        (`pdw.sim.options.LEGACY`).
 
     Returns
     -------
@@ -166,19 +196,24 @@ def simulate_many(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method="
         The same result either way; its ``engine`` says which path ran (``"batch"`` or
         ``"scalar"``).
     """
-    batch_only = {k: options.pop(k) for k in ("lanes", "vector") if k in options}
-    scalar_only = {k: options.pop(k) for k in ("rtol", "atol", "event_tol", "h_max", "features",
-                                               "contact") if k in options}
-    plain = plain_model(scalar_only.get("features"), scalar_only.get("contact"))
-    kw = dict(x0=x0, t_end=t_end, dt=dt, params=params, variant=variant, method=method,
-              flags0=flags0, threads=threads, executor=executor, chunk_size=chunk_size,
-              record=record, record_every=record_every, **options)
-    if plain and supports(method, variant):
-        accepted = inspect.signature(simulate_batch).parameters
-        out = simulate_batch(**kw, **batch_only,
-                             **{k: v for k, v in scalar_only.items() if k in accepted})
+    settled = _opt.settle(
+        "simulate_many", _positional, _legacy, integrator=integrator, stop=stop,
+        limits=limits, method=method, dt=dt, t_end=t_end,
+        keywords=dict(params=(params, None), variant=(variant, "paper"), method=(method, None),
+                      flags0=(flags0, (0, 1)), threads=(threads, None)))
+    plain = settled.plain
+    it, st = settled.ran()
+    kw = dict(params=plain.get("params", params), variant=plain.get("variant", variant),
+              integrator=it, stop=st, limits=settled.limits,
+              flags0=plain.get("flags0", flags0), threads=plain.get("threads", threads),
+              executor=executor, chunk_size=chunk_size, record=record,
+              record_every=record_every)
+    if plain_model(features, contact) and supports(settled.method, kw["variant"]):
+        batch_only: dict[str, Any] = {k: v for k, v in (("lanes", lanes), ("vector", vector))
+                                      if v is not None}
+        out = simulate_batch(x0, **kw, **batch_only, progress=progress)
         out.engine = "batch"
     else:
-        out = scalar_batch(**kw, **scalar_only)
+        out = scalar_batch(x0, **kw, features=features, contact=contact)
         out.engine = "scalar"
     return out

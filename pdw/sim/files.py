@@ -44,14 +44,15 @@ from ..core.params import Params
 from ..core.provenance import provenance
 from .dense import DenseOutput
 from .gait import STEP_UNITS, Steps
+from .options import Outcome
 
 #: The format tag of a saved `Result` (``meta["format"]``).
 FORMAT = "pdw-result-1"
 #: The format tag of a saved `BatchResult`.
 BATCH_FORMAT = "pdw-batch-1"
-#: statuses and stop reasons a saved Result can carry
-STATUSES = ("walked", "periodic", "fell", "diverged", "no_steps", "interrupted")
-STOP_REASONS = ("t_end", "steps", "periodic", "touch_down") + STATUSES
+#: statuses and stop reasons a saved Result can carry: the readings of `Outcome`
+STATUSES = tuple(dict.fromkeys(o.status for o in Outcome))
+STOP_REASONS = tuple(o.stop_reason for o in Outcome)
 
 UNITS = dict(zip(_layout.STATE, ("m", "m", "rad", "rad", "m/s", "m/s", "rad/s", "rad/s")))
 UNITS.update({name: "m" for name in _layout.BRISTLE})      # LuGre's bristle deflections

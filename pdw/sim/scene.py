@@ -17,6 +17,7 @@ TOML layout (every key optional; defaults are `Scene()`'s)::
     variant = "paper"                # docs/model.md section 6: "paper" or "consistent"
     x0 = [0.0, 0.4969, -0.0582, 0.0582, 0.5092, 0.0186, 3.3338, -1.0093]
     flags0 = [0, 1]
+    # approach_speeds0 = [0.0, 0.0]  # [m/s] of the feet starting in support (default -v_y)
 
     [params]                         # overrides of the preset, any pdw.Params field
     k_hip = 0.9
@@ -27,6 +28,8 @@ TOML layout (every key optional; defaults are `Scene()`'s)::
     rtol = 1e-06                     # adaptive methods only: rtol, atol, h_max, event_tol
     atol = 1e-08
     event_tol = 1e-09
+    check_step = "warn"              # fixed-step methods: dt above the stability limit
+    # h_max [s], max_steps: largest step and step budget of adaptive methods
 
     [forces]                         # force elements present
     hip_spring = true
@@ -40,6 +43,8 @@ TOML layout (every key optional; defaults are `Scene()`'s)::
     forces = true                    # contact forces at those samples
     energies = false                 # energies at those samples
     events = true                    # the list of touch-downs and lift-offs
+    dense_output = false             # also the interpolant Result.sol (needs every = 1)
+    # t_eval = [0.5, 1.0]            # return the solution at these times [s] (every = 1)
 
     [contact]                        # contact laws (docs/contact_laws.md)
     normal = "hunt_crossley"         # hertz, kelvin_voigt, lankarani_nikravesh, flores
@@ -52,11 +57,18 @@ TOML layout (every key optional; defaults are `Scene()`'s)::
     periodic = false                 # stop when the last periodic_steps steps agree ...
     periodic_steps = 4
     periodic_tol = 0.001             # ... within this relative tolerance
+    touch_down = 0                   # 1 or 2: stop at that leg's first touch-down (0: off)
+
+    [limits]
     max_speed = 1000.0               # diverged above this speed
     on_failure = "raise"             # a diverged run: "raise" or "return"
     # fall_hip_height, fall_depth [m]: the fall thresholds (default 0.5 l, 0.25 l)
 
-Unknown keys and values of the wrong type are errors naming the key (``record.evry``).
+Unknown keys and values of the wrong type are errors naming the key (``record.evry``). The
+sections ``[integrator]``, ``[record]``, ``[stop]`` and ``[limits]`` are the option objects of
+`pdw.sim.options` that `pdw.simulate` takes, so a scene can say everything a run can (except
+``record.out``, a buffer in memory). The fall and divergence keys of ``[stop]`` of before are
+read into ``[limits]`` for one release, with a `DeprecationWarning`.
 
 Why this module is long: it is the scene's schema, every section's fields with their TOML
 types, units, meaning and checks (the field metadata), next to the reading, checking and
@@ -65,207 +77,33 @@ writing that use them; split, a field and its check would live apart.
 from __future__ import annotations
 
 import dataclasses
-import math
 import os
 import pathlib
-from dataclasses import dataclass, field
+import warnings
+from dataclasses import dataclass
 from typing import Any
 
 from ..core import _layout, _toml
 from ..core.contact import Contact
 from ..core.errors import InvalidInputError
-from ..core.integrators import METHODS
 from ..core.params import X0_PAPER, Params
+from . import options as _options
+from .options import (  # noqa: F401  (KINDS, _Section, _coerce, _f: their home before)
+    KINDS,
+    ON_FAILURE,
+    Integrator,
+    Limits,
+    Record,
+    Stop,
+    _coerce,
+    _err,
+    _f,
+    _one_of,
+    _Section,
+)
 from .simulation import Result, simulate
 
 PRESETS = ("paper", "paper_steady")
-ON_FAILURE = ("raise", "return")
-
-
-def _f(default, kind, doc, check=None):
-    """A scene field: its TOML type (``kind``), its meaning, and a value check returning an
-    error text or None."""
-    if isinstance(default, (dict, list)):
-        return field(default_factory=lambda: type(default)(default),
-                     metadata=dict(kind=kind, doc=doc, check=check))
-    return field(default=default, metadata=dict(kind=kind, doc=doc, check=check))
-
-
-def _positive(v):
-    return None if v > 0 and math.isfinite(v) else "must be finite and > 0"
-
-
-def _nonnegative(v):
-    return None if v >= 0 else "must be >= 0"
-
-
-def _one_of(options):
-    def check(v):
-        return None if v in options else "must be one of %s" % ", ".join(map(repr, options))
-    return check
-
-
-def _method_check(v):
-    return _one_of(METHODS)(v)
-
-
-def _periodic_steps_check(v):
-    return None if 2 <= v <= _layout.STEP_RING else "must be in [2, %d]" % _layout.STEP_RING
-
-
-KINDS = {
-    "str": "a string", "float": "a number", "float?": "a number", "int": "an integer",
-    "bool": "true or false", "state": "a list of 8 numbers", "flags": "a list of two 0/1 integers",
-    "params": "a table of parameter values",
-}
-
-
-def _err(key, text):
-    return InvalidInputError("scene key %r %s" % (key, text))
-
-
-def _coerce(value, kind, key):
-    """Check the type of one value (as read from TOML or given in Python) and normalise it."""
-    def bad():
-        return _err(key, "must be %s, got %r" % (KINDS[kind], value))
-
-    def number(v):
-        return isinstance(v, (int, float)) and not isinstance(v, bool)
-
-    if kind == "str":
-        if not isinstance(value, str):
-            raise bad()
-        return value
-    if kind in ("float", "float?"):
-        if value is None and kind == "float?":
-            return None
-        if not number(value):
-            raise bad()
-        return float(value)
-    if kind == "int":
-        if not isinstance(value, int) or isinstance(value, bool):
-            raise bad()
-        return int(value)
-    if kind == "bool":
-        if not isinstance(value, bool):
-            raise bad()
-        return value
-    if kind == "state":
-        if isinstance(value, (str, bytes, dict)) or not hasattr(value, "__len__") \
-                or len(value) != len(_layout.STATE) or not all(number(v) for v in value):
-            raise bad()
-        out = tuple(float(v) for v in value)
-        for name, v in zip(_layout.STATE, out):
-            if not math.isfinite(v):
-                raise _err(key, "component %s must be finite, got %r" % (name, v))
-        return out
-    if kind == "flags":
-        if isinstance(value, (str, bytes, dict)) or not hasattr(value, "__len__") \
-                or len(value) != 2 or not all(isinstance(v, int) and not isinstance(v, bool)
-                                              and v in (0, 1) for v in value):
-            raise bad()
-        return tuple(int(v) for v in value)
-    if kind == "params":
-        if not isinstance(value, dict):
-            raise bad()
-        out = {}
-        for name, v in value.items():
-            if name not in _layout.PARAMS:
-                raise _err("%s.%s" % (key, name), "is unknown; allowed: %s"
-                           % ", ".join(_layout.PARAMS))
-            if not number(v):
-                raise _err("%s.%s" % (key, name), "must be a number, got %r" % (v,))
-            out[name] = float(v)
-        return out
-    raise AssertionError(kind)
-
-
-class _Section:
-    """A table of a scene: typed, checked fields; from and to plain dicts."""
-
-    SECTION = ""
-
-    def __post_init__(self):
-        for f in dataclasses.fields(self):
-            key = "%s.%s" % (self.SECTION, f.name) if self.SECTION else f.name
-            value = getattr(self, f.name)
-            kind = f.metadata["kind"]
-            if kind in SECTION_TYPES:
-                value = SECTION_TYPES[kind].from_dict(value) if isinstance(value, dict) else value
-                if not isinstance(value, SECTION_TYPES[kind]):
-                    raise _err(key, "must be a table (%s), got %r"
-                               % (SECTION_TYPES[kind].__name__, value))
-            else:
-                value = _coerce(value, kind, key)
-                check = f.metadata["check"]
-                problem = check(value) if (check is not None and value is not None) else None
-                if problem:
-                    raise _err(key, "%s, got %r" % (problem, value))
-            object.__setattr__(self, f.name, value)
-        self._check()
-
-    def _check(self):
-        """Checks across fields (override)."""
-
-    @classmethod
-    def from_dict(cls, data: dict, prefix: str | None = None):
-        """Build from a (TOML) table; unknown keys are errors naming the key."""
-        prefix = cls.SECTION if prefix is None else prefix
-        if not isinstance(data, dict):
-            raise _err(prefix, "must be a table, got %r" % (data,))
-        names = [f.name for f in dataclasses.fields(cls)]  # type: ignore[arg-type]
-        for key in data:
-            if key not in names:
-                full = "%s.%s" % (prefix, key) if prefix else key
-                raise _err(full, "is unknown; allowed here: %s" % ", ".join(names))
-        return cls(**data)
-
-    def to_dict(self) -> dict:
-        """Plain dict (nested for sections); None values left out (TOML has no null)."""
-        out: dict[str, Any] = {}
-        for f in dataclasses.fields(self):  # type: ignore[arg-type]
-            v = getattr(self, f.name)
-            if isinstance(v, _Section):
-                out[f.name] = v.to_dict()
-            elif isinstance(v, tuple):
-                out[f.name] = list(v)
-            elif isinstance(v, dict):
-                out[f.name] = dict(v)
-            elif v is not None:
-                out[f.name] = v
-        return out
-
-    def replace(self, **changes):
-        """A copy with some fields changed; a table given as a dict updates that table."""
-        d = self.to_dict()
-        for key, v in changes.items():
-            if key not in d and key not in {f.name for f in dataclasses.fields(self)}:
-                full = "%s.%s" % (self.SECTION, key) if self.SECTION else key
-                raise _err(full, "is unknown; allowed here: %s"
-                           % ", ".join(f.name for f in dataclasses.fields(self)))
-            if isinstance(v, dict) and isinstance(d.get(key), dict):
-                d[key] = {**d[key], **v}
-            elif isinstance(v, _Section):
-                d[key] = v.to_dict()
-            else:
-                d[key] = v
-        return type(self).from_dict(d)
-
-
-@dataclass(frozen=True)
-class Integrator(_Section):
-    """How the run is integrated (docs/integrators.md)."""
-
-    SECTION = "integrator"
-    method: str = _f("cdm", "str", "integrator: cdm (the paper's), verlet, rk4, dopri5, rodas4",
-                     _method_check)
-    dt: float = _f(1e-4, "float", "step [s]; adaptive methods: the first trial step", _positive)
-    rtol: float = _f(1e-6, "float", "relative tolerance of adaptive methods", _positive)
-    atol: float = _f(1e-8, "float", "absolute tolerance of adaptive methods", _positive)
-    h_max: float | None = _f(None, "float?", "largest step of adaptive methods [s] (none)",
-                             _positive)
-    event_tol: float = _f(1e-9, "float", "adaptive methods locate flag switches to this [s]",
-                          _positive)
 
 
 @dataclass(frozen=True)
@@ -292,59 +130,6 @@ class Forces(_Section):
             raise _err("forces", "has no element(s) %s; allowed: %s"
                        % (", ".join(sorted(unknown)), ", ".join(_layout.FEATURES)))
         return cls(**{f: f in features for f in _layout.FEATURES})
-
-
-@dataclass(frozen=True)
-class Record(_Section):
-    """What the run records. The gait descriptors are always computed (online, O(1) memory:
-    `Result.gait`)."""
-
-    SECTION = "record"
-    every: int = _f(1, "int", "full state every k steps (0: none)", _nonnegative)
-    forces: bool = _f(True, "bool", "contact forces at the recorded samples")
-    energies: bool = _f(False, "bool", "energies at the recorded samples (needs every > 0)")
-    events: bool = _f(True, "bool", "the list of touch-downs and lift-offs (else only counts)")
-
-    def _check(self):
-        if self.energies and self.every == 0:
-            raise _err("record.energies", "needs recorded states (record.every > 0)")
-
-    @classmethod
-    def full(cls, every: int = 1) -> "Record":
-        """Everything: state, flags, contact forces and energies every step, events."""
-        return cls(every=every, forces=True, energies=True, events=True)
-
-    @classmethod
-    def events_only(cls) -> "Record":
-        """The events (and the descriptors), no samples."""
-        return cls(every=0, forces=False, energies=False, events=True)
-
-    @classmethod
-    def descriptors_only(cls) -> "Record":
-        """Only the gait descriptors and event counts: O(1) memory however long the run."""
-        return cls(every=0, forces=False, energies=False, events=False)
-
-
-@dataclass(frozen=True)
-class Stop(_Section):
-    """When the run ends: t_end, a number of gait steps, a periodic gait, or a fall (always)."""
-
-    SECTION = "stop"
-    t_end: float = _f(3.5, "float", "duration [s]", _positive)
-    steps: int = _f(0, "int", "stop after this many complete gait steps (0: no limit)",
-                    _nonnegative)
-    periodic: bool = _f(False, "bool", "stop when the last periodic_steps steps agree")
-    periodic_steps: int = _f(4, "int", "k: how many successive steps must agree",
-                             _periodic_steps_check)
-    periodic_tol: float = _f(1e-3, "float", "relative tolerance on L, travel, P and cycle",
-                             _positive)
-    fall_hip_height: float | None = _f(None, "float?", "fell when the hip is lower [m] "
-                                       "(default 0.5 l)")
-    fall_depth: float | None = _f(None, "float?", "fell when a foot is deeper [m] "
-                                  "(default 0.25 l)", _positive)
-    max_speed: float = _f(1e3, "float", "diverged when a velocity exceeds this", _positive)
-    on_failure: str = _f("raise", "str", "a diverged run: raise DivergedError, or return it",
-                         _one_of(ON_FAILURE))
 
 
 @dataclass(frozen=True)
@@ -378,7 +163,9 @@ class ContactLaws(_Section):
 
 
 SECTION_TYPES = {"integrator": Integrator, "forces": Forces, "record": Record, "stop": Stop,
-                 "contact": ContactLaws}
+                 "limits": Limits, "contact": ContactLaws}
+_options._EXTRA_SECTIONS.update(forces=Forces, contact=ContactLaws)
+MOVED_TO_LIMITS = _options.MOVED_TO_LIMITS   # keys of [stop] read into [limits], warning
 
 
 @dataclass(frozen=True)
@@ -404,9 +191,39 @@ class Scene(_Section):
     forces: Forces = _f(Forces(), "forces", "force elements present")
     record: Record = _f(Record(), "record", "what is recorded")
     stop: Stop = _f(Stop(), "stop", "when the run stops")
+    limits: Limits = _f(Limits(), "limits", "when the run fell or diverged")
     contact: ContactLaws = _f(ContactLaws(), "contact", "normal and friction contact laws")
+    approach_speeds0: tuple | None = _f(None, "pair?", "approach speeds [m/s] of the feet "
+                                        "that start in support (default max(-v_y, 0))")
+    ground: Any = _f(None, "object", "the ground under the walker (a Ground; default the "
+                     "paper's slope)")
+
+    def __post_init__(self):
+        stop, limits = _move_limits(self.stop, self.limits)
+        object.__setattr__(self, "stop", stop)
+        object.__setattr__(self, "limits", limits)
+        super().__post_init__()
+
+    def replace(self, **changes) -> Scene:
+        """A copy with some fields changed; a table given as a dict updates that table."""
+        if isinstance(changes.get("stop"), dict):
+            moved = {k: v for k, v in changes["stop"].items() if k in MOVED_TO_LIMITS}
+            if moved:
+                _warn_moved(moved)
+                changes["stop"] = {k: v for k, v in changes["stop"].items() if k not in moved}
+                lim = changes.get("limits", {})
+                changes["limits"] = {**(lim.to_dict() if isinstance(lim, Limits) else lim),
+                                     **moved}
+        return super().replace(**changes)
 
     def _check(self):
+        it, st = self.integrator, self.stop         # a scene says its method, dt and t_end
+        if it.method is None or it.dt is None:
+            object.__setattr__(self, "integrator", _options._with(
+                it, method=it.method or _options.METHOD,
+                dt=_options.DT if it.dt is None else it.dt))
+        if st.t_end is None:
+            object.__setattr__(self, "stop", _options._with(st, t_end=_options.T_END))
         for name, value in self.params.items():
             try:
                 Params.preset(self.preset, **{name: value})
@@ -435,18 +252,16 @@ class Scene(_Section):
         return self.forces.present()
 
     def simulate_kwargs(self) -> dict:
-        """The `pdw.simulate` arguments this scene stands for."""
-        st, it, rec = self.stop, self.integrator, self.record
-        return dict(
-            x0=self.x0, t_end=st.t_end, dt=it.dt, params=self.parameters(), variant=self.variant,
-            method=it.method, flags0=self.flags0, record_every=rec.every,
-            record_forces=rec.forces, on_failure=st.on_failure,
-            fall_hip_height=st.fall_hip_height, fall_depth=st.fall_depth,
-            max_speed=st.max_speed, rtol=it.rtol, atol=it.atol, h_max=it.h_max,
-            event_tol=it.event_tol, features=self.features, record_events=rec.events,
-            record_energies=rec.energies, stop_steps=st.steps,
-            periodic_steps=st.periodic_steps if st.periodic else 0,
-            periodic_tol=st.periodic_tol, contact=self.contact.to_contact())
+        """The `pdw.simulate` arguments this scene stands for: x0, t_end, dt, the option
+        objects (`pdw.sim.options`) and the model (params, variant, features, contact, ...)."""
+        kw = dict(x0=self.x0, t_end=self.stop.t_end, dt=self.integrator.dt,
+                  params=self.parameters(), variant=self.variant, flags0=self.flags0,
+                  integrator=self.integrator, record=self.record, stop=self.stop,
+                  limits=self.limits, features=self.features,
+                  contact=self.contact.to_contact(), approach_speeds0=self.approach_speeds0)
+        if self.ground is not None:
+            kw["ground"] = self.ground
+        return kw
 
     def run(self) -> Result:
         """Run the scene (`pdw.simulate` with the scene's settings).
@@ -525,6 +340,34 @@ class Scene(_Section):
         path = pathlib.Path(path)
         path.write_text(self.to_toml())
         return path
+
+
+def _warn_moved(moved):
+    warnings.warn("scene [stop] keys %s moved to [limits] (pdw.Limits); [stop] reads them for "
+                  "one more release" % ", ".join(sorted(moved)), DeprecationWarning, stacklevel=4)
+
+
+def _move_limits(stop, limits):
+    """A [stop] table of before with fall and divergence keys: move them to [limits]."""
+    if not isinstance(stop, dict):
+        return stop, limits
+    moved = {k: stop[k] for k in MOVED_TO_LIMITS if k in stop}
+    if not moved:
+        return stop, limits
+    _warn_moved(moved)
+    if isinstance(limits, Limits):
+        if limits != Limits():
+            both = [k for k in moved if getattr(limits, k) != getattr(Limits(), k)]
+            if both:
+                raise _err("stop.%s" % both[0], "is given in [limits] too: give it there only")
+        limits = limits.to_dict()
+    elif isinstance(limits, dict):
+        both = [k for k in moved if k in limits]
+        if both:
+            raise _err("stop.%s" % both[0], "is given in [limits] too: give it there only")
+    else:
+        return stop, limits
+    return ({k: v for k, v in stop.items() if k not in moved}, {**limits, **moved})
 
 
 def run(scene: Scene | str | os.PathLike) -> Result:

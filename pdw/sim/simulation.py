@@ -35,6 +35,7 @@ from ..core.params import X0_PAPER, Params
 from . import dense as _dense
 from . import files as _files
 from . import io as _io
+from . import options as _opt
 from . import stepsize as _stepsize
 from .buffers import RecordBuffer
 from .gait import Steps, steps_from_rows
@@ -50,18 +51,10 @@ class SceneLike(Protocol):
     def simulate_kwargs(self) -> dict: ...
 
 _STATUS = {i: s for i, s in enumerate(_layout.STATUS)}
-_REASONS = {
-    0: "none",
-    1: "a non-finite value (NaN or infinity) appeared in the state",
-    2: "a velocity exceeded max_speed (runaway state)",
-    3: "the hip dropped below fall_hip_height",
-    4: "a foot sank deeper than fall_depth below the ground",
-    5: "the step's linear system was singular",
-    6: "the adaptive step size underflowed (the error test never passed)",
-    7: "the step budget (max_steps) was used up before t_end",
-}
+#: Why a loop failed: PDW_REASON_* -> message (generated: derive/layout.py REASON).
+_REASONS = dict(enumerate(_layout.REASON_TEXT))
 #: Smallest step [s] (a smaller one makes the step matrices singular in double precision).
-DT_MIN = 1e-12
+DT_MIN = _opt.DT_MIN
 #: Runaway bounds checked on every recorded and the final state of a run that reached its end:
 #: the hip more than RUNAWAY_HIP leg lengths above its start, or a leg turned by more than
 #: RUNAWAY_ANGLE [rad] (a full turn).
@@ -127,6 +120,12 @@ class Result:
         With ``record_energies``: T, V_gravity, V_hip and E [J] at the recorded samples.
     sol : DenseOutput or None
         With ``dense_output=True``: the interpolant between accepted steps (`pdw.sim.dense`).
+    integrator, record, stop, limits : option objects
+        The options the run was made with (`pdw.sim.options`; ``integrator`` with the method
+        and dt run, ``stop`` with the t_end run).
+    outcome : Outcome
+        How the run ended (`pdw.sim.options.Outcome`), of which `status` and `stop_reason`
+        are the two readings.
     """
 
     t: np.ndarray
@@ -158,6 +157,16 @@ class Result:
     sol: object = None
     provenance: dict | None = None
     contact: _contact.Contact | None = None      # the pdw.Contact simulated (laws, parameters)
+    integrator: _opt.Integrator | None = None    # the options it ran with (pdw.sim.options)
+    record: _opt.Record | None = None
+    stop: _opt.Stop | None = None
+    limits: _opt.Limits | None = None
+
+    @property
+    def outcome(self) -> _opt.Outcome:
+        """How the run ended, one `pdw.sim.options.Outcome`; `status` and `stop_reason` are
+        its two readings (``Outcome.STEPS``: status ``"walked"``, stop_reason ``"steps"``)."""
+        return _opt.Outcome.of(self.status, self.stop_reason)
 
     @property
     def walked(self) -> bool:
@@ -246,30 +255,16 @@ def check_state(x0, name="x0"):
     return checks.real_array(name, x0, [shape], labels=STATE if shape == (_core.NX,) else None)
 
 
-_DEFAULTS = dict(t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm", flags0=(0, 1),
-                 record_every=1, record_forces=True, on_failure="raise", fall_hip_height=None,
-                 fall_depth=None, max_speed=1e3, rtol=1e-6, atol=1e-8, h_max=None, event_tol=1e-9,
-                 features=None, record_events=True, record_energies=False, stop_steps=0,
-                 periodic_steps=0, periodic_tol=1e-3, check_step="warn", t_eval=None,
-                 dense_output=False, out=None, max_steps=None,
-                 contact=None, approach_speeds0=None, stop_touch_down=0)
-
-
-def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float = 1e-4,
-             params: Params | None = None, variant: Literal["paper", "consistent"] = "paper",
-             method: str = "cdm", flags0: tuple[int, int] = (0, 1), record_every: int = 1,
-             record_forces: bool = True, on_failure: Literal["raise", "return"] = "raise",
-             fall_hip_height: float | None = None, fall_depth: float | None = None,
-             max_speed: float = 1e3, rtol: float = 1e-6, atol: float = 1e-8,
-             h_max: float | None = None, event_tol: float = 1e-9, *,
-             features: Iterable[str] | None = None, record_events: bool = True,
-             record_energies: bool = False, stop_steps: int = 0, periodic_steps: int = 0,
-             periodic_tol: float = 1e-3, check_step: Literal["warn", "error", "off"] = "warn",
-             t_eval: ArrayLike | None = None, dense_output: bool = False,
-             out: RecordBuffer | None = None, max_steps: int | None = None,
+def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
+             dt: float | None = None, *_positional, params: Params | None = None,
+             variant: Literal["paper", "consistent"] = "paper", method: str | None = None,
+             integrator: _opt.Integrator | dict | None = None,
+             record: _opt.Record | dict | None = None, stop: _opt.Stop | dict | None = None,
+             limits: _opt.Limits | dict | None = None,
              contact: _contact.Contact | dict | str | None = None,
-             approach_speeds0: tuple[float, float] | None = None,
-             stop_touch_down: int = 0) -> Result:
+             features: Iterable[str] | None = None, flags0: tuple[int, int] = (0, 1),
+             approach_speeds0: tuple[float, float] | None = None, ground: object = None,
+             **_legacy) -> Result:
     """Simulate the walker from ``x0`` for ``t_end`` seconds (or run a `pdw.Scene`).
 
     ``simulate(scene)`` runs the scene (as `pdw.run`); no other argument may be given then.
@@ -280,93 +275,76 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
         Initial state [x_o, y_o, theta1, theta2, xd_o, yd_o, thetad1, thetad2] (m, rad, m/s,
         rad/s), with LuGre friction optionally followed by the bristle states z1, z2 [m]
         (default 0; nx = 10). Default: the paper's typical gait (`X0_PAPER`).
-    t_end : float
-        Duration [s].
-    dt : float
-        Step [s] (the paper: 1e-4).
+    t_end : float, optional
+        Duration [s] (default ``stop.t_end``, 3.5).
+    dt : float, optional
+        Step [s] (default ``integrator.dt``, the paper's 1e-4); adaptive methods: the first
+        trial step.
     params : Params, optional
         Default `Params.paper()`.
     variant : {"paper", "consistent"}
         Contact reading of docs/model.md section 6.
-    method : str
-        Integrator (`pdw.core.integrators.INTEGRATORS`, docs/integrators.md): ``"cdm"`` is the
-        paper's central difference method (docs/model.md section 7); ``"verlet"``, ``"rk4"`` are
-        fixed-step, ``"dopri5"`` and ``"rodas4"`` (stiff, recommended) adaptive.
-    flags0 : (int, int)
-        Initial support flags of legs 1, 2 (the paper's start: leg 1 swing, leg 2 support).
-    record_every : int
-        Record every k-th step (0: record nothing but events and the final state).
-    record_forces : bool
-        Also record the contact forces Fn, Ft.
-    on_failure : {"raise", "return"}
-        A diverged run raises `pdw.DivergedError` (with the partial result attached), or
-        returns a Result with status ``"diverged"``. A fall is a status, never an error.
-    fall_hip_height : float, optional
-        The walker fell when the hip is lower than this above the slope [m]; default 0.5 l.
-    fall_depth : float, optional
-        ... or when a foot is deeper than this below the ground [m]; default 0.25 l.
-    max_speed : float
-        Diverged when any velocity component exceeds this [m/s or rad/s].
-    rtol, atol : float
-        Relative and absolute error tolerances of adaptive methods (ignored by fixed-step
-        ones); for adaptive methods ``dt`` is the first trial step.
-    h_max : float, optional
-        Largest step of adaptive methods [s] (default: no limit).
-    event_tol : float
-        Adaptive methods locate each flag switch (touch-down, lift-off, arming) to within this
-        time [s] and end a step there (docs/integrators.md); fixed-step methods switch at step
-        boundaries.
+    method : str, optional
+        Integrator (`pdw.core.integrators.INTEGRATORS`, docs/integrators.md), the short form
+        of ``integrator=Integrator(method=...)``: ``"cdm"`` (default) is the paper's central
+        difference method (docs/model.md section 7); ``"verlet"``, ``"rk4"`` are fixed-step,
+        ``"dopri5"`` and ``"rodas4"`` (stiff, recommended) adaptive.
+    integrator : pdw.Integrator, optional
+        How the run is integrated: method, dt, the tolerances rtol and atol, h_max and
+        event_tol of the adaptive methods (which locate each flag switch to within event_tol
+        [s] and end a step there; fixed-step methods switch at step boundaries), their step
+        budget max_steps (default 10^6 + 2 10^6 t_end/s; fixed-step methods take t_end/dt
+        steps and refuse a budget below that), and check_step: fixed-step methods compare dt
+        with `pdw.sim.stepsize.step_limit` (the method's estimated stability limit for these
+        parameters; with another contact law, times the law's factor
+        `pdw.sim.stepsize.LAW_CALIBRATION`) and warn (`pdw.StepSizeWarning`, ``"warn"``),
+        refuse (`pdw.StepSizeError`, ``"error"``) or do not check (``"off"``). Fields:
+        `pdw.sim.options.Integrator`.
+    record : pdw.Record, optional
+        What is recorded: ``every`` k-th step (0: nothing but events and the final state),
+        ``forces`` (Fn, Ft), ``energies`` (needs every > 0), ``events`` (False: only their
+        counts and the online gait analysis, O(1) memory however long the run), ``t_eval``
+        (times [s], non-decreasing, in [0, t_end]: ``Result.t`` is then t_eval up to the run's
+        end and x, flags, Fn, Ft, energies their values there from the method's dense output,
+        `pdw.sim.dense`), ``dense_output`` (also ``Result.sol(t)``, exact at every accepted
+        step), ``out`` (a `pdw.RecordBuffer`: record into its reusable arrays; the Result's
+        arrays are then views into it). t_eval and dense_output need every = 1.
+    stop : pdw.Stop, optional
+        When the run ends of its own before t_end: ``steps`` complete gait steps (status
+        ``"walked"``, ``stop_reason`` ``"steps"``), ``periodic`` (status ``"periodic"`` as soon as
+        the last ``periodic_steps`` steps agree, each of L, travel, P and cycle within
+        ``periodic_tol`` relative: ``max - min <= tol * abs(latest)``), ``touch_down`` (1 or
+        2: at that leg's first touch-down, the final state the event's; the touch-down
+        Poincare map's end, `pdw.limit_cycle`). Its ``t_end`` is the default of ``t_end``.
+    limits : pdw.Limits, optional
+        When the run fell or diverged: ``fall_hip_height`` (the hip lower than this above the
+        slope [m]; default 0.5 l), ``fall_depth`` (a foot deeper than this below the ground
+        [m]; default 0.25 l), ``max_speed`` (a velocity component above this [m/s or rad/s]:
+        diverged), and ``on_failure``: a diverged run raises `pdw.DivergedError` (with the
+        partial result attached, ``"raise"``) or returns a Result with status ``"diverged"``
+        (``"return"``). A fall is a status, never an error.
+    contact : pdw.Contact, dict or str, optional
+        Normal and friction contact laws and their parameters (`pdw.Contact`,
+        docs/contact_laws.md); default the paper's Hunt-Crossley and smooth Coulomb laws.
     features : iterable of str, optional
         Force elements present (`pdw.core._layout.FEATURES`; default all). The absent ones are
         switched off: a specialized generated kernel if there is one, else the general kernel
         with their parameters zeroed (`Params.without`). Under LuGre friction the same, except
         that a run without ``friction`` has no bristles: it runs the normal law with the
-        default friction law switched off (8-entry state; `pdw.Contact.for_features`).
-    record_events : bool
-        Keep the list of events (False: only their counts and the online gait analysis, O(1)
-        memory however long the run).
-    record_energies : bool
-        Also return the energies at the recorded samples (needs ``record_every > 0``).
-    stop_steps : int
-        Stop after this many complete gait steps (0: no limit); status ``"walked"``,
-        ``stop_reason`` ``"steps"``.
-    periodic_steps, periodic_tol : int, float
-        With ``periodic_steps = k >= 2``: stop (status ``"periodic"``) as soon as the last k
-        steps agree, each of L, travel, P and cycle within ``periodic_tol`` relative
-        (``max - min <= tol * abs(latest)``). 0: off.
-    stop_touch_down : {0, 1, 2}
-        1 or 2: stop at that leg's first touch-down (status ``"walked"``, ``stop_reason``
-        ``"touch_down"``); the final state is the event's (located to ``event_tol`` by the
-        adaptive methods). The touch-down Poincare map's end (`pdw.limit_cycle`). 0: off.
-    check_step : {"warn", "error", "off"}
-        Fixed-step methods: compare dt with `pdw.sim.stepsize.step_limit` (the method's estimated
-        stability limit for these parameters) and warn (`pdw.StepSizeWarning`) or refuse
-        (`pdw.StepSizeError`) above it, naming the limit and the force that sets it. With
-        another contact law, the default law's estimate times the law's factor fitted on its
-        measured limits (`pdw.sim.stepsize.LAW_CALIBRATION`, docs/contact_laws.md).
-    t_eval : array_like (M,), optional
-        Times [s] (non-decreasing, in [0, t_end]) at which to return the solution, as
-        ``solve_ivp``: ``Result.t`` is then t_eval (up to the run's end) and ``x``, ``flags``,
-        ``Fn``, ``Ft`` (and ``energies``) are their values there, from the method's dense
-        output (`pdw.sim.dense`: quintic Hermite for methods of order >= 4, cubic for cdm and
-        verlet), every state entry (LuGre's bristle states too). Needs ``record_every=1``.
-    dense_output : bool
-        Also return the interpolant: ``Result.sol(t)`` -> (nx,) or (len(t), nx), exact at
-        every accepted step (``Result.sol.t``); nx = 8, or 10 with LuGre (`pdw.Contact.nx`).
-    out : RecordBuffer, optional
-        Record into these reusable arrays (`pdw.sim.buffers.RecordBuffer`) instead of fresh
-        ones: no page faults on a repeated run, of any contact law. The Result's t, x, flags,
-        Fn, Ft are then views into ``out``, overwritten by the next run that uses it.
-    max_steps : int, optional
-        Budget of integration steps of the adaptive methods (default 10^6 + 2 10^6 t_end/s);
-        a run that uses it up stops early, saying so. Fixed-step methods take t_end/dt steps
-        and refuse a budget below that.
-    contact : pdw.Contact, dict or str, optional
-        Normal and friction contact laws and their parameters (`pdw.Contact`,
-        docs/contact_laws.md); default the paper's Hunt-Crossley and smooth Coulomb laws.
+        mechanical state only (`pdw.Contact.for_features`).
+    flags0 : (int, int)
+        Initial support flags of legs 1, 2 (the paper's start: leg 1 swing, leg 2 support).
     approach_speeds0 : (float, float), optional
         Approach speeds [m/s] (>= 0) of the feet that start in support (the damping of
         lankarani_nikravesh and flores); default max(-v_y(x0), 0) of each.
+    ground : optional
+        The ground under the walker (a Ground, pdw/core/ground.py); None: the paper's slope.
+        Not run by this build yet: any other value is refused.
+    **_legacy
+        The keywords of before (``record_every=``, ``rtol=``, ``stop_steps=``, ...) and the
+        positional form ``simulate(x0, t_end, dt, params, variant, method, ...)``: they work
+        for one release, each with a `DeprecationWarning` naming its new spelling
+        (`pdw.sim.options.LEGACY`).
 
     Returns
     -------
@@ -374,14 +352,40 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
     """
     scene_kwargs = getattr(x0, "simulate_kwargs", None)
     if callable(scene_kwargs):                      # a pdw.Scene (duck-typed: scene.py is above)
-        given = sorted(k for k, v in locals().items()
-                       if k in _DEFAULTS and not _same(v, _DEFAULTS[k]))
+        given = [k for k, v in dict(t_end=t_end, dt=dt, params=params, method=method,
+                                    integrator=integrator, record=record, stop=stop,
+                                    limits=limits, contact=contact, features=features,
+                                    approach_speeds0=approach_speeds0, ground=ground).items()
+                 if v is not None] + (["variant"] if variant != "paper" else []) \
+            + (["flags0"] if not _same(flags0, (0, 1)) else []) + sorted(_legacy) \
+            + (["positional arguments"] if _positional else [])
         if given:
             raise InvalidInputError("simulate(scene) takes no other arguments (got %s): set them "
                                     "in the scene" % ", ".join(given))
         res = simulate(**scene_kwargs())
         res.scene = x0
         return res
+    settled = _opt.settle(
+        "simulate", _positional, _legacy, integrator=integrator, record=record, stop=stop,
+        limits=limits, method=method, dt=dt, t_end=t_end,
+        keywords=dict(params=(params, None), variant=(variant, "paper"), method=(method, None),
+                      flags0=(flags0, (0, 1))))
+    it, rec, st, lim, method, dt, t_end, plain = settled
+    params = plain.get("params", params)
+    variant = plain.get("variant", variant)
+    flags0 = plain.get("flags0", flags0)
+    if ground is not None:
+        raise InvalidInputError("ground: this build runs the paper's slope only (ground=None), "
+                                "got %r" % (ground,))
+    record_every, record_forces, record_events, record_energies = (
+        rec.every, rec.forces, rec.events, rec.energies)
+    t_eval, dense_output, out = rec.t_eval, rec.dense_output, rec.out
+    rtol, atol, h_max, event_tol, max_steps, check_step = (
+        it.rtol, it.atol, it.h_max, it.event_tol, it.max_steps, it.check_step)
+    stop_steps, periodic_steps, periodic_tol, stop_touch_down = (
+        st.steps, st.periodic_k, st.periodic_tol, st.touch_down)
+    fall_hip_height, fall_depth, max_speed, on_failure = (
+        lim.fall_hip_height, lim.fall_depth, lim.max_speed, lim.on_failure)
     params = Params.paper() if params is None else params
     if not isinstance(params, Params):
         raise InvalidInputError("params must be a pdw.Params, got %s" % type(params).__name__)
@@ -480,6 +484,8 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
     res = _result(raw, params, variant, method, dt, t_end, wall, on_failure, feats,
                   bool(record_events), energies, x)
     res.contact = contact
+    res.integrator, res.stop = settled.ran((method, dt, t_end))
+    res.record, res.limits = rec, lim
     if t_eval is not None or dense_output:
         res = _dense.attach(res, t_eval, dense_output, params, variant, feats,
                             _integrators.get(method).order, record_energies, contact)
@@ -575,7 +581,8 @@ def _result(raw, params, variant, method, dt, t_end, wall, on_failure,
     if res.status == "diverged" and on_failure == "raise":
         cls = SingularSystemError if status == "singular" else DivergedError
         advice = ("Check the masses and inertias (Params) and dt." if status == "singular" else
-                  "Raise max_steps, or loosen rtol/atol." if raw["failure"]["reason"] == 7 else
+                  "Raise max_steps, or loosen rtol/atol."
+                  if raw["failure"]["reason"] == _layout.REASON.index("budget") else
                   "Try a smaller dt or a stiff method.")
         raise cls("simulation diverged at t = %.6g s (step %d, dt = %g, method %s): %s; "
                   "last good state %s. %s"

@@ -52,7 +52,7 @@ def batchable(study: Study) -> bool:
     n = max(run["steady"], 2)
     if 2 * n + 2 > _layout.STEP_RING:
         return False
-    if sc.record.every != 0 or sc.stop.on_failure != "return":
+    if sc.record.every != 0 or sc.limits.on_failure != "return":
         return False
     if not ensemble.plain_model(sc.features, sc.contact.to_contact()):
         return False
@@ -79,14 +79,10 @@ def run_points(tasks) -> list:
     try:
         scene = Scene.from_dict(tasks[0]["scene"])
         params = [Params(**t["params"]) for t in tasks]
-        kw = scene.simulate_kwargs()
         b = ensemble.simulate_many(
-            [kw["x0"]] * len(tasks), t_end=kw["t_end"], dt=kw["dt"], params=params,
-            variant=kw["variant"], method=kw["method"], flags0=kw["flags0"], threads=1,
-            stop_steps=kw["stop_steps"], periodic_steps=kw["periodic_steps"],
-            periodic_tol=kw["periodic_tol"], fall_hip_height=kw["fall_hip_height"],
-            fall_depth=kw["fall_depth"], max_speed=kw["max_speed"], rtol=kw["rtol"],
-            atol=kw["atol"], h_max=kw["h_max"], event_tol=kw["event_tol"])
+            [scene.x0] * len(tasks), params=params, variant=scene.variant,
+            flags0=scene.flags0, threads=1, integrator=scene.integrator, stop=scene.stop,
+            limits=scene.limits)
     except (PdwError, ValueError):
         return [run_point(t) for t in tasks]
     share = (time.perf_counter() - t0) / len(tasks)

@@ -34,7 +34,7 @@ RUN_DEFAULTS = {"mode": "simulate", "steady": 4, "period_tol": 1e-4, "fallback":
 SCENE_DEFAULTS = {"preset": "paper_steady",
                   "integrator": {"method": "rodas4", "rtol": 1e-7, "atol": 1e-9},
                   "record": {"every": 0, "forces": False, "energies": False, "events": True},
-                  "stop": {"t_end": 16.0, "on_failure": "return"}}
+                  "stop": {"t_end": 16.0}, "limits": {"on_failure": "return"}}
 #: Keys of the earlier study format and where they live now.
 MOVED = {"preset": "scene.preset", "variant": "scene.variant", "method": "scene.integrator.method",
          "params": "scene.params", "run.t_end": "scene.stop.t_end", "run.dt": "scene.integrator.dt",

@@ -42,24 +42,18 @@ void pdw_batch_finish(const pdw_batch_job *job, long i, const pdw_sim *s)
 
 /* Load walker i into lane s and take the start-up of pdw_cdm_advance. Returns 1 if the walker
  * is still running, 0 if it finished at once (a stop condition at t = 0). */
-/* What every lane takes of walker i, whatever the method: its parameters, fall limits, stop
- * conditions, initial state and discrete state (pdw_discrete_init last, on the loaded x). The
- * caller sets the method's own fields first (s zeroed here). */
+/* What every lane takes of walker i, whatever the method: its parameters, the job's options
+ * with the walker's fall limits, initial state and discrete state (pdw_discrete_init last, on
+ * the loaded x). The caller zeroes s first and sets the method's own options after. */
 static void load_walker(const pdw_batch_job *job, long i, pdw_sim *s)
 {
     int flags0[2];
     s->kernel = job->kernel;
     s->nx = PDW_NX;             /* the smooth Coulomb law only (_batch.pyx checks) */
     memcpy(s->p, job->p + i*job->p_stride, PDW_NP * sizeof(double));
-    s->dt = job->dt;
-    s->n_steps = job->n_steps;
-    s->fall_hip_height = job->fall_hip_height[i];
-    s->fall_depth = job->fall_depth[i];
-    s->max_speed = job->max_speed;
-    s->stop_steps = job->stop_steps;
-    s->periodic_k = job->periodic_k;
-    s->stop_touch_down = job->stop_touch_down;
-    s->periodic_tol = job->periodic_tol;
+    s->opt = job->opt;
+    s->opt.fall_hip_height = job->fall_hip_height[i];
+    s->opt.fall_depth = job->fall_depth[i];
     pdw_gait_init(&s->gait);
     memcpy(s->x, job->x0 + i*PDW_NX, PDW_NX * sizeof(double));
     flags0[0] = job->flags0[2*i];
@@ -70,8 +64,9 @@ static void load_walker(const pdw_batch_job *job, long i, pdw_sim *s)
 static int start(const pdw_batch_job *job, long i, pdw_sim *s)
 {
     memset(s, 0, sizeof *s);
-    s->t_end = job->n_steps * job->dt;
     load_walker(job, i, s);
+    s->opt.t_end = job->opt.n_steps * job->opt.dt;
+    s->opt.max_steps = 0;       /* as pdw.simulate's fixed-step runs */
     /* pdw_cdm_advance's start-up (no events stored: the update cannot return -1) */
     s->status = PDW_STATUS_RUNNING;
     if (pdw_update_flags(s, 0.0) > 0) { s->started = 1; return 0; }
@@ -84,7 +79,7 @@ static int start(const pdw_batch_job *job, long i, pdw_sim *s)
 static int step(pdw_sim *s)
 {
     const pdw_kernel *k = s->kernel;
-    const double dt = s->dt;
+    const double dt = s->opt.dt;
     double *trig = s->work + PDW_WORK_TRIG, *kin = s->work + PDW_WORK_KIN;
     double *contact = s->work + PDW_WORK_CONTACT, *M = s->work + PDW_WORK_M;
     double C[PDW_NQ*PDW_NQ], QmG[PDW_NQ];
@@ -94,7 +89,7 @@ static int step(pdw_sim *s)
     k->contact(kin, s->disc.flags, s->p, contact);
     k->cdm_terms(s->x, trig, s->p, contact, M, C, QmG);
     if (pdw_cdm_update(s, M, C, QmG, t)) return 0;
-    if (s->n < s->n_steps) return 1;
+    if (s->n < s->opt.n_steps) return 1;
     /* final flags at t_end (scalar trig, as pdw_cdm_advance) */
     if (pdw_update_flags(s, s->n * dt) == 0) s->status = PDW_STATUS_DONE;
     return 0;
@@ -169,17 +164,14 @@ void pdw_batch_start_method(const pdw_batch_job *job, long i, pdw_sim *s)
 {
     const pdw_method *m = &pdw_methods[job->method];
     memset(s, 0, sizeof *s);
-    s->t_end = job->t_end;
-    s->rtol = job->rtol;
-    s->atol = job->atol;
-    s->h_max = job->h_max > 0 ? job->h_max : job->t_end;
-    s->h = job->dt;
-    s->event_tol = job->event_tol;
-    s->max_steps = m->adaptive ? job->max_steps : 0;
+    load_walker(job, i, s);
+    s->opt.h_max = job->opt.h_max > 0 ? job->opt.h_max : job->opt.t_end;
+    s->opt.event_tol = job->opt.event_tol > 0.0 ? job->opt.event_tol : 1e-9;
+    s->opt.max_steps = m->adaptive ? job->opt.max_steps : 0;
+    s->h = job->opt.dt;
     /* a poll every 2 loop iterations returns after each (accepted) step: the drivers poll at
      * the top of an iteration, where a resumed call continues exactly */
     s->poll_every = 2;
-    load_walker(job, i, s);
 }
 
 /* Every PDW_BATCH_POLL rounds: job->poll; if it says stop, write the running walkers as they
@@ -309,8 +301,8 @@ static int soa_start(const pdw_batch_job *job, long i, pdw_sim *s, pdw_soa_state
 {
     if (!start(job, i, s)) return 0;
     for (int j = 0; j < PDW_NP; ++j) S->p[j*PDW_SOA_STRIDE + l] = s->p[j];
-    S->hip[l] = s->fall_hip_height;
-    S->depth[l] = s->fall_depth;
+    S->hip[l] = s->opt.fall_hip_height;
+    S->depth[l] = s->opt.fall_depth;
     soa_load(S, l, s);
     return 1;
 }
@@ -371,7 +363,7 @@ long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_si
                 return done;
             }
         }
-        stepfn((int)kid, S, W, job->dt, job->max_speed, vector);
+        stepfn((int)kid, S, W, job->opt.dt, job->opt.max_speed, vector);
         for (int l = 0; l < W; ++l) {
             if (walker[l] < 0) continue;
             pdw_sim *s = &lanes[l];
@@ -386,15 +378,15 @@ long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_si
                 if (more) soa_load(S, l, s);
             } else {
                 s->n++;
-                s->t = s->n * s->dt;
+                s->t = s->n * s->opt.dt;
                 s->n_rhs++;
                 lane_steps++;
                 S->upd[l] = 1;
-                more = s->n < s->n_steps;
+                more = s->n < s->opt.n_steps;
                 if (!more) {
                     /* final flags at t_end (scalar trig), as step() */
                     soa_store(S, l, s);
-                    if (pdw_update_flags(s, s->n * s->dt) == 0) s->status = PDW_STATUS_DONE;
+                    if (pdw_update_flags(s, s->n * s->opt.dt) == 0) s->status = PDW_STATUS_DONE;
                 }
             }
             if (more) continue;

@@ -26,21 +26,13 @@ typedef struct pdw_batch_job {
     const double *p;            /* (n, PDW_NP) parameter vectors; (1, PDW_NP) with p_stride 0 */
     long p_stride;              /* PDW_NP, or 0 (one parameter vector for all) */
     const int *flags0;          /* (n, 2) initial support flags */
-    const double *fall_hip_height;  /* (n,) [m] */
-    const double *fall_depth;       /* (n,) [m] */
-    double dt;                  /* step [s] */
-    long n_steps;               /* steps to take (t_end = n_steps dt) */
-    double max_speed;
-    long stop_steps;            /* 0: off */
-    int periodic_k;             /* 0: off */
-    int stop_touch_down;        /* 1 or 2: stop at that leg's first touch-down; 0: off */
-    double periodic_tol;
-    /* methods other than cdm (pdw_batch_method): the settings of pdw_sim as pdw.simulate
-     * (pdw/core/_core.pyx run) sets them */
-    int method;                 /* index into pdw_methods */
-    double t_end;               /* end time [s] (adaptive methods end exactly here) */
-    double rtol, atol, h_max, event_tol;  /* adaptive methods; dt is the first step */
-    long max_steps;             /* adaptive methods' step budget (accepted + rejected); 0: none */
+    const double *fall_hip_height;  /* (n,) [m]: each walker's opt.fall_hip_height */
+    const double *fall_depth;       /* (n,) [m]: each walker's opt.fall_depth */
+    pdw_run_opts opt;           /* the options of every walker, as pdw.simulate's pdw_sim has
+                                 * them (pdw/core/_core.pyx run); nothing recorded (record_every
+                                 * = record_events = 0); t_end = n_steps dt for cdm. The fall
+                                 * limits above replace opt's per walker */
+    int method;                 /* index into pdw_methods (pdw_batch_method) */
     /* --- outputs, per walker (caller-allocated) --- */
     int *status;                /* (n,) PDW_STATUS_* */
     int *stop_reason;           /* (n,) PDW_STOP_* */

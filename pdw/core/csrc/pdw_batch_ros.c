@@ -55,8 +55,8 @@ static void ros_load(pdw_ros_soa *S, int l, pdw_sim *s, int fresh)
     }
     if (fresh) {
         for (int j = 0; j < PDW_NP; ++j) S->p[j*PDW_SOA_STRIDE + l] = s->p[j];
-        S->hip[l] = s->fall_hip_height;
-        S->depth[l] = s->fall_depth;
+        S->hip[l] = s->opt.fall_hip_height;
+        S->depth[l] = s->opt.fall_depth;
     }
 }
 
@@ -88,7 +88,7 @@ long pdw_batch_rodas4_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw
         return pdw_batch_method(job, i0, i1, W, lanes);
     const pdw_adaptive_method *m = &pdw_rodas4_method;
     long lane_steps = 0;
-    const double t_end = job->t_end;
+    const double t_end = job->opt.t_end;
     long walker[PDW_BATCH_MAXW], next = i0, since_poll = 0, done = 0;
     long nrej[PDW_BATCH_MAXW];              /* rejections of the lane's current step so far */
     double hcur[PDW_BATCH_MAXW];            /* the step size pdw_sim's h would have now */
@@ -148,9 +148,9 @@ long pdw_batch_rodas4_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw
             S->jac[l] = 0;
             if (walker[l] < 0 || mode[l] != LANE_VECTOR) continue;
             const pdw_sim *s = &lanes[l];
-            const double h = fmin(hcur[l], s->h_max);
+            const double h = fmin(hcur[l], s->opt.h_max);
             const double rem = t_end - s->t;
-            if ((s->max_steps > 0 && s->n + s->n_rejected + nrej[l] >= s->max_steps)
+            if ((s->opt.max_steps > 0 && s->n + s->n_rejected + nrej[l] >= s->opt.max_steps)
                 || h >= rem - 1e-12 * fmax(1.0, t_end)
                 || !(h > 8.0 * DBL_EPSILON * fmax(fabs(s->t), 1e-3))) {
                 mode[l] = LANE_SCALAR;      /* the budget, the last step, a step too small */
@@ -169,7 +169,7 @@ long pdw_batch_rodas4_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw
             S->jac[l] = 0;
         }
         /* (3) every vector lane's attempt */
-        tryfn((int)kid, S, W, any_jac, job->rtol, job->atol, job->max_speed, vector);
+        tryfn((int)kid, S, W, any_jac, job->opt.rtol, job->opt.atol, job->opt.max_speed, vector);
         /* (4) pdw_adaptive_advance's decision, per lane */
         for (int l = 0; l < W; ++l) {
             if (walker[l] < 0 || mode[l] != LANE_VECTOR) continue;

@@ -15,7 +15,7 @@
  * lane loop of pdw_batch.c, so both take the very same arithmetic. */
 void pdw_cdm_start(pdw_sim *s)
 {
-    const double dt = s->dt;
+    const double dt = s->opt.dt;
     double xdot[PDW_NX_MAX];
     s->kernel->rhs(s->x, s->p, s->disc.flags, s->disc.anchors, xdot, s->work);
     for (int i = 0; i < PDW_NQ; ++i)
@@ -53,7 +53,7 @@ static void bristle_update(const pdw_sim *s, double dt, double *xnew)
 
 int pdw_cdm_update(pdw_sim *s, const double *M, const double *C, const double *QmG, double t)
 {
-    const double dt = s->dt, idt2 = 1.0/(dt*dt), ih = 0.5/dt;
+    const double dt = s->opt.dt, idt2 = 1.0/(dt*dt), ih = 0.5/dt;
     double K[PDW_NQ*PDW_NQ], b[PDW_NQ], u[PDW_NQ], xnew[PDW_NX_MAX];
     for (int i = 0; i < PDW_NQ; ++i) {
         double mu = 0.0, ku = 0.0;
@@ -88,7 +88,7 @@ int pdw_cdm_update(pdw_sim *s, const double *M, const double *C, const double *Q
 int pdw_cdm_advance(pdw_sim *s)
 {
     const pdw_kernel *k = s->kernel;
-    const double dt = s->dt;
+    const double dt = s->opt.dt;
     double *trig = s->work + PDW_WORK_TRIG, *kin = s->work + PDW_WORK_KIN;
     double *contact = s->work + PDW_WORK_CONTACT, *M = s->work + PDW_WORK_M;
     double C[PDW_NQ*PDW_NQ], QmG[PDW_NQ];
@@ -101,7 +101,7 @@ int pdw_cdm_advance(pdw_sim *s)
         pdw_cdm_start(s);
         pdw_record(s, 0.0);
     }
-    while (s->n < s->n_steps) {
+    while (s->n < s->opt.n_steps) {
         /* a return here resumes exactly: at n > 0 the top of the loop recomputes work */
         if (s->n > 0 && !pdw_records_room(s)) { s->status = PDW_STATUS_RECORDS_FULL; return s->status; }
         if (s->n > 0 && pdw_poll_due(s)) return s->status;

@@ -49,7 +49,7 @@ static int periodic(const pdw_sim *s)
 {
     static const int fields[PDW_NPERIODIC] = PDW_PERIODIC_FIELDS;
     const pdw_gait *g = &s->gait;
-    const long k = s->periodic_k < PDW_STEP_RING ? s->periodic_k : PDW_STEP_RING;
+    const long k = s->opt.periodic_k < PDW_STEP_RING ? s->opt.periodic_k : PDW_STEP_RING;
     if (k < 2 || g->n_steps < k) return 0;
     const double *last = g->ring[(g->n_steps - 1) % PDW_STEP_RING];
     for (int f = 0; f < PDW_NPERIODIC; ++f) {
@@ -60,7 +60,7 @@ static int periodic(const pdw_sim *s)
             lo = fmin(lo, v);
             hi = fmax(hi, v);
         }
-        if (!(hi - lo <= s->periodic_tol * fabs(ref))) return 0;   /* NaN: not periodic */
+        if (!(hi - lo <= s->opt.periodic_tol * fabs(ref))) return 0;   /* NaN: not periodic */
     }
     return 1;
 }
@@ -88,15 +88,15 @@ static int gait_touch_down(pdw_sim *s, int j, double t, double x)
         r[PDW_STEP_DS_FRACTION] = NAN;
         g->n_steps++;
         g->ds_leg = i;
-        if (s->stop_steps > 0 && g->n_steps >= s->stop_steps) stop = PDW_STOP_STEPS;
-        else if (s->periodic_k > 0 && periodic(s)) stop = PDW_STOP_PERIODIC;
+        if (s->opt.stop_steps > 0 && g->n_steps >= s->opt.stop_steps) stop = PDW_STOP_STEPS;
+        else if (s->opt.periodic_k > 0 && periodic(s)) stop = PDW_STOP_PERIODIC;
     }
     g->td_t[j] = t;
     g->td_x[j] = x;
     g->has_td[j] = 1;
     g->prev_td_t = t;
     g->has_prev_td = 1;
-    if (stop == PDW_STOP_NONE && s->stop_touch_down == j + 1) stop = PDW_STOP_TOUCH_DOWN;
+    if (stop == PDW_STOP_NONE && s->opt.stop_touch_down == j + 1) stop = PDW_STOP_TOUCH_DOWN;
     return stop;
 }
 
@@ -119,7 +119,7 @@ static void gait_lift_off(pdw_sim *s, int j, double t, double x)
 /* One event: stored (if recorded), then seen by the gait analysis. Returns a PDW_STOP_*. */
 static int push_event(pdw_sim *s, double t, int leg, int kind, const double *ki)
 {
-    if (s->record_events) {
+    if (s->opt.record_events) {
         double *e = s->events + s->n_events * PDW_NEVENT;
         e[PDW_EVENT_T] = t;
         e[PDW_EVENT_LEG] = leg;
@@ -184,7 +184,7 @@ int pdw_update_flags_trig(pdw_sim *s, double t)
 
 void pdw_record_final(pdw_sim *s, double t)
 {
-    if (s->record_every <= 0 || s->n % s->record_every != 0) return;
+    if (s->opt.record_every <= 0 || s->n % s->opt.record_every != 0) return;
     s->kernel->contact(s->work + PDW_WORK_KIN, s->disc.flags, s->p, s->work + PDW_WORK_CONTACT);
     pdw_record_now(s, t);
 }
@@ -193,7 +193,7 @@ int pdw_check_feet(pdw_sim *s, double t)
 {
     const double *kin = s->work + PDW_WORK_KIN;
     for (int i = 0; i < 2; ++i) {
-        if (kin[i*PDW_NKIN + PDW_KIN_Y_D] < -s->fall_depth) {
+        if (kin[i*PDW_NKIN + PDW_KIN_Y_D] < -s->opt.fall_depth) {
             fail(s, PDW_STATUS_FELL, PDW_REASON_FOOT_DEEP, i, t);
             return 1;
         }
@@ -210,9 +210,9 @@ int pdw_check_state(pdw_sim *s, const double *xnew, double t)
     for (int i = PDW_NX; i < s->nx; ++i) nan_if_any += xnew[i] * 0.0;
     if (nan_if_any != 0.0) { fail(s, PDW_STATUS_DIVERGED, PDW_REASON_NONFINITE, -1, t); return 1; }
     for (int i = PDW_NQ; i < PDW_NX; ++i) {
-        if (fabs(xnew[i]) > s->max_speed) { fail(s, PDW_STATUS_DIVERGED, PDW_REASON_SPEED, -1, t); return 1; }
+        if (fabs(xnew[i]) > s->opt.max_speed) { fail(s, PDW_STATUS_DIVERGED, PDW_REASON_SPEED, -1, t); return 1; }
     }
-    if (xnew[PDW_X_Y_O] < s->fall_hip_height) {
+    if (xnew[PDW_X_Y_O] < s->opt.fall_hip_height) {
         fail(s, PDW_STATUS_FELL, PDW_REASON_HIP_LOW, -1, t);
         return 1;
     }
@@ -243,7 +243,7 @@ int pdw_switch_pending(const pdw_sim *s, const double *x, double *work)
 
 void pdw_record(pdw_sim *s, double t)
 {
-    if (s->record_every <= 0 || s->n % s->record_every != 0) return;
+    if (s->opt.record_every <= 0 || s->n % s->opt.record_every != 0) return;
     pdw_record_now(s, t);
 }
 

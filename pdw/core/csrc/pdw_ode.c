@@ -43,7 +43,7 @@ double pdw_err_norm(const pdw_sim *s, const double *x, const double *xnew, const
 {
     double acc = 0.0;
     for (int i = 0; i < s->nx; ++i) {
-        const double sc = s->atol + s->rtol * fmax(fabs(x[i]), fabs(xnew[i]));
+        const double sc = s->opt.atol + s->opt.rtol * fmax(fabs(x[i]), fabs(xnew[i]));
         const double r = errv[i] / sc;
         acc += r * r;
     }
@@ -73,7 +73,7 @@ static int forces_changed(const pdw_discrete *a, const pdw_discrete *b)
 
 int pdw_fixed_advance(pdw_sim *s, pdw_fixed_step_fn step)
 {
-    const double dt = s->dt;
+    const double dt = s->opt.dt;
     double xnew[PDW_NX_MAX];
     s->status = PDW_STATUS_RUNNING;
     if (!s->started) {
@@ -83,10 +83,10 @@ int pdw_fixed_advance(pdw_sim *s, pdw_fixed_step_fn step)
         s->n = 0;
         s->t = 0.0;
         s->cache_valid = 0;
-        if (s->record_every > 0) sample(s);
+        if (s->opt.record_every > 0) sample(s);
         if (r > 0) return s->status;                        /* a stop condition */
     }
-    while (s->n < s->n_steps) {
+    while (s->n < s->opt.n_steps) {
         if (!pdw_records_room(s)) { s->status = PDW_STATUS_RECORDS_FULL; return s->status; }
         if (pdw_poll_due(s)) return s->status;
         if (s->n > 0) {
@@ -97,7 +97,7 @@ int pdw_fixed_advance(pdw_sim *s, pdw_fixed_step_fn step)
             if (r > 0) { pdw_record_final(s, s->t); return s->status; }   /* a stop condition */
             if (forces_changed(&before, &s->disc)) s->cache_valid = 0;
             if (pdw_check_feet(s, s->t)) return s->status;
-            if (s->record_every > 0 && s->n % s->record_every == 0) sample(s);
+            if (s->opt.record_every > 0 && s->n % s->opt.record_every == 0) sample(s);
         }
         if (step(s, dt, xnew)) return s->status;
         if (pdw_check_state(s, xnew, s->t)) return s->status;
@@ -107,7 +107,7 @@ int pdw_fixed_advance(pdw_sim *s, pdw_fixed_step_fn step)
     }
     const int r = pdw_update_flags(s, s->t);
     if (r < 0) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
-    if (s->record_every > 0 && s->n % s->record_every == 0) sample(s);
+    if (s->opt.record_every > 0 && s->n % s->opt.record_every == 0) sample(s);
     if (r == 0) s->status = PDW_STATUS_DONE;           /* else: the stop condition's status */
     return s->status;
 }
@@ -144,7 +144,7 @@ static double locate_switch(pdw_sim *s, const double *x0, const double *f0, cons
                             const double *f1, double h)
 {
     double ta = 0.0, tb = h, xi[PDW_NX_MAX];
-    while (tb - ta > s->event_tol) {
+    while (tb - ta > s->opt.event_tol) {
         const double tm = 0.5 * (ta + tb);
         if (tm <= ta || tm >= tb) break;
         hermite(s->nx, x0, f0, x1, f1, h, tm / h, xi);
@@ -166,11 +166,10 @@ static int fail_step_size(pdw_sim *s)
 int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx)
 {
     double xnew[PDW_NX_MAX], fnew[PDW_NX_MAX];
-    const double t_end = s->t_end;
+    const double t_end = s->opt.t_end;
     int new_point = 1, last_rejected = 0;
 
     s->status = PDW_STATUS_RUNNING;
-    if (s->event_tol <= 0.0) s->event_tol = 1e-9;
     if (!s->started) {
         s->t = 0.0;
         s->n = 0;
@@ -180,28 +179,28 @@ int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx)
         const int r = settle_flags(s, 0.0);
         if (r < 0) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
         s->started = 1;
-        if (s->record_every > 0) sample(s);
+        if (s->opt.record_every > 0) sample(s);
         if (r > 0) return s->status;                        /* a stop condition */
     }
     while (s->t < t_end) {
         /* room for what an accepted step may append; return here only (before a step), so
          * that a resumed call continues exactly */
         if (!pdw_events_room(s, 6)) { s->status = PDW_STATUS_EVENTS_FULL; return s->status; }
-        if (s->record_every > 0 && s->n_rec + 1 > s->rec_capacity) {
+        if (s->opt.record_every > 0 && s->n_rec + 1 > s->rec_capacity) {
             s->status = PDW_STATUS_RECORDS_FULL;
             return s->status;
         }
         /* poll only where a resumed call continues exactly (new_point and last_rejected are
          * what a fresh call starts with: right after an accepted step) */
         if (new_point && !last_rejected && pdw_poll_due(s)) return s->status;
-        if (s->max_steps > 0 && s->n + s->n_rejected >= s->max_steps) {
+        if (s->opt.max_steps > 0 && s->n + s->n_rejected >= s->opt.max_steps) {
             fail_step_size(s);
             s->failure.reason = PDW_REASON_BUDGET;
             return s->status;
         }
         if (!s->cache_valid) { pdw_ode_f(s, s->x, s->cache); s->cache_valid = 1; }
 
-        double h = fmin(s->h, s->h_max);
+        double h = fmin(s->h, s->opt.h_max);
         int last = 0;
         const double rem = t_end - s->t;
         if (h >= rem - 1e-12 * fmax(1.0, t_end)) { h = rem; last = 1; }
@@ -250,12 +249,12 @@ int pdw_adaptive_advance(pdw_sim *s, const pdw_adaptive_method *m, void *ctx)
 
         const pdw_discrete before = s->disc;
         if (settle_flags(s, s->t) > 0) {                    /* room checked above */
-            if (s->record_every > 0) sample(s);             /* a stop condition: like t_end, */
+            if (s->opt.record_every > 0) sample(s);             /* a stop condition: like t_end, */
             return s->status;                               /* the final state is recorded */
         }
         if (forces_changed(&before, &s->disc)) s->cache_valid = 0;
         if (pdw_check_feet(s, s->t)) return s->status;
-        if (s->record_every > 0 && (s->n % s->record_every == 0 || s->t >= t_end)) sample(s);
+        if (s->opt.record_every > 0 && (s->n % s->opt.record_every == 0 || s->t >= t_end)) sample(s);
     }
     s->status = PDW_STATUS_DONE;
     return s->status;

@@ -27,15 +27,8 @@ typedef struct pdw_failure {
     int reason;         /* PDW_REASON_* */
 } pdw_failure;
 
-enum {
-    PDW_REASON_NONE = 0,
-    PDW_REASON_NONFINITE = 1,     /* a NaN or infinity in the new state */
-    PDW_REASON_SPEED = 2,         /* a velocity above max_speed */
-    PDW_REASON_HIP_LOW = 3,       /* hip below fall_hip_height */
-    PDW_REASON_FOOT_DEEP = 4,     /* a foot deeper than fall_depth below the ground */
-    PDW_REASON_SINGULAR = 5,      /* singular step matrix */
-    PDW_REASON_STEP_SIZE = 6      /* adaptive step size underflow (error test never passed) */
-};
+/* PDW_REASON_*: generated from derive/layout.py's REASON (pdw_model.h), with the messages
+ * pdw/core/_layout.py's REASON_TEXT gives Python. */
 
 /* Online gait analysis (docs/model.md section 8): the per-step descriptors of pdw/sim/gait.py, computed
  * as the events happen, in O(1) memory: the latest touch-down and lift-off of each leg, counts,
@@ -64,27 +57,26 @@ enum { PDW_STATUS_RECORDS_FULL = 64 };
  * the GIL, checks for signals (Ctrl-C) and the step budget, and calls advance again. */
 enum { PDW_STATUS_POLL = 65 };
 
-/* Why an adaptive loop stopped beyond pdw_failure's PDW_REASON_*: the step budget. */
-enum { PDW_REASON_BUDGET = 7 };
-
-typedef struct pdw_sim {
-    /* --- model and settings (inputs) --- */
-    const pdw_kernel *kernel;
-    int nx;                     /* size of the continuous state: kernel->nx (PDW_NX, or
-                                 * PDW_NX_LUGRE with the bristle states) */
-    double p[PDW_NP];           /* parameters + derived constants (pdw_precompute) */
-    double dt;                  /* step [s] */
-    long n_steps;               /* number of steps to take */
-    long record_every;          /* record every k-th step; 0 = record nothing */
-    double fall_hip_height;     /* fell when y_o < this [m] */
-    double fall_depth;          /* fell when a foot is deeper than this [m] */
-    double max_speed;           /* diverged when |qd_i| > this [m/s, rad/s] */
+/* The options a loop reads: pdw.sim.options' Integrator, Record, Stop and Limits as C (plus
+ * n_steps and the fixed t_end, derived from them). Filled once before a run (pdw/core/_core.pyx
+ * run; the ensemble's job->opt, pdw_batch.c) and never written by a loop: the loops read them
+ * through s->opt, the run state is the rest of pdw_sim. A new stop condition is one field here,
+ * the loop that tests it (pdw_discrete.c for the gait's), and its option in pdw/sim/options.py. */
+typedef struct pdw_run_opts {
+    /* Integrator */
+    double dt;                  /* step [s] (adaptive methods: the first trial step) */
+    long n_steps;               /* number of steps to take (fixed-step methods) */
     double t_end;               /* end time [s] (adaptive methods; = n_steps*dt for fixed) */
     double rtol, atol;          /* tolerances of adaptive methods */
     double h_max;               /* largest step of adaptive methods [s] */
     double event_tol;           /* adaptive methods: a flag switch is located to within this [s] */
+    long max_steps;             /* adaptive methods: fail (PDW_REASON_BUDGET) once accepted +
+                                 * rejected steps reach this; 0: no budget */
+    /* Record */
+    long record_every;          /* record every k-th step; 0 = record nothing */
     int record_events;          /* 1: store every event in `events`; 0: only count them (the
                                  * online gait analysis sees them either way) */
+    /* Stop */
     long stop_steps;            /* stop (PDW_STATUS_DONE, PDW_STOP_STEPS) at this many complete
                                  * gait steps; 0: no limit */
     int stop_touch_down;        /* 1 or 2: stop (PDW_STATUS_DONE, PDW_STOP_TOUCH_DOWN) at that leg's
@@ -93,6 +85,20 @@ typedef struct pdw_sim {
                                  * each PDW_PERIODIC_FIELDS descriptor within periodic_tol (relative,
                                  * max - min <= tol |latest|); 0: off. 2 <= k <= PDW_STEP_RING */
     double periodic_tol;
+    /* Limits */
+    double fall_hip_height;     /* fell when y_o < this [m] */
+    double fall_depth;          /* fell when a foot is deeper than this [m] */
+    double max_speed;           /* diverged when |qd_i| > this [m/s, rad/s] */
+} pdw_run_opts;
+
+typedef struct pdw_sim {
+    /* --- model (inputs) --- */
+    const pdw_kernel *kernel;
+    int nx;                     /* size of the continuous state: kernel->nx (PDW_NX, or
+                                 * PDW_NX_LUGRE with the bristle states) */
+    double p[PDW_NP];           /* parameters + derived constants (pdw_precompute) */
+    /* --- options (inputs, read only by the loops) --- */
+    pdw_run_opts opt;
     /* --- outputs (caller-allocated) --- */
     double *rec_t;              /* (rec_capacity,) */
     double *rec_x;              /* (rec_capacity, nx) */
@@ -125,8 +131,6 @@ typedef struct pdw_sim {
     /* --- interruptibility (see PDW_STATUS_POLL) --- */
     long poll_every;            /* return PDW_STATUS_POLL every this many loop iterations; 0: never */
     long since_poll;            /* iterations since the last poll */
-    long max_steps;             /* adaptive methods: fail (PDW_REASON_BUDGET) once accepted +
-                                 * rejected steps reach this; 0: no budget */
 } pdw_sim;
 
 /* Copy a state of s's size (s->nx); the common size PDW_NX as a compile-time constant, so that
@@ -150,7 +154,7 @@ static inline int pdw_poll_due(pdw_sim *s)
  * return resumes exactly) */
 static inline int pdw_records_room(const pdw_sim *s)
 {
-    return s->record_every <= 0 || s->n_rec + 2 <= s->rec_capacity;
+    return s->opt.record_every <= 0 || s->n_rec + 2 <= s->rec_capacity;
 }
 
 /* Initialise the discrete state for x0 and initial flags: anchors of support legs at x0. */
@@ -173,7 +177,7 @@ int pdw_update_flags_trig(pdw_sim *s, double t);
 /* Room for `n` more events (always, when events are not stored)? */
 static inline int pdw_events_room(const pdw_sim *s, long n)
 {
-    return !s->record_events || s->n_events + n <= s->ev_capacity;
+    return !s->opt.record_events || s->n_events + n <= s->ev_capacity;
 }
 
 /* Reset the online gait analysis (before the first step). */
