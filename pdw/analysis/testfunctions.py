@@ -36,7 +36,7 @@ class TestFunction:
     Attributes
     ----------
     kind : str
-        The bifurcation kind it reports (`pdw.Bifurcation.kind`).
+        The bifurcation kind it reports (the ``kind`` of a `pdw.Bifurcation`).
     label : str
         AUTO's two-letter type (LP, PD, NS, BP, EP, UZ).
     """
