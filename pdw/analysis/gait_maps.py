@@ -293,13 +293,36 @@ class ContinuousProblem(_Problem):
     CHECK_TOL = 1e-3
 
     def crosscheck(self, z, mu, multipliers):
-        """The multipliers again from central differences with ``CHECK_FACTOR`` x ``fd_step``:
-        (largest difference to ``multipliers``, note or ""). A difference above
+        """The multipliers again, exactly (`pdw.analysis.variational`: default laws, paper
+        variant, period 1) or else from central differences with ``CHECK_FACTOR`` x
+        ``fd_step``: (largest difference to ``multipliers``, note or ""). A difference above
         ``CHECK_TOL`` means the step map has a kink within a few difference steps of z (the
-        finite-difference multipliers then depend on the step), and the note says so."""
+        finite-difference multipliers then depend on the step), and the note says so;
+        ``last_check`` says which check ran."""
+        z = np.asarray(z, dtype=float)
+        if self.contact is None and self.variant == "paper" and self.period == 1:
+            # the exact monodromy (pdw.analysis.variational) where it exists
+            from . import variational
+            try:
+                Mx = variational.step_jacobian(z, self.params_at(mu), **{
+                    k: self.opts[k] for k in ("rtol", "atol") if k in self.opts})["M"]
+            except InvalidInputError as e:
+                return np.inf, "the exact monodromy failed (%s): not checked" % e
+            m = np.linalg.eigvals(Mx)
+            m = m[np.argsort(-np.abs(m))]
+            ref = np.asarray(multipliers)
+            diff = float(np.max(np.abs(np.sort_complex(m) - np.sort_complex(ref))))
+            self.last_check = "variational"
+            if diff > self.CHECK_TOL:
+                return diff, ("the finite-difference multipliers (fd_step %g) differ from the "
+                              "exact ones (variational equations) by %.3g (largest %s against "
+                              "%s): a kink of the step map within a difference step of this "
+                              "point" % (self.fd_step, diff, np.round(ref[0], 4),
+                                         np.round(m[0], 4)))
+            return diff, ""
+        self.last_check = "finite differences x%g" % self.CHECK_FACTOR
         h = self.fd_step * self.CHECK_FACTOR
         E = np.eye(self.dim) * h
-        z = np.asarray(z, dtype=float)
         outs = self._run([(z + e, mu) for e in E] + [(z - e, mu) for e in E])
         self.n_maps += self.period * 2 * self.dim
         if any(o[0] is None for o in outs):
