@@ -63,3 +63,19 @@ def test_bifurcation_cross_check_uses_the_exact_monodromy(steady):
     assert prob.last_check == "variational" and diff < 1e-3 and note == ""
     diff, note = prob.crosscheck(g.details["z"], P.k_hip, g.multipliers * 1.01)
     assert diff > 1e-3 and "exact" in note
+
+
+def test_continuation_with_the_exact_monodromy(steady):
+    """continue_gait(..., monodromy="exact"): the same branch points as with differences, the
+    multipliers equal to them within their resolution, and the gait says which M it has."""
+    P, _ = steady
+    a = pdw.continue_gait(P, "k_hip", 0.97, max_points=3, step=0.01, monodromy="exact")
+    b = pdw.continue_gait(P, "k_hip", 0.97, max_points=3, step=0.01)
+    assert len(a) == len(b) >= 2
+    np.testing.assert_allclose(a.values, b.values, atol=1e-6)
+    np.testing.assert_allclose(np.abs(a.multipliers[:, :3]), np.abs(b.multipliers[:, :3]),
+                               atol=2e-4)
+    with pytest.raises(pdw.InvalidInputError, match="monodromy"):
+        pdw.continue_gait(P, "k_hip", 0.97, monodromy="exact", variant="consistent")
+    with pytest.raises(pdw.InvalidInputError, match="monodromy"):
+        pdw.continue_gait(P, "k_hip", 0.97, monodromy="adjoint")

@@ -223,6 +223,7 @@ class ContinuousProblem(_Problem):
         self.workers = max(1, int(workers or os.cpu_count() or 1))
         self.t_hint = None
         self.ref_events = None       # support events per cycle at the branch's first point
+        self.monodromy = "differences"   # or "exact" (pdw.analysis.variational)
 
     def section(self, state):
         s = np.asarray(state, dtype=float).reshape(-1)
@@ -251,13 +252,15 @@ class ContinuousProblem(_Problem):
         except InvalidInputError as e:
             return Evaluation(False, "invalid parameter: %s" % e)
         tasks = [(z, mu)]
+        exact = jac and self.monodromy == "exact"
         if jac:
             h = self.fd_step
             up, down = self.lam_offsets(mu)
             if up == down:
                 return Evaluation(False, "invalid parameter: no room for a difference")
             E = np.eye(self.dim) * h
-            tasks += [(z + e, mu) for e in E] + [(z - e, mu) for e in E]
+            if not exact:
+                tasks += [(z + e, mu) for e in E] + [(z - e, mu) for e in E]
             tasks += [(z, mu + up), (z, mu + down)]
         outs = self._run(tasks)
         self.n_maps += self.period * len(tasks)
@@ -272,8 +275,18 @@ class ContinuousProblem(_Problem):
                 bad = next(o[1][-1]["status"] for o in outs if o[0] is None)
                 return Evaluation(False, "finite-difference neighbour: " + bad)
             n = self.dim
-            M = np.column_stack([(vals[1 + k] - vals[1 + n + k]) / (2 * h) for k in range(n)])
-            P_lam = (vals[1 + 2 * n] - vals[2 + 2 * n]) / (up - down)
+            if exact:
+                from . import variational
+                try:
+                    M = variational.step_jacobian(z, self.params_at(mu), **{
+                        k: self.opts[k] for k in ("rtol", "atol") if k in self.opts})["M"]
+                except InvalidInputError as e:
+                    return Evaluation(False, "exact monodromy: %s" % e)
+                P_lam = (vals[1] - vals[2]) / (up - down)
+            else:
+                M = np.column_stack([(vals[1 + k] - vals[1 + n + k]) / (2 * h)
+                                     for k in range(n)])
+                P_lam = (vals[1 + 2 * n] - vals[2 + 2 * n]) / (up - down)
         info = {"period": float(sum(s["period"] for s in steps)),
                 "step_length": float(np.mean([s["step_length"] for s in steps])),
                 "double_support": float(np.mean([s["double_support"] for s in steps])),
@@ -300,7 +313,8 @@ class ContinuousProblem(_Problem):
         finite-difference multipliers then depend on the step), and the note says so;
         ``last_check`` says which check ran."""
         z = np.asarray(z, dtype=float)
-        if self.contact is None and self.variant == "paper" and self.period == 1:
+        if (self.contact is None and self.variant == "paper" and self.period == 1
+                and self.monodromy != "exact"):
             # the exact monodromy (pdw.analysis.variational) where it exists
             from . import variational
             try:
@@ -347,7 +361,10 @@ class ContinuousProblem(_Problem):
                     step_length=ev.info["step_length"], double_support=ev.info["double_support"],
                     multipliers=multipliers, model="continuous", params=self.params_at(mu),
                     details={"z": np.array(z), "period_n": self.period, "jacobian": ev.M,
-                             "jacobian_kind": "central differences, fd_step %g" % self.fd_step,
+                             "jacobian_kind": ("exact (variational equations + saltation)"
+                                               if self.monodromy == "exact" else
+                                               "central differences, fd_step %g"
+                                               % self.fd_step),
                              "variant": self.variant, "options": dict(self.opts),
                              "section_names": LC.section_names(self.contact)})
 
