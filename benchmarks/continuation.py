@@ -12,6 +12,7 @@ and docs/figures/continuation_*.png.
     python benchmarks/continuation.py kelvin_voigt    # Kelvin-Voigt's d_n branch (docs/contact_laws.md)
     python benchmarks/continuation.py codim2    # compass doubling curve in (slope, c): CPU time
     python benchmarks/continuation.py chaos     # orbit diagram, Lyapunov exponents, Feigenbaum
+    python benchmarks/continuation.py monodromy # exact (variational) vs finite-difference M
 """
 from __future__ import annotations
 
@@ -362,6 +363,27 @@ def part_chaos():
     say("load average after: %s" % (os.getloadavg(),))
 
 
+def part_monodromy(rounds=3):
+    from pdw.analysis import limit_cycle as LC
+    from pdw.analysis import variational as V
+    P = pdw.Params.paper_steady()
+    g = pdw.find_gait(P)
+    z = g.details["z"]
+    say("== continuous model, paper_steady's gait: one monodromy matrix, exact vs differences ==")
+    say("load average before: %s" % (os.getloadavg(),))
+    for r in range(rounds):
+        c0, t0 = time.process_time(), time.perf_counter()
+        J, _, _ = LC.jacobian(z, P, workers=1, **LC.TIGHT)
+        c1, t1 = time.process_time(), time.perf_counter()
+        res = V.step_jacobian(z, P)
+        c2, t2 = time.process_time(), time.perf_counter()
+        say("round %d: finite differences (13 maps, 1 thread) %.3f s CPU / %.3f s wall; "
+            "variational (Python/SciPy) %.3f s CPU / %.3f s wall; ratio %.1f; max|M - J| %.2g"
+            % (r, c1 - c0, t1 - t0, c2 - c1, t2 - t1, (c2 - c1) / (c1 - c0),
+               np.max(np.abs(res["M"] - J))))
+    say("load average after: %s" % (os.getloadavg(),))
+
+
 if __name__ == "__main__":
     parts = sys.argv[1:] or ["hybrid"]
     for part in parts:
@@ -371,7 +393,7 @@ if __name__ == "__main__":
          "dhip": part_dhip, "rigid": part_rigid,
          "rigid_paper": part_rigid_paper, "fig11": part_fig11,
          "simplest_limit": part_simplest_limit, "kelvin_voigt": part_kelvin_voigt,
-         "codim2": part_codim2, "chaos": part_chaos}[part]()
+         "codim2": part_codim2, "chaos": part_chaos, "monodromy": part_monodromy}[part]()
         say("(%s: %.1f s wall; python benchmarks/continuation.py %s)"
             % (part, time.perf_counter() - t0, part))
         RESULTS.mkdir(exist_ok=True)

@@ -119,7 +119,8 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
                   options: dict | None = None, at: Sequence[float] = (),
                   progress: bool | Progress = False,
                   events: Sequence[TF.TestFunction] = (), stall_points: int = 8,
-                  stall_length: float = 1e-3) -> Branch:
+                  stall_length: float = 1e-3,
+                  monodromy: Literal["differences", "exact"] = "differences") -> Branch:
     """Follow the period-``period`` gait of ``params`` as ``parameter`` moves towards ``stop``.
 
     Parameters
@@ -185,6 +186,10 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
         User test functions, e.g. ``pdw.analysis.testfunctions.Event("step_length", 0.4)``
         (step length = 0.4 m): located like bifurcations and reported with them (kind
         ``"event"``, label UZ).
+    monodromy : {"differences", "exact"}
+        The continuous model's M: central differences (default), or exact from the variational
+        equations with saltation matrices (`pdw.analysis.variational`; default laws, paper
+        variant, period 1; 25-40x the CPU time per point).
     stall_points, stall_length : int, float
         The continuation stops as *stalled* when the last ``stall_points`` steps together
         advanced less than ``stall_length`` in arclength (scaled coordinates: the requested
@@ -205,6 +210,16 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
     TF.select(detect, events)
     prob = _problem(params, parameter, model, variant, period, params_of, log, options,
                     executor, workers, fd_step)
+    if monodromy not in ("differences", "exact"):
+        raise InvalidInputError("monodromy must be 'differences' or 'exact', got %r"
+                                % (monodromy,))
+    if monodromy == "exact" and model == "continuous":
+        if (getattr(prob, "contact", None) is not None or variant != "paper"
+                or prob.period != 1):
+            raise InvalidInputError("monodromy='exact' of the continuous model needs the "
+                                    "default laws, variant 'paper' and period 1 "
+                                    "(pdw.analysis.variational)")
+        prob.monodromy = "exact"
     if value is None:
         if isinstance(start, Gait) and start.details and "value" in start.details:
             value = start.details["value"]
@@ -223,7 +238,8 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
                             step=step, step_min=step_min, step_max=step_max, tol=tol,
                             locate_tol=locate_tol, detect=detect, max_newton=max_newton,
                             direction=details.get("direction"), origin=details.get("origin"),
-                            settings=dict(log=log, variant=variant, fd_step=fd_step), t0=t0,
+                            settings=dict(log=log, variant=variant, fd_step=fd_step,
+                                          monodromy=monodromy), t0=t0,
                             at=at, progress=progress, events=events,
                             stall_points=stall_points, stall_length=stall_length)
 

@@ -239,6 +239,7 @@ def check_crossings(engine, a, b, index, locate_tol, detect=None):
         if check is not None and tf.kind in ("fold", "period_doubling", "neimark_sacker"):
             diff, note = check(loc.point.x[:-1], engine.mu(loc.point.x), loc.point.mult)
             bif.details["fd_check"] = diff
+            bif.details["fd_check_kind"] = getattr(engine.prob, "last_check", "")
             if note:
                 warnings.warn("%s at %s = %.8g: %s" % (tf.kind, engine.prob.parameter,
                                                       bif.value, note), stacklevel=3)

@@ -223,6 +223,7 @@ class ContinuousProblem(_Problem):
         self.workers = max(1, int(workers or os.cpu_count() or 1))
         self.t_hint = None
         self.ref_events = None       # support events per cycle at the branch's first point
+        self.monodromy = "differences"   # or "exact" (pdw.analysis.variational)
 
     def section(self, state):
         s = np.asarray(state, dtype=float).reshape(-1)
@@ -251,13 +252,15 @@ class ContinuousProblem(_Problem):
         except InvalidInputError as e:
             return Evaluation(False, "invalid parameter: %s" % e)
         tasks = [(z, mu)]
+        exact = jac and self.monodromy == "exact"
         if jac:
             h = self.fd_step
             up, down = self.lam_offsets(mu)
             if up == down:
                 return Evaluation(False, "invalid parameter: no room for a difference")
             E = np.eye(self.dim) * h
-            tasks += [(z + e, mu) for e in E] + [(z - e, mu) for e in E]
+            if not exact:
+                tasks += [(z + e, mu) for e in E] + [(z - e, mu) for e in E]
             tasks += [(z, mu + up), (z, mu + down)]
         outs = self._run(tasks)
         self.n_maps += self.period * len(tasks)
@@ -272,8 +275,18 @@ class ContinuousProblem(_Problem):
                 bad = next(o[1][-1]["status"] for o in outs if o[0] is None)
                 return Evaluation(False, "finite-difference neighbour: " + bad)
             n = self.dim
-            M = np.column_stack([(vals[1 + k] - vals[1 + n + k]) / (2 * h) for k in range(n)])
-            P_lam = (vals[1 + 2 * n] - vals[2 + 2 * n]) / (up - down)
+            if exact:
+                from . import variational
+                try:
+                    M = variational.step_jacobian(z, self.params_at(mu), **{
+                        k: self.opts[k] for k in ("rtol", "atol") if k in self.opts})["M"]
+                except InvalidInputError as e:
+                    return Evaluation(False, "exact monodromy: %s" % e)
+                P_lam = (vals[1] - vals[2]) / (up - down)
+            else:
+                M = np.column_stack([(vals[1 + k] - vals[1 + n + k]) / (2 * h)
+                                     for k in range(n)])
+                P_lam = (vals[1 + 2 * n] - vals[2 + 2 * n]) / (up - down)
         info = {"period": float(sum(s["period"] for s in steps)),
                 "step_length": float(np.mean([s["step_length"] for s in steps])),
                 "double_support": float(np.mean([s["double_support"] for s in steps])),
@@ -293,13 +306,37 @@ class ContinuousProblem(_Problem):
     CHECK_TOL = 1e-3
 
     def crosscheck(self, z, mu, multipliers):
-        """The multipliers again from central differences with ``CHECK_FACTOR`` x ``fd_step``:
-        (largest difference to ``multipliers``, note or ""). A difference above
+        """The multipliers again, exactly (`pdw.analysis.variational`: default laws, paper
+        variant, period 1) or else from central differences with ``CHECK_FACTOR`` x
+        ``fd_step``: (largest difference to ``multipliers``, note or ""). A difference above
         ``CHECK_TOL`` means the step map has a kink within a few difference steps of z (the
-        finite-difference multipliers then depend on the step), and the note says so."""
+        finite-difference multipliers then depend on the step), and the note says so;
+        ``last_check`` says which check ran."""
+        z = np.asarray(z, dtype=float)
+        if (self.contact is None and self.variant == "paper" and self.period == 1
+                and self.monodromy != "exact"):
+            # the exact monodromy (pdw.analysis.variational) where it exists
+            from . import variational
+            try:
+                Mx = variational.step_jacobian(z, self.params_at(mu), **{
+                    k: self.opts[k] for k in ("rtol", "atol") if k in self.opts})["M"]
+            except InvalidInputError as e:
+                return np.inf, "the exact monodromy failed (%s): not checked" % e
+            m = np.linalg.eigvals(Mx)
+            m = m[np.argsort(-np.abs(m))]
+            ref = np.asarray(multipliers)
+            diff = float(np.max(np.abs(np.sort_complex(m) - np.sort_complex(ref))))
+            self.last_check = "variational"
+            if diff > self.CHECK_TOL:
+                return diff, ("the finite-difference multipliers (fd_step %g) differ from the "
+                              "exact ones (variational equations) by %.3g (largest %s against "
+                              "%s): a kink of the step map within a difference step of this "
+                              "point" % (self.fd_step, diff, np.round(ref[0], 4),
+                                         np.round(m[0], 4)))
+            return diff, ""
+        self.last_check = "finite differences x%g" % self.CHECK_FACTOR
         h = self.fd_step * self.CHECK_FACTOR
         E = np.eye(self.dim) * h
-        z = np.asarray(z, dtype=float)
         outs = self._run([(z + e, mu) for e in E] + [(z - e, mu) for e in E])
         self.n_maps += self.period * 2 * self.dim
         if any(o[0] is None for o in outs):
@@ -324,7 +361,10 @@ class ContinuousProblem(_Problem):
                     step_length=ev.info["step_length"], double_support=ev.info["double_support"],
                     multipliers=multipliers, model="continuous", params=self.params_at(mu),
                     details={"z": np.array(z), "period_n": self.period, "jacobian": ev.M,
-                             "jacobian_kind": "central differences, fd_step %g" % self.fd_step,
+                             "jacobian_kind": ("exact (variational equations + saltation)"
+                                               if self.monodromy == "exact" else
+                                               "central differences, fd_step %g"
+                                               % self.fd_step),
                              "variant": self.variant, "options": dict(self.opts),
                              "section_names": LC.section_names(self.contact)})
 
