@@ -3,7 +3,7 @@ of `Params`, `simulate`, scenes and studies (malformed input), and of long rando
 
 Every case either succeeds (with an honest result) or raises the documented error -- never a
 crash, a raw Python error, or a status that lies. A small budget runs in ``make test``; the
-``slow`` twins (``make study``) run about 1.6 10^5 cases in all (counts in docs/stability.md).
+``slow`` twins (``make study``) run about 1.7 10^5 cases in all (counts in docs/stability.md).
 ``PDW_FUZZ_EXAMPLES`` overrides the small budget per test.
 """
 import json
@@ -23,7 +23,7 @@ from pdw.core.model import parameter_vector
 from pdw.studies.study import parse_study
 
 SMALL = int(os.environ.get("PDW_FUZZ_EXAMPLES", "25"))
-#: the slow twins' examples per test (their sum is the study's count: 1.56e5)
+#: the slow twins' examples per test (their sum is the study's count: 1.71e5)
 LARGE = {"compiled": 40000, "hybrid": 15000, "params": 20000, "simulate": 5000,
          "scene": 10000, "study": 9900, "long": 100,
          # the entry points merged after issue 16's first pass
