@@ -49,6 +49,9 @@ CASES = [
     ("_core.run(0, 0, X0, P, 0, 1, 1e-4, 2 ** 64, 0, False, 0.2, 0.1, 1e3)", "n_steps",
      "InvalidInputError"),
     ("_core.bench(0, 'rhs', X0, P, 0, 1, 0.0, 0.0, BIG)", "n", "InvalidInputError"),
+    # found by the round-three fuzz run: a poll before every step, so never a step (a hang)
+    ("_core.run(0, 0, X0, P, 0, 1, 1e-4, 20, 1, True, 0.25, 0.125, 1e3, poll_every=1)",
+     "poll_every", "InvalidInputError"),
 ]
 
 

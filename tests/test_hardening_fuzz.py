@@ -3,7 +3,7 @@ of `Params`, `simulate`, scenes and studies (malformed input), and of long rando
 
 Every case either succeeds (with an honest result) or raises the documented error -- never a
 crash, a raw Python error, or a status that lies. A small budget runs in ``make test``; the
-``slow`` twins (``make study``) run about 1.6 10^5 cases in all (counts in docs/stability.md).
+``slow`` twins (``make study``) run about 1.7 10^5 cases in all (counts in docs/stability.md).
 ``PDW_FUZZ_EXAMPLES`` overrides the small budget per test.
 """
 import json
@@ -23,12 +23,15 @@ from pdw.core.model import parameter_vector
 from pdw.studies.study import parse_study
 
 SMALL = int(os.environ.get("PDW_FUZZ_EXAMPLES", "25"))
-#: the slow twins' examples per test (their sum is the study's count: 1.56e5)
+#: the slow twins' examples per test (their sum is the study's count: 1.71e5)
 LARGE = {"compiled": 40000, "hybrid": 15000, "params": 20000, "simulate": 5000,
          "scene": 10000, "study": 9900, "long": 100,
          # the entry points merged after issue 16's first pass
          "batch": 5000, "batch_compiled": 20000, "ode": 20000, "contact": 3000, "load": 5000,
-         "buffer": 3000}
+         "buffer": 3000,
+         # issue 26 (round three): counts into the compiled layer, NaN states at every public
+         # entry point, silent coercions, the file formats (BatchResult, the sweep CSV)
+         "counts": 4000, "nan_states": 4000, "coerce": 3000, "batch_file": 2000, "csv": 2000}
 _HC = [HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much]
 P = parameter_vector(pdw.Params.paper())
 X0 = np.array(pdw.X0_PAPER)
@@ -507,3 +510,237 @@ def _load(data):
 
 
 test_fuzz_load, test_fuzz_load_study = _twin("load", _load)
+
+
+# --- issue 26 (round three) -------------------------------------------------------------------
+
+#: a count: small and valid, or beyond every range (negative, past MAX_COUNT, past a C long)
+COUNTS = (st.integers(0, 60) | st.integers(-2 ** 70, -1) | st.integers(2 ** 40 + 1, 2 ** 70)
+          | st.sampled_from([2 ** 62, 2 ** 63 - 1, 2 ** 63, 2 ** 64, -2 ** 63 - 1]))
+
+
+def _counts(data):
+    """Any count into the compiled layer: a result, or a refusal naming it (ValueError /
+    InvalidInputError, MemoryError for an allocation too large); never a crash, a hang (no
+    count past MAX_COUNT is run) or a raw OverflowError."""
+    p = parameter_vector(pdw.Params.paper_steady())
+    y0 = np.array([0.2, -0.2, -1.0, -0.3])
+    which = data.draw(st.sampled_from(["walk", "step", "run", "batch", "find_gait"]))
+    c1, c2 = data.draw(COUNTS), data.draw(COUNTS)
+    try:
+        if which == "walk":
+            _hybrid.walk(p, y0, 0.0, min(c1, 5) if 0 <= c1 <= 60 else c1, {}, c2)
+        elif which == "step":
+            _hybrid.step(p, y0, {}, 0.0, 0.0, c1)
+        elif which == "run":
+            name = data.draw(st.sampled_from(["max_records", "event_capacity", "stop_steps",
+                                              "max_steps", "poll_every"]))
+            _core.run(0, 0, X0, P, 0, 1, 1e-4, c1 if not 0 <= c1 <= 60 else 20,
+                      data.draw(st.integers(0, 3)), True, 0.25, 0.125, 1e3, **{name: c2})
+        elif which == "batch":
+            from pdw.sim.batch import _outputs
+            out = _outputs(1)
+            _batch.run_range(0, X0[None].copy(), P[None].copy(), np.array([[0, 1]], np.intc),
+                             np.array([0.2]), np.array([0.1]), 1e-4,
+                             c1 if not 0 <= c1 <= 60 else 20, 1e3, c2 if c2 > 60 or c2 < 0
+                             else 0, 0, 0.0, out, 0, 1, 1, False)
+        else:
+            pdw.hybrid.find_gait(pdw.Params.paper_steady(), settle_steps=c1 if c1 > 60 or c1 < 0
+                                 else 1, max_iter=c2 if c2 > 60 or c2 < 0 else 1)
+    except (ValueError, MemoryError, pdw.hybrid.GaitNotFoundError):
+        pass
+
+
+test_fuzz_counts, test_fuzz_counts_study = _twin("counts", _counts)
+
+_NAN_ENTRIES = {
+    "rhs": lambda x: pdw.rhs(x), "jacobian": lambda x: pdw.jacobian(x),
+    "contact_forces": lambda x: pdw.contact_forces(x).F_n,
+    "energies": lambda x: pdw.energies(x)["E"], "mass_matrix": lambda x: pdw.mass_matrix(x),
+    "ode_f": lambda x: pdw.ode_function()(0.0, x), "ode_jac": lambda x: pdw.ode_function().jac(0.0, x),
+    "ode_batch": lambda x: pdw.ode_function().batch(np.ascontiguousarray(x[None])),
+    "hybrid_rhs": lambda x: pdw.hybrid.stance_rhs(x[:4]),
+    "hybrid_step": lambda x: pdw.hybrid.step_map(x[:4]),
+    "simulate": lambda x: pdw.simulate(x, t_end=0.001, check_step="off"),
+}
+
+
+def _nan_states(data):
+    """A state with random NaN/inf entries (and random finite ones) into every public entry
+    point that takes a state: InvalidInputError, or an answer of NaN in every entry."""
+    x = np.array([data.draw(NICE_FLOAT) for _ in range(8)])
+    bad = data.draw(st.lists(st.integers(0, 7), min_size=1, max_size=3))
+    for i in bad:
+        x[i] = data.draw(st.sampled_from([np.nan, np.inf, -np.inf]))
+    name = data.draw(st.sampled_from(sorted(_NAN_ENTRIES)))
+    if name.startswith("hybrid") and not any(i < 4 for i in bad):
+        return
+    try:
+        out = _NAN_ENTRIES[name](x)
+    except pdw.InvalidInputError as e:
+        assert "finite" in str(e), (name, str(e))
+        return
+    assert np.isnan(np.asarray(out, dtype=float)).all(), (name, x, out)
+
+
+test_fuzz_nan_states, test_fuzz_nan_states_study = _twin("nan_states", _nan_states)
+
+_COERCE_JUNK = (st.booleans() | st.text(max_size=4) | st.floats(allow_nan=True)
+                | st.integers(-3, 5) | st.just(np.float64(1.5)) | st.just([1.5]) | st.just("12")
+                | st.just(np.ma.masked_array([1.0], mask=[True])[0]))
+
+
+def _coerce(data):
+    """No silent coercion: record indices, LuGre parameters, Kelvin-Voigt's k/d, steady()'s
+    last/rtol and masked states take integers/reals of their type or raise InvalidInputError
+    (a bool, a string, 1.5 where an index is expected, a masked entry)."""
+    which = data.draw(st.sampled_from(["record", "lugre", "kv", "steady", "masked"]))
+    v = data.draw(_COERCE_JUNK)
+    try:
+        if which == "record":
+            rec = v if isinstance(v, (list, str)) else [v]
+            b = pdw.simulate_batch(np.tile(X0, (3, 1)), t_end=0.002, record=rec)
+            assert all(isinstance(i, int) and 0 <= i < 3 for i in b.recorded)
+            assert all(type(r) is not bool and float(r) == int(r) for r in np.ravel(rec))
+        elif which == "lugre":
+            name = data.draw(st.sampled_from(["sigma0", "sigma1", "sigma2", "mu_s", "mu_c", "v_s"]))
+            c = pdw.Contact(friction="lugre", **{name: v})
+            assert type(getattr(c, name)) is float and not isinstance(v, (bool, str))
+        elif which == "kv":
+            c = pdw.Contact("kelvin_voigt", **{data.draw(st.sampled_from(["k", "d"])): v})
+            assert type(c.k) is float and type(c.d) is float and not isinstance(v, (bool, str))
+        elif which == "steady":
+            sd = pdw.steps(_short_run()).steady(v)
+            assert isinstance(sd["converged"], bool) and not isinstance(v, (bool, str))
+        else:
+            mask = np.zeros(8, bool)
+            mask[data.draw(st.integers(0, 7))] = data.draw(st.booleans())
+            x = np.ma.masked_array(X0.copy(), mask=mask)
+            r = pdw.rhs(x)
+            assert not mask.any() and np.array_equal(r, pdw.rhs(X0))
+    except pdw.InvalidInputError:
+        pass
+
+
+_SHORT = {}
+
+
+def _short_run():
+    if not _SHORT:
+        _SHORT["r"] = pdw.simulate(t_end=1.2, record_every=0)
+    return _SHORT["r"]
+
+
+test_fuzz_coerce, test_fuzz_coerce_study = _twin("coerce", _coerce)
+
+_BATCH_SAVED = {}
+
+
+def _batch_saved():
+    if not _BATCH_SAVED:
+        import tempfile
+        d = tempfile.mkdtemp(prefix="pdw-fuzz-batch-")
+        x = np.tile(X0, (3, 1))
+        x[1, 1] = -0.3
+        path = os.path.join(d, "good.npz")
+        pdw.simulate_batch(x, t_end=0.05, record=[0], record_every=20).save(path)
+        with np.load(path) as z:
+            a = {k: z[k] for k in z.files}
+        _BATCH_SAVED.update(dir=d, arrays=a, meta=json.loads(str(a.pop("meta"))))
+    return _BATCH_SAVED
+
+
+def _batch_file(data):
+    """A saved BatchResult with arrays replaced, dropped or poked and metadata junk: pdw.load
+    gives an InvalidInputError naming the file, or a BatchResult of consistent shapes."""
+    s = _batch_saved()
+    a = {k: v.copy() for k, v in s["arrays"].items()}
+    m = json.loads(json.dumps(s["meta"]))
+    for _ in range(data.draw(st.integers(1, 3))):
+        key = data.draw(st.sampled_from(sorted(a)))
+        action = data.draw(st.sampled_from(["replace", "drop", "poke"]))
+        if action == "drop":
+            a.pop(key, None)
+        elif action == "replace" and key in a:
+            a[key] = data.draw(arrays(a[key].shape))
+        elif key in a and a[key].size and a[key].dtype.kind in "fiu":
+            flat = a[key].astype(float).reshape(-1)
+            flat[data.draw(st.integers(0, flat.size - 1))] = data.draw(ANY_FLOAT)
+            a[key] = flat.reshape(a[key].shape)
+    if data.draw(st.booleans()):
+        m[data.draw(st.sampled_from(sorted(m)))] = data.draw(
+            JUNK.filter(lambda v: not isinstance(v, complex)))
+    path = os.path.join(s["dir"], "case.npz")
+    np.savez(path, meta=np.array(json.dumps(m)), **a)
+    try:
+        b = pdw.load(path)
+    except pdw.InvalidInputError as e:
+        assert "case.npz" in str(e)
+        return
+    n = len(b)
+    assert b.x_final.shape == (n, 8) and b.status.shape == (n,) and b.gait_rows.shape[0] == n
+    assert set(b.status) <= set(pdw.sim.files.STATUSES + pdw.sim.files.STOP_REASONS)
+
+
+test_fuzz_batch_file, test_fuzz_batch_file_study = _twin("batch_file", _batch_file)
+
+_CSV_SAVED = {}
+
+
+def _csv_saved():
+    if not _CSV_SAVED:
+        import tempfile
+
+        from pdw.studies import sweep
+        d = tempfile.mkdtemp(prefix="pdw-fuzz-csv-")
+        st_ = sweep.parse_study('name = "f"\n[scene]\npreset = "paper_steady"\n'
+                                'stop = { t_end = 1.5 }\nrecord = { every = 0 }\n'
+                                '[[axes]]\nname = "gamma"\nvalues = [0.036, 0.04, 0.044]\n'
+                                '[run]\nsteady = 2\nfallback = false\n')
+        sweep.run_study(st_, d, backend="serial")
+        _CSV_SAVED.update(dir=d, study=st_, text=open(os.path.join(d, "f.csv")).read())
+    return _CSV_SAVED
+
+
+def _csv(data):
+    """A sweep CSV with random cells replaced by junk, lines cut or duplicated: load_sweep gives
+    a table or an InvalidInputError naming the file; read_rows (a resume) keeps only rows of
+    the column types and never raises anything but PdwError."""
+    s = _csv_saved()
+    lines = s["text"].splitlines()
+    for _ in range(data.draw(st.integers(1, 4))):
+        i = data.draw(st.integers(0, len(lines) - 1))
+        cells = lines[i].split(",")
+        action = data.draw(st.sampled_from(["cell", "cut", "dup", "drop"]))
+        if action == "cell":
+            j = data.draw(st.integers(0, len(cells) - 1))
+            cells[j] = data.draw(st.text(max_size=6).filter(lambda t: "\n" not in t and "\r" not in t
+                                                            and "," not in t and '"' not in t))
+            lines[i] = ",".join(cells)
+        elif action == "cut":
+            lines[i] = lines[i][:data.draw(st.integers(0, len(lines[i])))]
+        elif action == "dup":
+            lines.insert(i, lines[i])
+        else:
+            lines.pop(i)
+            if not lines:
+                lines = [""]
+    path = os.path.join(s["dir"], "case.csv")
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    from pdw.studies import table
+    try:
+        out = pdw.load_sweep(path, as_frame=False)
+        assert out.dtype.names[0] == "index"
+    except pdw.InvalidInputError as e:
+        assert "case.csv" in str(e)
+    try:
+        rows = table.read_rows(path, s["study"])
+    except pdw.PdwError:
+        return
+    for r in rows.values():
+        assert type(r["index"]) is int and (r["n_steps"] == "" or type(r["n_steps"]) is int)
+        assert r["status"] in table.STATUSES
+
+
+test_fuzz_csv, test_fuzz_csv_study = _twin("csv", _csv)

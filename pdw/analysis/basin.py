@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core import _layout, paths
+from ..core import _layout, checks, paths
 from ..core.errors import InvalidInputError
 from ..core.params import Params
 from ..core.progress import progress_bar
@@ -166,12 +166,8 @@ def basin(params=None, phi=(0.69, 0.81, 100), thetad2=(-3.2, -0.4, 100), *, t_en
     p = Params.paper_steady() if params is None else params
     if not isinstance(p, Params):
         raise InvalidInputError("params must be a pdw.Params, got %s" % type(p).__name__)
-    (a0, a1, na), (b0, b1, nb) = phi, thetad2
-    if int(na) < 1 or int(nb) < 1:
-        raise InvalidInputError("grid sizes must be >= 1, got %r, %r" % (na, nb))
-    chunk_size = int(chunk_size)
-    if chunk_size < 1:
-        raise InvalidInputError("chunk_size must be >= 1, got %r" % (chunk_size,))
+    (a0, a1, na), (b0, b1, nb) = cmap.grid_axis("phi", phi), cmap.grid_axis("thetad2", thetad2)
+    chunk_size = checks.count("chunk_size", chunk_size, lo=1)
     z_ref = cmap.reference_point(p) if reference is None else lc._z(reference, "reference")
     if z_ref is None:
         raise InvalidInputError("the paper's initial condition does not reach a touch-down "

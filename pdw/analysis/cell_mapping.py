@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core import interrupt
+from ..core import checks, interrupt
 from ..core.errors import InvalidInputError
 from ..core.params import X0_PAPER, Params
 from ..core.progress import progress_bar
@@ -216,6 +216,23 @@ def _cell_index(a_edges, b_edges, a, b):
     return np.where(ok, i * nb + j, SINK)
 
 
+#: Most cells of one grid axis (`grid_axis`): a cell is at least one step map.
+MAX_GRID = 10 ** 6
+
+
+def grid_axis(name, spec):
+    """(lo, hi, n) of a grid axis given as (lo, hi, n): finite lo < hi, an integer n in
+    [1, `MAX_GRID`] (no 1.5 read as 1, no 2**62: `InvalidInputError` naming the axis)."""
+    try:
+        lo, hi, n = spec
+    except (TypeError, ValueError):
+        raise InvalidInputError("%s must be (lo, hi, n), got %r" % (name, spec)) from None
+    lo, hi = checks.number(name + "[0] (lo)", lo), checks.number(name + "[1] (hi)", hi)
+    if not hi > lo:
+        raise InvalidInputError("%s must have lo < hi, got %r" % (name, spec))
+    return lo, hi, checks.count(name + "[2] (n)", n, lo=1, hi=MAX_GRID)
+
+
 def cell_map(params=None, variant="paper", phi=(0.69, 0.81, 80), thetad2=(-3.2, -0.4, 80), *,
              reference=None, method="rodas4", workers=None, progress=False, **options) -> CellMap:
     """Simple cell mapping of the touch-down map on a (phi, thetad2) grid.
@@ -244,10 +261,7 @@ def cell_map(params=None, variant="paper", phi=(0.69, 0.81, 80), thetad2=(-3.2, 
     """
     p = Params.paper_steady() if params is None else params
     opts = {**lc.LOOSE, **options}
-    (a0, a1, na), (b0, b1, nb) = phi, thetad2
-    if not (a1 > a0 and b1 > b0 and int(na) >= 1 and int(nb) >= 1):
-        raise InvalidInputError("grid ranges must be (lo < hi, n >= 1), got %r, %r"
-                                % (phi, thetad2))
+    (a0, a1, na), (b0, b1, nb) = grid_axis("phi", phi), grid_axis("thetad2", thetad2)
     a_edges = np.linspace(a0, a1, int(na) + 1)
     b_edges = np.linspace(b0, b1, int(nb) + 1)
     contact = options.get("contact")

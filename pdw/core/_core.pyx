@@ -462,6 +462,9 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     _count("stop_steps", stop_steps, 0)
     _count("max_steps", max_steps, 0)
     _count("poll_every", poll_every, 0)
+    if poll_every == 1:     # the loop would poll before every step and never take one
+        raise _InvalidInputError("poll_every = 1 is out of range; allowed: 0 (never) or "
+                                 "integers in [2, %d]" % _MAX_COUNT)
     if not (dt > 0):
         raise ValueError("dt must be > 0, got %r" % dt)
     if method < 0 or method >= pdw_nmethods:

@@ -140,8 +140,10 @@ class ContactLaws(_Section):
     SECTION = "contact"
     normal: str = _f("hunt_crossley", "str", "normal law", _one_of(_layout.NORMAL_LAWS))
     friction: str = _f("coulomb", "str", "friction law", _one_of(_layout.FRICTION_LAWS))
-    k: float | None = _f(None, "float?", "normal stiffness [N/m^1.5; kelvin_voigt N/m]")
-    d: float | None = _f(None, "float?", "normal damping [N s/m^2.5; kelvin_voigt N s/m]")
+    k: float | None = _f(None, "float?", "normal stiffness [N/m^1.5; kelvin_voigt N/m] "
+                         "(default Params.k_n; kelvin_voigt its calibrated 7318)")
+    d: float | None = _f(None, "float?", "normal damping [N s/m^2.5; kelvin_voigt N s/m] "
+                         "(default Params.d_n; kelvin_voigt its calibrated 112.2)")
     e: float | None = _f(None, "float?", "coefficient of restitution (lankarani_nikravesh, flores)")
     v_in_min: float | None = _f(None, "float?", "smallest approach speed [m/s] (idem)")
     sigma0: float | None = _f(None, "float?", "LuGre bristle stiffness per unit normal force [1/m]")
