@@ -621,8 +621,8 @@ def c_options(*objects, skip: frozenset = frozenset()) -> dict:
     `pdw.core._batch.run_range` set these last (``opts=``)."""
     out: dict = {}
     for obj in objects:
-        cache = obj.__dict__.setdefault("_c", {})     # made once per (frozen) object
-        own = cache.get(skip)
+        cache: dict = obj.__dict__.setdefault("_c", {})     # made once per (frozen) object
+        own: dict | None = cache.get(skip)
         if own is None:
             own = cache[skip] = {}
             for f in dataclasses.fields(obj):
