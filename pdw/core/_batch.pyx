@@ -28,24 +28,10 @@ cdef extern from "pdw_model.h":
     const pdw_kernel pdw_kernels[]
 
 
+include "_opts.pxi"
+
+
 cdef extern from "pdw_sim.h":
-    ctypedef struct pdw_run_opts:
-        double dt
-        long n_steps
-        double t_end
-        double rtol, atol
-        double h_max
-        double event_tol
-        long max_steps
-        long record_every
-        int record_events
-        long stop_steps
-        int stop_touch_down
-        int periodic_k
-        double periodic_tol
-        double fall_hip_height
-        double fall_depth
-        double max_speed
     ctypedef struct pdw_sim:
         int status
 
@@ -158,7 +144,7 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
               dict out, long i0, long i1, int lanes, bint vector, int method=0,
               double t_end=0.0, double rtol=1e-6, double atol=1e-8, double h_max=0.0,
               double event_tol=1e-9, long max_steps=0, int isa=0, int stop_touch_down=0,
-              long[::1] next_walker=None):
+              long[::1] next_walker=None, dict opts=None):
     """Advance walkers [i0, i1) with `lanes` lanes (GIL released), writing rows of `out`.
 
     method: index into the compiled method table (pdw.core.integrators.METHODS); 0 (cdm) takes
@@ -167,6 +153,8 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     pdw_batch_method with t_end (0: n_steps dt), rtol, atol, h_max (0: t_end), event_tol and
     max_steps (0: no budget) as `pdw.core._core.run` takes them; dt is then the first step.
     stop_touch_down: 1 or 2, stop each walker at that leg's first touch-down; 0: off.
+    opts: further fields of pdw_run_opts by name (`pdw.sim.options.c_options`), set after the
+    arguments (as `pdw.core._core.run`'s); the fall limits are each walker's (hip, depth).
     next_walker: a shared (1,) counter (start it at i0): the threads that call this on the same
     range [i0, i1) take their walkers from it one by one (atomically), so every lane of every
     thread keeps busy until the batch runs out; None: the range is this call's alone.
@@ -283,6 +271,7 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     job.opt.h_max = h_max
     job.opt.event_tol = event_tol
     job.opt.max_steps = max_steps
+    _set_opts(&job.opt, opts)
     job.status = &status[0]
     job.stop_reason = &stop_reason[0]
     job.flags_final = &flags_final[0, 0]

@@ -55,6 +55,9 @@ cdef extern from "pdw_model.h":
     void pdw_trig(const double *x, double *trig) noexcept nogil
 
 
+include "_opts.pxi"
+
+
 cdef extern from "pdw_sim.h":
     ctypedef struct pdw_discrete:
         int flags[2]
@@ -69,23 +72,6 @@ cdef extern from "pdw_sim.h":
         long n_steps
         long n_touch_down, n_lift_off
         double ring[1][1]
-    ctypedef struct pdw_run_opts:
-        double dt
-        long n_steps
-        double t_end
-        double rtol, atol
-        double h_max
-        double event_tol
-        long max_steps
-        long record_every
-        int record_events
-        long stop_steps
-        int stop_touch_down
-        int periodic_k
-        double periodic_tol
-        double fall_hip_height
-        double fall_depth
-        double max_speed
     ctypedef struct pdw_sim:
         long poll_every
         const pdw_kernel *kernel
@@ -422,7 +408,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         long event_capacity=256, double event_tol=1e-9, bint record_events=True,
         long stop_steps=0, int periodic_k=0, double periodic_tol=0.0, double t_end=0.0,
         long max_steps=0, long poll_every=POLL_EVERY, buffers=None, approach_speeds0=None,
-        int stop_touch_down=0):
+        int stop_touch_down=0, dict opts=None):
     """Run one simulation in compiled code (GIL released). Returns a dict of arrays and status.
 
     The online gait analysis runs for every method: the result's "gait" holds the last
@@ -444,6 +430,10 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
 
     approach_speeds0: (v1, v2) [m/s] replaces the approach speeds of the feet that start in
     support (default: pdw_discrete_init's max(-v_y, 0)).
+
+    opts: fields of pdw_run_opts by name (`pdw.sim.options.c_options`), set after the
+    arguments: an option of the loops that has no argument here (a new stop condition) is a
+    field of the struct, a line of _opts.pxi and an entry of this dict.
 
     Shapes (checked): x0 (kernel_nx(k),), p (NP,).
     """
@@ -539,6 +529,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     s.opt.stop_touch_down = stop_touch_down
     s.opt.periodic_k = periodic_k
     s.opt.periodic_tol = periodic_tol
+    _set_opts(&s.opt, opts)
     pdw_gait_init(&s.gait)
     memcpy(s.x, &x0[0], nx * sizeof(double))
     flags0[0] = f1; flags0[1] = f2

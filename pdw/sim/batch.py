@@ -409,7 +409,7 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
     t_stop = t_end if adaptive else n_steps * dt
     opts = dict(method=METHODS.index(method), t_end=t_stop, rtol=rtol, atol=atol, h_max=h_max,
                 event_tol=event_tol, max_steps=budget, isa=_batch.ISAS[batch_isa()],
-                stop_touch_down=stop_touch_down)
+                stop_touch_down=stop_touch_down, opts=_opt.c_options(it, st, lim, skip=_opt.RUN_ARGS))
     if n:
         args = (k, x, pvec, f0, hip, depth, dt, n_steps, max_speed, stop_steps, periodic_steps,
                 periodic_tol, out, 0, n, lanes, bool(vector))

@@ -43,13 +43,14 @@ ON_FAILURE = ("raise", "return")
 CHECK_STEP = ("warn", "error", "off")
 
 
-def _f(default, kind, doc, check=None):
-    """An option field: its type (``kind``, a key of `KINDS`), its meaning, and a value check
-    returning an error text or None."""
+def _f(default, kind, doc, check=None, c=None):
+    """An option field: its type (``kind``, a key of `KINDS`), its meaning, a value check
+    returning an error text or None, and ``c``: the name of the field of the compiled loops'
+    pdw_run_opts (pdw/core/csrc/pdw_sim.h) that takes its value as is (`c_options`)."""
+    meta = dict(kind=kind, doc=doc, check=check, c=c)
     if isinstance(default, (dict, list)):
-        return field(default_factory=lambda: type(default)(default),
-                     metadata=dict(kind=kind, doc=doc, check=check))
-    return field(default=default, metadata=dict(kind=kind, doc=doc, check=check))
+        return field(default_factory=lambda: type(default)(default), metadata=meta)
+    return field(default=default, metadata=meta)
 
 
 def _positive(v):
@@ -280,12 +281,14 @@ class Integrator(_Section):
                             "rk4, dopri5, rodas4", _method_check)
     dt: float | None = _f(None, "float?", "step [s] (default 1e-4, the paper's); adaptive "
                           "methods: the first trial step; a run refuses one below DT_MIN)", _positive)
-    rtol: float = _f(1e-6, "float", "relative tolerance of adaptive methods", _positive)
-    atol: float = _f(1e-8, "float", "absolute tolerance of adaptive methods", _positive)
+    rtol: float = _f(1e-6, "float", "relative tolerance of adaptive methods", _positive,
+                     c="rtol")
+    atol: float = _f(1e-8, "float", "absolute tolerance of adaptive methods", _positive,
+                     c="atol")
     h_max: float | None = _f(None, "float?", "largest step of adaptive methods [s] (none)",
                              _positive)
     event_tol: float = _f(1e-9, "float", "adaptive methods locate flag switches to this [s]",
-                          _positive)
+                          _positive, c="event_tol")
     max_steps: int | None = _f(None, "int?", "step budget of adaptive methods (default "
                                "10^6 + 2 10^6 t_end/s); fixed-step methods refuse fewer than "
                                "t_end/dt", _at_least(1))
@@ -300,10 +303,12 @@ class Record(_Section):
     `Result.gait`)."""
 
     SECTION = "record"
-    every: int = _f(1, "int", "full state every k steps (0: none)", _count_check)
+    every: int = _f(1, "int", "full state every k steps (0: none)", _count_check,
+                    c="record_every")
     forces: bool = _f(True, "bool", "contact forces at the recorded samples")
     energies: bool = _f(False, "bool", "energies at the recorded samples (needs every > 0)")
-    events: bool = _f(True, "bool", "the list of touch-downs and lift-offs (else only counts)")
+    events: bool = _f(True, "bool", "the list of touch-downs and lift-offs (else only counts)",
+                      c="record_events")
     t_eval: tuple | None = _f(None, "times?", "times [s] at which to return the solution "
                               "(dense output; needs every = 1)")
     dense_output: bool = _f(False, "bool", "also return the interpolant Result.sol "
@@ -341,14 +346,14 @@ class Stop(_Section):
     SECTION = "stop"
     t_end: float | None = _f(None, "float?", "duration [s] (default 3.5)", _positive)
     steps: int = _f(0, "int", "stop after this many complete gait steps (0: no limit)",
-                    _count_check)
+                    _count_check, c="stop_steps")
     periodic: bool = _f(False, "bool", "stop when the last periodic_steps steps agree")
     periodic_steps: int = _f(4, "int", "k: how many successive steps must agree",
                              _periodic_steps_check)
     periodic_tol: float = _f(1e-3, "float", "relative tolerance on L, travel, P and cycle",
-                             _positive)
+                             _positive, c="periodic_tol")
     touch_down: int = _f(0, "int", "1 or 2: stop at that leg's first touch-down (0: off)",
-                         _one_of((0, 1, 2)))
+                         _one_of((0, 1, 2)), c="stop_touch_down")
 
     @property
     def periodic_k(self) -> int:
@@ -366,7 +371,7 @@ class Limits(_Section):
     fall_depth: float | None = _f(None, "float?", "fell when a foot is deeper [m] "
                                   "(default 0.25 l)", _positive)
     max_speed: float = _f(1e3, "float", "diverged when a velocity exceeds this [m/s, rad/s]",
-                          _positive)
+                          _positive, c="max_speed")
     on_failure: str = _f("raise", "str", "a diverged run: raise DivergedError, or return it",
                          _one_of(ON_FAILURE))
 
@@ -600,6 +605,34 @@ def check_type(name: str, value, cls):
                             % (name, cls.__name__, type(value).__name__))
 
 
+#: The fields of pdw_run_opts that `pdw.core._core.run` and `pdw.core._batch.run_range` take
+#: as arguments of their own: `c_options(..., skip=RUN_ARGS)` leaves them out (no work twice).
+RUN_ARGS = frozenset(("dt", "n_steps", "t_end", "rtol", "atol", "h_max", "event_tol",
+                      "max_steps", "record_every", "record_events", "stop_steps",
+                      "stop_touch_down", "periodic_k", "periodic_tol", "fall_hip_height",
+                      "fall_depth", "max_speed"))
+
+
+def c_options(*objects, skip: frozenset = frozenset()) -> dict:
+    """The fields of the compiled loops' pdw_run_opts (pdw/core/csrc/pdw_sim.h) that the given
+    option objects set as they are: each field with a C name (``_f(..., c=NAME)``), by that
+    name, unset (None) ones left out. What a run derives (dt, n_steps, t_end, the periodic
+    window, the fall limits of l, the step budget) it passes itself; `pdw.core._core.run` and
+    `pdw.core._batch.run_range` set these last (``opts=``)."""
+    out: dict = {}
+    for obj in objects:
+        cache: dict = obj.__dict__.setdefault("_c", {})     # made once per (frozen) object
+        own: dict | None = cache.get(skip)
+        if own is None:
+            own = cache[skip] = {}
+            for f in dataclasses.fields(obj):
+                name, value = f.metadata.get("c"), getattr(obj, f.name)
+                if name is not None and value is not None and name not in skip:
+                    own[name] = int(value) if isinstance(value, bool) else value
+        out.update(own)
+    return out
+
+
 class Settled(NamedTuple):
     """The options of one call, settled: the four objects (defaults where not given), the
     method, dt and t_end to run, and the plain arguments given by (deprecated) position."""
@@ -632,6 +665,7 @@ def _with(obj, **changes):
     new = object.__new__(type(obj))
     new.__dict__.update(obj.__dict__)
     new.__dict__.update(changes)
+    new.__dict__.pop("_c", None)                # c_options of the copy: made anew
     return new
 
 

@@ -472,7 +472,7 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
                     event_tol=event_tol, record_events=bool(record_events), stop_steps=stop_steps,
                     periodic_k=periodic_steps, periodic_tol=periodic_tol, t_end=t_end,
                     max_steps=budget, buffers=buffers, approach_speeds0=v_in0,
-                    stop_touch_down=stop_touch_down)
+                    stop_touch_down=stop_touch_down, opts=_opt.c_options(it, rec, st, lim, skip=_opt.RUN_ARGS))
     wall = time.perf_counter() - start
     energies = None
     if record_energies and raw["interrupted"] is None:

@@ -60,8 +60,9 @@ enum { PDW_STATUS_POLL = 65 };
 /* The options a loop reads: pdw.sim.options' Integrator, Record, Stop and Limits as C (plus
  * n_steps and the fixed t_end, derived from them). Filled once before a run (pdw/core/_core.pyx
  * run; the ensemble's job->opt, pdw_batch.c) and never written by a loop: the loops read them
- * through s->opt, the run state is the rest of pdw_sim. A new stop condition is one field here,
- * the loop that tests it (pdw_discrete.c for the gait's), and its option in pdw/sim/options.py. */
+ * through s->opt, the run state is the rest of pdw_sim. A new stop condition is one field here
+ * (and its line in pdw/core/_opts.pxi), the loop that tests it (pdw_discrete.c for the gait's),
+ * and its option in pdw/sim/options.py with this field's name (c=...), which the run sets. */
 typedef struct pdw_run_opts {
     /* Integrator */
     double dt;                  /* step [s] (adaptive methods: the first trial step) */
