@@ -231,3 +231,11 @@ def test_run_args_are_fields_and_a_new_c_field_is_passed():
     assert c_options(Stop(touch_down=1), skip=RUN_ARGS) == {}
     assert c_options(Stop(touch_down=1)) == {"stop_steps": 0, "periodic_tol": 1e-3,
                                              "stop_touch_down": 1}
+
+
+@pytest.mark.parametrize("fn", [pdw.simulate_batch, pdw.simulate_many])
+def test_ensembles_refuse_recording_keywords_instead_of_ignoring_them(fn):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        with pytest.raises(pdw.InvalidInputError, match="records no samples"):
+            fn(X2, 0.1, record_forces=False)

@@ -310,6 +310,7 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
                       flags0=(flags0, (0, 1)), threads=(threads, None), lanes=(lanes, LANES),
                       vector=(vector, False)))
     it, _, st, lim, method, dt, t_end, plain = settled
+    _opt.no_record("simulate_batch", settled)
     params = plain.get("params", params)
     variant = plain.get("variant", variant)
     flags0 = plain.get("flags0", flags0)

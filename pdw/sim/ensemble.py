@@ -77,6 +77,7 @@ def scalar_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None = N
         method=method, dt=dt, t_end=t_end,
         keywords=dict(params=(params, None), variant=(variant, "paper"), method=(method, None),
                       flags0=(flags0, (0, 1)), threads=(threads, None)))
+    _opt.no_record("scalar_batch", settled)
     plain = settled.plain
     params = plain.get("params", params)
     variant = plain.get("variant", variant)
@@ -201,6 +202,7 @@ def simulate_many(x0: ArrayLike, t_end: float | None = None, dt: float | None = 
         limits=limits, method=method, dt=dt, t_end=t_end,
         keywords=dict(params=(params, None), variant=(variant, "paper"), method=(method, None),
                       flags0=(flags0, (0, 1)), threads=(threads, None)))
+    _opt.no_record("simulate_many", settled)
     plain = settled.plain
     it, st = settled.ran()
     kw = dict(params=plain.get("params", params), variant=plain.get("variant", variant),

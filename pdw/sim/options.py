@@ -660,6 +660,14 @@ class Settled(NamedTuple):
         return it, st
 
 
+def no_record(fn: str, settled: Settled) -> None:
+    """The ensembles record no samples (their ``record`` lists walkers to rerun): an old
+    ``record_*`` keyword given to them is an error, not ignored."""
+    if settled.record is not DEFAULTS["record"]:
+        raise InvalidInputError("%s records no samples: record_every (walkers listed in "
+                                "record=) is its only recording option" % fn)
+
+
 def _with(obj, **changes):
     """A copy of an option object with already validated field values (no checks)."""
     new = object.__new__(type(obj))
