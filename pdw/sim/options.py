@@ -30,7 +30,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..core import _layout
-from ..core.checks import MAX_COUNT
+from ..core.checks import MAX_COUNT, unmasked
 from ..core.errors import InvalidInputError
 from ..core.integrators import METHODS
 
@@ -147,6 +147,7 @@ def _coerce(value, kind, key):
             raise bad()
         return bool(value)
     if kind in ("state", "times?", "pair?"):
+        value = unmasked("scene key %r" % key, value)
         if isinstance(value, (str, bytes, dict)) or not hasattr(value, "__len__") \
                 or (kind == "state" and len(value) != len(_layout.STATE)) \
                 or (kind == "pair?" and len(value) != 2) \
