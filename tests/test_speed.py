@@ -2,6 +2,7 @@
 and the runaway check's answers on the recorded samples (no copies). Timings are benchmarks
 (benchmarks/bench_simulate.py); instruction counts are guarded by tests/test_instructions.py."""
 import tracemalloc
+import warnings
 
 import numpy as np
 import pytest
@@ -79,3 +80,27 @@ def test_runaway_is_found_on_the_samples_and_the_final_state():
     raw["x"][2, 1] = 5.0
     assert simulation._honest(raw, "done", p, np.zeros(_core.NX), None) == "diverged"
     assert raw["failure"]["t"] == 1.0 and "hip rose" in raw["failure"]["reason"]
+
+
+def test_the_presets_shipped_step_limits_are_the_computed_ones():
+    """The first fixed-step simulate of a process looks its presets' limits up instead of
+    computing them for ~7 ms (issue 23); the table must be what the computation gives, bit
+    for bit (a change of the model or the calibration fails here: print
+    `stepsize._preset_table()` into `PRESET_DT_MAX`)."""
+    from pdw.sim import stepsize
+    assert stepsize._preset_table() == stepsize.PRESET_DT_MAX
+    for (preset, variant), limits in stepsize.PRESET_DT_MAX.items():
+        for method, dt_max in limits.items():
+            params = getattr(pdw.Params, preset)()
+            assert stepsize._dt_max(params, method, variant) == dt_max
+            assert stepsize.step_limit(params, method, variant).dt_max == dt_max
+
+
+def test_a_preset_warns_above_its_shipped_limit_and_not_below():
+    from pdw.sim import stepsize
+    dt_max = stepsize.PRESET_DT_MAX["paper", "paper"]["cdm"]
+    with pytest.warns(pdw.StepSizeWarning, match="exceeds the estimated"):
+        pdw.simulate(t_end=0.01, dt=dt_max * 1.001, on_failure="return", record_every=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        pdw.simulate(t_end=0.01, dt=dt_max / 1.001, on_failure="return", record_every=0)

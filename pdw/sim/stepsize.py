@@ -256,6 +256,15 @@ LANDING_FLAGS = (1, 0)
 
 
 def stance_states(params: Params | None = None, variant: str = "paper") -> tuple:
+    """The representative states of `step_limit` (`_stance_states`; computed once per
+    ``params`` and ``variant``): ``(X, flags)``, X (4, 8) a fresh copy."""
+    params = Params.paper() if params is None else params
+    X, flags = _stance_states(params, variant)
+    return X.copy(), list(flags)
+
+
+@functools.lru_cache(maxsize=256)
+def _stance_states(params: Params, variant: str) -> tuple:
     """The representative states of `step_limit`: ``(X, flags)``, X of shape (4, 8): the three
     `STANCE_STATES` (flags (0, 1)) and the landing, `DOUBLE_SUPPORT_STATE` with flags
     `LANDING_FLAGS`; each with the support foot stuck (x_o' set so that its slip velocity is 0
@@ -275,7 +284,9 @@ def stance_states(params: Params | None = None, variant: str = "paper") -> tuple
             x[5] = -(params.l - params.r) * math.sin(x[3]) * x[7]
         out.append(_set_hip_height(x, params, variant, fl, load * params.weight))
         flags.append(fl)
-    return np.array(out), flags
+    X = np.array(out)
+    X.flags.writeable = False
+    return X, tuple(flags)
 
 
 # --------------------------------------------------------------------------------------------
@@ -401,11 +412,49 @@ def _chatter_limit(params: Params, method: str, variant: str) -> float:
     return min(_limits(params, method, variant, features=None)[:len(STANCE_STATES)])
 
 
-def _dt_max(params, method, variant):
+def _dt_max_computed(params, method, variant):
     dt = CALIBRATION[variant][method] * _linear(params, method, variant)[0]
     if _friction_load(params, variant) >= FRICTION_LOAD:
         dt = min(dt, CHATTER_CALIBRATION * _chatter_limit(params, method, variant))
     return dt
+
+
+#: `_dt_max` of the presets (`Params.paper`, `Params.paper_steady`), as computed by
+#: `_dt_max_computed` (about 7 ms each, which the first fixed-step `simulate` of a process would
+#: pay: 2-3x the paper run it checks; issue 23). tests/test_speed.py checks that every entry is
+#: still what the computation gives, bit for bit; `_preset_table()` prints the table anew.
+PRESET_DT_MAX = {
+    ("paper", "paper"): {"cdm": 0.0009030974043457654, "verlet": 0.000885461827847902,
+                         "rk4": 0.0038950736442615094},
+    ("paper", "consistent"): {"cdm": 0.0013552465686015552, "verlet": 0.0006777378803506724,
+                              "rk4": 0.0027709840482022952},
+    ("paper_steady", "paper"): {"cdm": 0.0009047607891374658, "verlet": 0.000885846897839419,
+                                "rk4": 0.0038956723965252087},
+    ("paper_steady", "consistent"): {"cdm": 0.0013597924412892721,
+                                     "verlet": 0.0006781025277612672,
+                                     "rk4": 0.0027724749375081332},
+}
+
+
+@functools.lru_cache(maxsize=1)
+def _presets():
+    """{(Params of a preset, variant): {method: dt_max}} of `PRESET_DT_MAX`."""
+    return {(getattr(Params, preset)(), variant): v
+            for (preset, variant), v in PRESET_DT_MAX.items()}
+
+
+def _preset_table():
+    """`PRESET_DT_MAX` computed anew (for a change of the model or of the calibration)."""
+    return {(preset, variant): {m: _dt_max_computed(getattr(Params, preset)(), m, variant)
+                                for m in FIXED_STEP}
+            for preset, variant in PRESET_DT_MAX}
+
+
+def _dt_max(params, method, variant):
+    known = _presets().get((params, variant))
+    if known is not None and method in known:
+        return known[method]
+    return _dt_max_computed(params, method, variant)
 
 
 @functools.lru_cache(maxsize=256)
@@ -480,8 +529,9 @@ def check_step(dt: float, params: Params, method: str, variant: str, mode: str =
 
     ``mode``: "warn" (a `pdw.StepSizeWarning` when dt > `step_limit`), "error" (raise
     `pdw.StepSizeError` instead), "off". Adaptive methods are not checked (their dt is only
-    the first trial step). Returns the `StepLimit` when dt exceeds it, else None. Costs ~7 ms
-    per new (params, method, variant), nothing after (cached).
+    the first trial step). Returns the `StepLimit` when dt exceeds it, else None. Costs ~5 ms
+    per new (params, method, variant), nothing after (cached), and nothing for the presets
+    (`PRESET_DT_MAX`).
     """
     if mode not in CHECK_MODES:
         raise InvalidInputError("check_step must be one of %s, got %r"
