@@ -104,3 +104,30 @@ def test_a_preset_warns_above_its_shipped_limit_and_not_below():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         pdw.simulate(t_end=0.01, dt=dt_max / 1.001, on_failure="return", record_every=0)
+
+
+def test_the_caches_of_the_python_set_up_hand_out_nothing_shared_that_can_change():
+    """Python around a run (issue 23): the default Params and Contact are shared (immutable),
+    the parameter vector is cached per Params but every caller gets its own writeable copy,
+    the kernel index is cached but unhashable features still work, checks keep refusing."""
+    from pdw.core import checks, model
+    assert pdw.Params.paper() is pdw.Params.paper() and pdw.Params.paper() == pdw.Params()
+    assert pdw.Params.paper(d_hip=0.01) == pdw.Params.paper_steady()
+    with pytest.raises(AttributeError):
+        pdw.Params.paper().l = 1.0
+    p1 = model.parameter_vector(pdw.Params.paper())
+    p1[:] = -1.0
+    p2 = model.parameter_vector(pdw.Params.paper())
+    assert p2.flags.writeable and not np.array_equal(p1, p2)
+    feats = [f for f in _layout.FEATURES if f != "tangential"]
+    assert model.kernel_index("paper", feats) == model.kernel_index("paper", tuple(feats))
+    assert model.kernel_index("paper", feats) != model.kernel_index("paper")
+    for bad in (True, np.bool_(True), "1", 1j, None):
+        with pytest.raises(pdw.InvalidInputError):
+            checks.number("dt", bad)
+    for bad in ((0, 2), (0.0, 1), (0, 1, 0), "01"):
+        with pytest.raises(pdw.InvalidInputError):
+            checks.flags("flags0", bad)
+    assert checks.count("n", 3) == 3 and checks.number("x", 2) == 2.0
+    with pytest.raises(pdw.InvalidInputError, match="out of range"):
+        checks.count("n", -1)

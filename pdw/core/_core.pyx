@@ -352,10 +352,18 @@ def bench(int k, str what, const double[::1] x, const double[::1] p, int f1, int
     return ns
 
 
+def _method_table():
+    return tuple((pdw_methods[i].name.decode(), pdw_methods[i].order,
+                  bool(pdw_methods[i].adaptive)) for i in range(pdw_nmethods))
+
+
+_METHOD_TABLE = _method_table()
+
+
 def method_table():
-    """[(name, order, adaptive)] of the compiled integrators, in method-id order."""
-    return [(pdw_methods[i].name.decode(), pdw_methods[i].order, bool(pdw_methods[i].adaptive))
-            for i in range(pdw_nmethods)]
+    """[(name, order, adaptive)] of the compiled integrators, in method-id order (a new list
+    of the table read once from C)."""
+    return list(_METHOD_TABLE)
 
 
 def rk_tableau(str name):

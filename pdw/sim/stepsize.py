@@ -32,6 +32,7 @@ from ..core.integrators import METHODS
 from ..core.model import check_variant, contact_forces, jacobian
 from ..core.params import X0_PAPER, Params
 from .stepsize_laws import LAW_CALIBRATION, LUGRE_SIGMA1, law_factor, law_message, law_of  # noqa: F401
+from .stepsize_presets import PRESET_DT_MAX
 
 NQ = _core.NQ
 NX = _core.NX
@@ -417,23 +418,6 @@ def _dt_max_computed(params, method, variant):
     if _friction_load(params, variant) >= FRICTION_LOAD:
         dt = min(dt, CHATTER_CALIBRATION * _chatter_limit(params, method, variant))
     return dt
-
-
-#: `_dt_max` of the presets (`Params.paper`, `Params.paper_steady`), as computed by
-#: `_dt_max_computed` (about 7 ms each, which the first fixed-step `simulate` of a process would
-#: pay: 2-3x the paper run it checks; issue 23). tests/test_speed.py checks that every entry is
-#: still what the computation gives, bit for bit; `_preset_table()` prints the table anew.
-PRESET_DT_MAX = {
-    ("paper", "paper"): {"cdm": 0.0009030974043457654, "verlet": 0.000885461827847902,
-                         "rk4": 0.0038950736442615094},
-    ("paper", "consistent"): {"cdm": 0.0013552465686015552, "verlet": 0.0006777378803506724,
-                              "rk4": 0.0027709840482022952},
-    ("paper_steady", "paper"): {"cdm": 0.0009047607891374658, "verlet": 0.000885846897839419,
-                                "rk4": 0.0038956723965252087},
-    ("paper_steady", "consistent"): {"cdm": 0.0013597924412892721,
-                                     "verlet": 0.0006781025277612672,
-                                     "rk4": 0.0027724749375081332},
-}
 
 
 @functools.lru_cache(maxsize=1)
