@@ -61,6 +61,7 @@ def _counted(fn):
 
 
 def _child(which):
+    sys.path.insert(0, str(ROOT))       # this tree's pdw (a script's sys.path[0] is its folder)
     import numpy as np
 
     import pdw

@@ -76,6 +76,17 @@ def _rk(name):
     return np.array(T["A"]), np.array(T["b"])
 
 
+@functools.lru_cache(maxsize=1)
+def _blocks():
+    """[E Z Z], [Z E Z], [Z Z E] (NQ x 3 NQ; E the identity, Z zeros), read-only: the block
+    rows of the second-order step maps, built once (the step-size check builds ~60 maps)."""
+    Z, E = np.zeros((NQ, NQ)), np.eye(NQ)
+    out = (np.hstack([E, Z, Z]), np.hstack([Z, E, Z]), np.hstack([Z, Z, E]))
+    for b in out:
+        b.flags.writeable = False
+    return out
+
+
 def step_matrix(method: str, J, h: float) -> np.ndarray:
     """The one-step map of ``method`` with step ``h`` applied to the linear system x' = J x.
 
@@ -100,15 +111,15 @@ def step_matrix(method: str, J, h: float) -> np.ndarray:
             K.append(J @ X)
         return eye + h * sum(b[i] * K[i] for i in range(len(b)))
     Aq, Bv = J[NQ:, :NQ], J[NQ:, NQ:]
-    Z, E = np.zeros((NQ, NQ)), np.eye(NQ)
+    B0, B1, B2 = _blocks()
     if method == "verlet":
-        vh = np.hstack([Z, E, 0.5 * h * E])
-        q1 = np.hstack([E, Z, Z]) + h * vh
-        a1 = Aq @ q1 + Bv @ (vh + np.hstack([Z, Z, 0.5 * h * E]))
+        vh = B1 + 0.5 * h * B2
+        q1 = B0 + h * vh
+        a1 = Aq @ q1 + Bv @ (vh + 0.5 * h * B2)
         v1 = vh + 0.5 * h * a1
         return np.vstack([q1, v1, a1])
     if method == "cdm":
-        Un, Um1, Um2 = np.hstack([E, Z, Z]), np.hstack([Z, E, Z]), np.hstack([Z, Z, E])
+        Un, Um1, Um2 = B0, B1, B2
         U1 = 2 * Un - Um1 + h * h * (Aq @ Un) + 0.5 * h * (Bv @ (Un - Um2))
         return np.vstack([U1, Un, Um1])
     raise InvalidInputError("no explicit step map for method %r; allowed: cdm, verlet, rk4, dopri5"
