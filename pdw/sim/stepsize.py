@@ -16,6 +16,9 @@ the stiffest forces of the model (docs/stability.md has the measured maps). This
 
 Other contact laws (`pdw.Contact`): the default law's estimate at the run's parameters times a
 per-law, per-method factor fitted on measured limits (`pdw.sim.stepsize_laws`).
+
+Why this module is long: the step maps, the representative states and the check built on them
+share their constants and caches; the presets' limits and the per-law factors are apart.
 """
 from __future__ import annotations
 
@@ -32,7 +35,7 @@ from ..core.integrators import METHODS
 from ..core.model import check_variant, contact_forces, jacobian
 from ..core.params import X0_PAPER, Params
 from .stepsize_laws import LAW_CALIBRATION, LUGRE_SIGMA1, law_factor, law_message, law_of  # noqa: F401
-from .stepsize_presets import PRESET_DT_MAX
+from .stepsize_presets import PRESET_DT_MAX, preset_limits
 
 NQ = _core.NQ
 NX = _core.NX
@@ -431,13 +434,6 @@ def _dt_max_computed(params, method, variant):
     return dt
 
 
-@functools.lru_cache(maxsize=1)
-def _presets():
-    """{(Params of a preset, variant): {method: dt_max}} of `PRESET_DT_MAX`."""
-    return {(getattr(Params, preset)(), variant): v
-            for (preset, variant), v in PRESET_DT_MAX.items()}
-
-
 def _preset_table():
     """`PRESET_DT_MAX` computed anew (for a change of the model or of the calibration)."""
     return {(preset, variant): {m: _dt_max_computed(getattr(Params, preset)(), m, variant)
@@ -446,7 +442,7 @@ def _preset_table():
 
 
 def _dt_max(params, method, variant):
-    known = _presets().get((params, variant))
+    known = preset_limits(params, variant)
     if known is not None and method in known:
         return known[method]
     return _dt_max_computed(params, method, variant)

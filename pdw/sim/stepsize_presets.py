@@ -1,5 +1,10 @@
 """The step-size check's limits of the presets, precomputed: the first fixed-step `simulate` of
 a process looks them up instead of computing them (`pdw.sim.stepsize`; issue 23)."""
+from __future__ import annotations
+
+import functools
+
+from ..core.params import Params
 
 #: `pdw.sim.stepsize._dt_max` of the presets (`Params.paper`, `Params.paper_steady`), as
 #: computed by `pdw.sim.stepsize._dt_max_computed` (about 7 ms each, which the first fixed-step
@@ -17,3 +22,14 @@ PRESET_DT_MAX = {
                                      "verlet": 0.0006781025277612672,
                                      "rk4": 0.0027724749375081332},
 }
+
+
+@functools.lru_cache(maxsize=1)
+def _presets() -> dict:
+    return {(getattr(Params, preset)(), variant): v
+            for (preset, variant), v in PRESET_DT_MAX.items()}
+
+
+def preset_limits(params: Params, variant: str) -> dict | None:
+    """{method: dt_max} of ``params`` and ``variant`` when ``params`` is a preset, else None."""
+    return _presets().get((params, variant))
