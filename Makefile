@@ -10,7 +10,8 @@ SOURCES := $(wildcard generated/*.c generated/*.h pdw/core/*.pyx pdw/core/*.pxi 
 # an extra's requirements, read from pyproject.toml (installed without rebuilding pdw)
 EXTRA_REQS = $(PY) -c "import sys, tomllib; print('\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies'][sys.argv[1]]))"
 
-.PHONY: docs all run test test-quick lint test-all derive check-generated bench study sanitize mutation clean distclean
+.PHONY: docs all run test test-quick lint test-all derive check-generated bench study sanitize mutation clean \
+        distclean instructions instructions-baseline
 
 all: $(STAMP)
 
@@ -78,6 +79,19 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_sweep_batch.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_step_maps.py $(UPDATE_DOCS)
 	$(PY) benchmarks/work_precision.py $(UPDATE_DOCS)
+
+## instructions: the instruction-count guard (valgrind's callgrind; benchmarks/instructions.py):
+## the paper run with and without recording, a first call, 64-walker batches, find_gait,
+## compared with benchmarks/results/instructions.json (fails on growth > 3 %; without valgrind,
+## or with other compiler/libc/Python/NumPy versions than the baselines', one line and skip).
+## About 30 s of CPU: run by .ci/run, not by `make test`.
+instructions: $(STAMP)
+	$(PY) benchmarks/instructions.py
+
+## instructions-baseline: re-count and rewrite the baselines -- deliberately: commit the new
+## benchmarks/results/instructions.json with a message that says why the counts changed
+instructions-baseline: $(STAMP)
+	$(PY) benchmarks/instructions.py --update
 
 ## study: slow studies (marked slow in tests/), written to out/ (UPDATE_DOCS as for bench)
 study: $(STAMP)

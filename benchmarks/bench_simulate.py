@@ -1,55 +1,135 @@
 """Speed and memory of the main job: the paper's typical gait, 3.5 s at dt = 1e-4 with the
-central difference method, with event recording only and with full recording.
+central difference method (issue 23's goals).
 
-Run: `make bench` (or `.venv/bin/python benchmarks/bench_simulate.py`). Prints a table and
-writes benchmarks/results/simulate.txt. Wall times are medians of repeated runs in this one
-process; the reference is the issue's 2-4 ms for a compiled central-difference loop.
+* recording: the run with events only, with full recording and with every 10th state, in turn
+  in each round (interleaved), CPU time (time.process_time), medians; ratios to events only;
+  peak traced memory (tracemalloc) of each, and the bytes of the samples it records;
+* the first call: `pdw.simulate()` (record_every=0, the default step-size check) in fresh
+  processes, first and second call of each process, CPU time;
+* Python around a run: `pdw.simulate` of 2 steps against the compiled loop `_core.run` of the
+  same 2 steps (CPU time per call, the difference is the Python set-up and Result assembly).
+
+The load average is printed with the numbers: the development machine is shared, so read the
+ratios (measured side by side), not the absolute times.
+
+Run: `make bench` (or `.venv/bin/python benchmarks/bench_simulate.py [ROUNDS]`). Writes
+benchmarks/results/simulate.txt with --update-docs (else out/benchmarks/results/).
 """
+import os
 import statistics
+import subprocess
+import sys
 import time
 import tracemalloc
 
+import numpy as np
 from _results import publish
 
 import pdw
+from pdw.core import _core, _layout
+from pdw.core.model import parameter_vector
 
-REPEATS = 31
-REFERENCE_MS = (2.0, 4.0)
+ROUNDS = int(sys.argv[1]) if len(sys.argv) > 1 else 21
+FRESH = 7
+clock = time.process_time
+SAMPLE = 8 * (1 + _core.NX + 1 + len(_layout.RECORD_CONTACT))
+CASES = [
+    ("events only", dict(record_every=0, record_forces=False)),
+    ("full recording (state, flags, forces every step)", dict(record_every=1, record_forces=True)),
+    ("state every 10th step", dict(record_every=10, record_forces=False)),
+]
+FIRST_CALL = """
+import time, pdw
+t = time.process_time(); pdw.simulate(record_every=0); t1 = time.process_time()
+pdw.simulate(record_every=0); t2 = time.process_time()
+print(t1 - t, t2 - t1)
+"""
 
 
-def timed(**kw):
-    ts = []
-    for _ in range(REPEATS):
-        t0 = time.perf_counter()
-        r = pdw.simulate(**kw)
-        ts.append(time.perf_counter() - t0)
-    return statistics.median(ts), r
+def load():
+    return "load %.1f %.1f %.1f" % os.getloadavg()
 
 
 def peak_memory(**kw):
     tracemalloc.start()
-    pdw.simulate(**kw)
+    r = pdw.simulate(**kw)
     _, peak = tracemalloc.get_traced_memory()
     tracemalloc.stop()
-    return peak
+    return peak, r
+
+
+def recording(lines):
+    P = pdw.Params.paper()
+    times = {label: [] for label, _ in CASES}
+    for _label, kw in CASES:                    # warm: the step check, the allocator
+        pdw.simulate(params=P, **kw)
+    for _ in range(ROUNDS):
+        for label, kw in CASES:
+            t = clock()
+            pdw.simulate(params=P, **kw)
+            times[label].append(clock() - t)
+    base = statistics.median(times[CASES[0][0]])
+    lines += ["typical gait: Params.paper(), X0_PAPER, 3.5 s, dt = 1e-4 (35,000 steps), method cdm",
+              "CPU time of pdw.simulate (Python set-up included), median of %d interleaved rounds; %s"
+              % (ROUNDS, load()), "",
+              "%-50s %8s %8s %9s %11s %11s" % ("recording", "ms", "ns/step", "vs events", "peak MB",
+                                              "samples MB")]
+    for label, kw in CASES:
+        t = statistics.median(times[label])
+        mem, r = peak_memory(params=P, **kw)
+        assert r.status == "walked"
+        rec = len(r.t) * (SAMPLE if kw["record_forces"] else SAMPLE - 8 * len(_layout.RECORD_CONTACT))
+        lines.append("%-50s %8.2f %8.1f %8.2fx %11.3f %11.3f" % (
+            label, 1e3 * t, 1e9 * t / r.n_steps, t / base, mem / 1e6, rec / 1e6))
+
+
+def first_call(lines):
+    firsts, seconds = [], []
+    for _ in range(FRESH):
+        out = subprocess.run([sys.executable, "-c", FIRST_CALL], capture_output=True, text=True,
+                             check=True).stdout.split()
+        firsts.append(float(out[0]))
+        seconds.append(float(out[1]))
+    a, b = statistics.median(firsts), statistics.median(seconds)
+    lines += ["", "first call of a fresh process (simulate(record_every=0), default step check), "
+              "%d processes; %s" % (FRESH, load()),
+              "  first %.2f ms, second %.2f ms: first / second = %.2fx (per process: %s)"
+              % (1e3 * a, 1e3 * b, a / b,
+                 ", ".join("%.2f" % (f / s) for f, s in zip(firsts, seconds)))]
+
+
+def python_overhead(lines, n=2000):
+    P = pdw.Params.paper()
+    x, p = np.asarray(pdw.X0_PAPER, dtype=float), parameter_vector(P)
+    jobs = {
+        "simulate, 2 steps, params given": lambda: pdw.simulate(params=P, t_end=2e-4, record_every=0),
+        "simulate, 2 steps, defaults": lambda: pdw.simulate(t_end=2e-4, record_every=0),
+        "_core.run, 2 steps": lambda: _core.run(0, 0, x, p, 0, 1, 1e-4, 2, 0, True, 0.25, 0.125, 1e3),
+    }
+    times = {k: [] for k in jobs}
+    for f in jobs.values():
+        f()
+    for _ in range(7):
+        for k, f in jobs.items():
+            t = clock()
+            for _ in range(n // 7):
+                f()
+            times[k].append((clock() - t) / (n // 7))
+    med = {k: statistics.median(v) for k, v in times.items()}
+    lines += ["", "Python around a run: CPU time per call, median of 7 interleaved rounds of %d "
+              "calls; %s" % (n // 7, load())]
+    for k, v in med.items():
+        lines.append("  %-40s %7.1f us" % (k, 1e6 * v))
+    lines.append("  Python set-up and Result (simulate - _core.run): %.1f us (defaults: %.1f us)"
+                 % (1e6 * (med["simulate, 2 steps, params given"] - med["_core.run, 2 steps"]),
+                    1e6 * (med["simulate, 2 steps, defaults"] - med["_core.run, 2 steps"])))
 
 
 def main():
-    cases = [
-        ("events only", dict(record_every=0, record_forces=False)),
-        ("full recording (state, flags, forces every step)", dict(record_every=1, record_forces=True)),
-        ("state every 10th step", dict(record_every=10, record_forces=False)),
-    ]
-    lines = ["typical gait: Params.paper(), X0_PAPER, 3.5 s, dt = 1e-4 (35,000 steps), method cdm",
-             "median of %d runs (wall time of pdw.simulate, Python set-up included)" % REPEATS, "",
-             "%-50s %9s %9s %12s %12s" % ("recording", "ms", "ns/step", "vs 2-4 ms", "peak memory")]
-    for label, kw in cases:
-        t, r = timed(**kw)
-        mem = peak_memory(**kw)
-        assert r.status == "walked"
-        lines.append("%-50s %9.2f %9.1f %5.2f-%5.2fx %9.2f MB" % (
-            label, 1e3 * t, 1e9 * t / r.n_steps, 1e3 * t / REFERENCE_MS[1], 1e3 * t / REFERENCE_MS[0],
-            mem / 2**20))
+    lines = []
+    recording(lines)
+    first_call(lines)
+    python_overhead(lines)
     publish("simulate.txt", lines)
 
 

@@ -19,6 +19,7 @@ from cpython.buffer cimport (PyObject_GetBuffer, PyBuffer_Release, PyBUF_C_CONTI
 
 cdef extern from "pdw_model.h":
     enum:
+        PDW_X_Y_O, PDW_X_THETA1, PDW_X_THETA2
         PDW_NX, PDW_NQ, PDW_NP, PDW_NPARAM, PDW_NKIN, PDW_NCONTACT, PDW_NENERGY, PDW_NWORK
         PDW_NKERNELS, PDW_NEVENT, PDW_NREC
         PDW_WORK_TRIG, PDW_WORK_KIN, PDW_WORK_CONTACT, PDW_WORK_M, PDW_WORK_F, PDW_WORK_QDD
@@ -339,10 +340,18 @@ def bench(int k, str what, const double[::1] x, const double[::1] p, int f1, int
     return ns
 
 
+def _method_table():
+    return tuple((pdw_methods[i].name.decode(), pdw_methods[i].order,
+                  bool(pdw_methods[i].adaptive)) for i in range(pdw_nmethods))
+
+
+_METHOD_TABLE = _method_table()
+
+
 def method_table():
-    """[(name, order, adaptive)] of the compiled integrators, in method-id order."""
-    return [(pdw_methods[i].name.decode(), pdw_methods[i].order, bool(pdw_methods[i].adaptive))
-            for i in range(pdw_nmethods)]
+    """[(name, order, adaptive)] of the compiled integrators, in method-id order (a new list
+    of the table read once from C)."""
+    return list(_METHOD_TABLE)
 
 
 def rk_tableau(str name):
@@ -383,21 +392,68 @@ def ros_tableau(str name="rodas4"):
 
 #: Loop iterations between two polls for signals (Ctrl-C) and the step budget.
 POLL_EVERY = 2000
-#: First size of the record buffers [samples]; they double as a run needs more.
+#: First size of the record buffers of an adaptive run [samples] (its step count is not known
+#: in advance); they double as the run needs more and are trimmed to the samples recorded at its
+#: end. A fixed-step run's buffers hold exactly its n_steps // record_every + 2 samples when
+#: that is at most RECORD_EXACT_MAX, else they grow from RECORD_CHUNK as an adaptive run's.
 RECORD_CHUNK = 1 << 16
+RECORD_EXACT_MAX = 1 << 24
 _SAMPLE_BYTES = 8 * (1 + PDW_NX + 1 + PDW_NREC)
 
 
-cdef object _grown(object a, long n):
-    """a (rows, ...) copied into n rows (zeros after), or pdw's MemoryError."""
+cdef tuple _records(long n, int nx, bint contact):
+    """Record arrays for n samples: (t (n,), x (n, nx), flags (n, 2) intc, contact (n or 0,
+    NREC)), C-contiguous views of one np.empty block (rows are read only once written, so
+    reused memory is not cleared first; one block is reused by the allocator from one run to
+    the next, where four arrays fault in fresh pages for several runs), or pdw's MemoryError
+    saying how much recording needs."""
+    cdef long nc = n if contact else 0
     try:
-        out = np.zeros((n,) + a.shape[1:], dtype=a.dtype)
-    except MemoryError:
+        block = np.empty(n * (2 + nx) + nc * PDW_NREC)     # t, x, flags (2 int = 1 double)
+    except (MemoryError, ValueError):
         raise MemoryError("recording needs more than %.3g GB (%d samples of %d bytes): record "
                           "fewer samples (record_every) or none (record_every=0)"
                           % (n * _SAMPLE_BYTES / 1e9, n, _SAMPLE_BYTES)) from None
+    t = block[:n]
+    x = block[n:n * (1 + nx)].reshape(n, nx)
+    flags = block[n * (1 + nx):n * (2 + nx)].view(np.intc).reshape(n, 2)
+    c = block[n * (2 + nx):].reshape(nc, PDW_NREC)
+    return t, x, flags, c
+
+
+cdef tuple _records_copy(tuple old, long n, long n_copy, int nx, bint contact):
+    """Fresh record arrays for n samples (`_records`) holding the first n_copy of old's."""
+    new = _records(n, nx, contact)
+    cdef int i
+    for i in range(4):
+        if new[i].shape[0]:
+            new[i][:n_copy] = old[i][:n_copy]
+    return new
+
+
+cdef object _grown(object a, long n):
+    """a (rows, ...) copied into the first rows of n (the rest not yet written)."""
+    out = np.empty((n,) + a.shape[1:], dtype=a.dtype)
     out[:a.shape[0]] = a
     return out
+
+
+@_named_buffers
+def first_runaway(const double[:, ::1] x, double hip_max, double angle_max):
+    """Index of the first row of x (N, nx >= 4) whose hip height y_o exceeds hip_max or whose
+    leg angle theta1 or theta2 exceeds angle_max in magnitude; -1 if none (NaN exceeds
+    nothing). One pass over the rows, no copy (the runaway check of `pdw.simulate`)."""
+    if x.shape[0] and x.shape[1] <= PDW_X_THETA2:
+        raise ValueError("x must have at least %d columns, got %d" % (PDW_X_THETA2 + 1, x.shape[1]))
+    cdef Py_ssize_t i, found = -1
+    with nogil:
+        for i in range(x.shape[0]):
+            if (x[i, PDW_X_Y_O] > hip_max or x[i, PDW_X_THETA1] > angle_max
+                    or x[i, PDW_X_THETA1] < -angle_max or x[i, PDW_X_THETA2] > angle_max
+                    or x[i, PDW_X_THETA2] < -angle_max):
+                found = i
+                break
+    return found
 
 
 @_named_buffers
@@ -421,12 +477,15 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     Fixed-step methods take n_steps steps of dt; adaptive ones integrate to t_end (default
     n_steps*dt) with first step dt, locating flag switches to within event_tol [s], and fail
     (reason PDW_REASON_BUDGET) once max_steps (> 0) steps were tried. The record buffer first
-    holds min(n_steps/record_every + 2, RECORD_CHUNK) samples (or max_records); when a loop
-    fills the event or the record buffer it returns PDW_STATUS_EVENTS_FULL /
-    PDW_STATUS_RECORDS_FULL; this function then doubles that buffer and calls the loop again,
-    which resumes where it stopped: no sample is dropped. Every poll_every loop iterations the
-    loop returns PDW_STATUS_POLL: signals are checked here (GIL held); on Ctrl-C the run stops
-    and the result (so far) is returned with "interrupted" set to the KeyboardInterrupt.
+    holds n_steps/record_every + 2 samples (or max_records; an adaptive run's, or one of more
+    than RECORD_EXACT_MAX samples, at most RECORD_CHUNK); when a loop fills the event or the
+    record buffer it returns PDW_STATUS_EVENTS_FULL / PDW_STATUS_RECORDS_FULL; this function
+    then doubles that buffer and calls the loop again, which resumes where it stopped: no sample
+    is dropped. Record arrays of its own that hold more than the samples recorded (an adaptive
+    run, an early stop) are trimmed to them at the end (one copy). Every poll_every loop
+    iterations the loop returns PDW_STATUS_POLL: signals are checked here (GIL held); on Ctrl-C
+    the run stops and the result (so far) is returned with "interrupted" set to the
+    KeyboardInterrupt.
 
     approach_speeds0: (v1, v2) [m/s] replaces the approach speeds of the feet that start in
     support (default: pdw_discrete_init's max(-v_y, 0)).
@@ -464,9 +523,13 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     if periodic_k < 0 or periodic_k == 1 or periodic_k > PDW_STEP_RING:
         raise ValueError("periodic_k must be 0 (off) or in [2, %d], got %d" % (PDW_STEP_RING, periodic_k))
     cdef long n_rec_cap = 0
+    cdef bint adaptive = pdw_methods[method].adaptive
     if record_every > 0:
-        n_rec_cap = max_records if max_records > 0 else min(n_steps // record_every + 2,
-                                                            <long>RECORD_CHUNK)
+        n_rec_cap = n_steps // record_every + 2        # a fixed-step run's samples, exactly
+        if max_records > 0:
+            n_rec_cap = max_records
+        elif adaptive or n_rec_cap > RECORD_EXACT_MAX:
+            n_rec_cap = min(n_rec_cap, <long>RECORD_CHUNK)
         n_rec_cap = max(n_rec_cap, 3)
     cdef pdw_advance_fn advance = pdw_methods[method].advance
     memset(&s, 0, sizeof(pdw_sim))
@@ -503,11 +566,8 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
             _rows("buffers[3] (contact)", rec_contact.shape[0],
                   rec_contact.shape[1] if rec_contact.ndim == 2 else -1, n_rec_cap, PDW_NREC)
     else:
-        rec_t = _zeros("the record (max_records)", n_rec_cap)
-        rec_x = _zeros("the record (max_records)", (n_rec_cap, nx))
-        rec_flags = _zeros("the record (max_records)", (n_rec_cap, 2), np.intc)
-        rec_contact = _zeros("the record (max_records)",
-                             (n_rec_cap if record_contact else 0, PDW_NREC))
+        rec_t, rec_x, rec_flags, rec_contact = _records(n_rec_cap, nx, record_contact)
+    cdef bint owned = buffers is None or record_every == 0  # the record arrays are ours
     events = _zeros("the event buffer (event_capacity)",
                     (max(event_capacity, 4) if record_events else 1, PDW_NEVENT))
     cdef double[::1] v_t = rec_t
@@ -559,11 +619,8 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         elif status == PDW_STATUS_RECORDS_FULL:
             # double the record arrays (copying what is there) and resume
             n_rec_cap = 2 * max(n_rec_cap, 2)
-            rec_t = _grown(rec_t, n_rec_cap)
-            rec_x = _grown(rec_x, n_rec_cap)
-            rec_flags = _grown(rec_flags, n_rec_cap)
-            if record_contact:
-                rec_contact = _grown(rec_contact, n_rec_cap)
+            rec_t, rec_x, rec_flags, rec_contact = _records_copy(
+                (rec_t, rec_x, rec_flags, rec_contact), n_rec_cap, s.n_rec, nx, record_contact)
             v_t = rec_t
             v_x = rec_x
             v_f = rec_flags
@@ -574,9 +631,14 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
                 v_c = rec_contact
                 s.rec_contact = &v_c[0, 0]
             s.rec_capacity = n_rec_cap
+            owned = True
         else:
             break
     n_rec = s.n_rec
+    if owned and n_rec + 2 < n_rec_cap:
+        # trim once (an adaptive run, an early stop): the memory of the samples recorded
+        rec_t, rec_x, rec_flags, rec_contact = _records_copy(
+            (rec_t, rec_x, rec_flags, rec_contact), n_rec, n_rec, nx, record_contact)
     cdef long n_gait = s.gait.n_steps
     cdef long n_keep = min(n_gait, <long>PDW_STEP_RING)
     cdef double *ring = &s.gait.ring[0][0]

@@ -38,6 +38,11 @@ def unmasked(name, value):
 
 def _real(name, value):
     """A real scalar as float (no bool, str, complex, None, 0-d arrays of those)."""
+    t = type(value)
+    if t is float:                      # the common cases first: no ABC checks (issue 23)
+        return value
+    if t is int:
+        return float(value)
     value = unmasked(name, value)
     if isinstance(value, np.ndarray) and value.ndim == 0:
         value = value[()]
@@ -49,13 +54,13 @@ def _real(name, value):
 def number(name, value, lo=None, hi=None, lo_open=False, hi_open=False):
     """A finite real number in the given range (bounds optional, closed unless ``*_open``)."""
     v = _real(name, value)
-    rng = _range_text(lo, hi, lo_open, hi_open)
     if not math.isfinite(v):
-        raise InvalidInputError("%s must be finite (%s), got %r" % (name, rng, value))
-    if lo is not None and (v <= lo if lo_open else v < lo):
-        raise InvalidInputError("%s = %r is out of range; allowed: %s" % (name, value, rng))
-    if hi is not None and (v >= hi if hi_open else v > hi):
-        raise InvalidInputError("%s = %r is out of range; allowed: %s" % (name, value, rng))
+        raise InvalidInputError("%s must be finite (%s), got %r"
+                                % (name, _range_text(lo, hi, lo_open, hi_open), value))
+    if (lo is not None and (v <= lo if lo_open else v < lo)) or \
+            (hi is not None and (v >= hi if hi_open else v > hi)):
+        raise InvalidInputError("%s = %r is out of range; allowed: %s"
+                                % (name, value, _range_text(lo, hi, lo_open, hi_open)))
     return v
 
 
@@ -67,6 +72,8 @@ def positive(name, value, hi=None):
 def count(name, value, lo=0, hi=MAX_COUNT):
     """An integer in [lo, hi] (no bool, no string; an integral float such as 2.0 is accepted,
     1.5 is not)."""
+    if type(value) is int and lo <= value <= hi:        # the common case first
+        return value
     value = unmasked(name, value)
     if isinstance(value, np.ndarray) and value.ndim == 0:
         value = value[()]
@@ -100,6 +107,10 @@ def choice(name, value, allowed):
 def flags(name, value, n=None):
     """Support flags: a pair (2,) of 0/1 integers, or with ``n`` also an array (n, 2). Returns a
     tuple (pair) or an int array (n, 2). Strings, non-integers, other lengths are refused."""
+    if type(value) is tuple and len(value) == 2:        # the common case first: (0, 1)
+        a, b = value
+        if type(a) is int and type(b) is int and a in (0, 1) and b in (0, 1):
+            return a, b
     if isinstance(value, (str, bytes)):
         raise InvalidInputError("%s must be two integers in {0, 1}, got the string %r" % (name, value))
     value = unmasked(name, value)
@@ -140,8 +151,8 @@ def real_array(name, value, shapes, labels=None, lo=None):
         raise InvalidInputError("%s must have shape %s, got %s"
                                 % (name, " or ".join(_shape_text(s) for s in shapes), arr.shape))
     arr = np.array(arr, dtype=float, order="C")
-    bad = ~np.isfinite(arr)
-    if bad.any():
+    if not np.isfinite(arr).all():
+        bad = ~np.isfinite(arr)
         where = tuple(int(i) for i in np.argwhere(bad)[0])
         label = " (%s)" % labels[where[-1]] if labels and len(labels) == arr.shape[-1] else ""
         raise InvalidInputError("%s%s%s must be finite, got %r"

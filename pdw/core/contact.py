@@ -195,7 +195,7 @@ class Contact:
     def coerce(cls, contact) -> "Contact":
         """A `Contact` from None (the default), a Contact, a law name, or a dict of fields."""
         if contact is None:
-            return cls()
+            return _DEFAULT if cls is Contact else cls()     # immutable: one shared default
         if isinstance(contact, cls):
             return contact
         if isinstance(contact, str):
@@ -213,7 +213,7 @@ class Contact:
     @property
     def is_default(self) -> bool:
         """The paper's laws with the parameters of `Params` (the default kernels)."""
-        return self == Contact()
+        return self == _DEFAULT
 
     def parameters(self, params: Params) -> Params:
         """``params`` with k_n and d_n set from this contact's k and d (if given); hertz sets
@@ -301,3 +301,7 @@ class Contact:
         """The fields that are set (for scenes and reports)."""
         return {n: getattr(self, n) for n in self.__dataclass_fields__
                 if getattr(self, n) is not None}
+
+
+#: The default contact (the paper's laws), shared: a Contact is immutable.
+_DEFAULT = Contact()

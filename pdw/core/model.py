@@ -25,6 +25,20 @@ _IX = {n: i for i, n in enumerate(STATE)}
 
 def kernel_index(variant: str = "paper", features=None, normal: str = "hunt_crossley",
                  friction: str = "coulomb") -> int:
+    """Index of the generated kernel (`_kernel_index`; looked up once per combination)."""
+    try:
+        return _kernel_index_cached(variant, features, normal, friction)
+    except TypeError:                   # unhashable features (a list): not cached
+        return _kernel_index(variant, features, normal, friction)
+
+
+@functools.lru_cache(maxsize=256)
+def _kernel_index_cached(variant, features, normal, friction):
+    return _kernel_index(variant, features, normal, friction)
+
+
+def _kernel_index(variant: str = "paper", features=None, normal: str = "hunt_crossley",
+                  friction: str = "coulomb") -> int:
     """Index of the generated kernel for ``variant`` with the given force elements, normal
     contact law (`pdw.core._layout.NORMAL_LAWS`) and friction law (`FRICTION_LAWS`).
 
@@ -61,8 +75,15 @@ def parameter_vector(params: Params | None) -> np.ndarray:
     params = Params.paper() if params is None else params
     if not isinstance(params, Params):
         raise InvalidInputError("params must be a pdw.Params, got %s" % type(params).__name__)
+    return _parameter_vector(params).copy()
+
+
+@functools.lru_cache(maxsize=256)
+def _parameter_vector(params: Params) -> np.ndarray:
+    """`parameter_vector`, computed once per Params (callers get a copy)."""
     p = np.zeros(_core.NP)
     _core.precompute(params.as_array(), p)
+    p.flags.writeable = False
     return p
 
 

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -58,16 +59,17 @@ class Params:
     mu_d: float = _f(0.4, "-", "dynamic friction coefficient", lo=0.0, lo_open=False)
 
     def __post_init__(self):
-        for f in dataclasses.fields(self):
+        for f, lo, hi, lo_open, hi_open in _bounds():
             v = getattr(self, f.name)
-            v = _real("Params." + f.name, v)
-            object.__setattr__(self, f.name, v)
+            if type(v) is not float:
+                v = _real("Params." + f.name, v)
+                object.__setattr__(self, f.name, v)
             if not math.isfinite(v):
                 raise InvalidInputError("Params.%s must be finite, got %r (allowed: %s)"
                                  % (f.name, v, _range_text(f)))
             md = f.metadata
-            bad_lo = md["lo"] is not None and (v <= md["lo"] if md["lo_open"] else v < md["lo"])
-            bad_hi = md["hi"] is not None and (v >= md["hi"] if md["hi_open"] else v > md["hi"])
+            bad_lo = lo is not None and (v <= lo if lo_open else v < lo)
+            bad_hi = hi is not None and (v >= hi if hi_open else v > hi)
             if bad_lo or bad_hi:
                 raise InvalidInputError("Params.%s = %r is out of range; allowed: %s [%s]"
                                  % (f.name, v, _range_text(f), md["unit"]))
@@ -87,7 +89,10 @@ class Params:
         """The paper's Tables 1-3 as read in docs/model.md section 1 (d_hip = 0.018).
 
         ``overrides``: fields to change (name=value, SI units), validated as in the constructor.
+        Without overrides, one shared instance (a Params is immutable): no validation per call.
         """
+        if not overrides and cls is Params:
+            return _paper()
         return cls(**overrides)
 
     @classmethod
@@ -158,6 +163,19 @@ class Params:
     def weight(self) -> float:
         """Weight of the walker normal to the slope, (m_h + 2 m_l) g cos(gamma) [N]."""
         return (self.m_h + 2 * self.m_l) * self.g * math.cos(self.gamma)
+
+
+@functools.lru_cache(maxsize=None)
+def _bounds():
+    """(field, lo, hi, lo_open, hi_open) of every field, read once from the metadata."""
+    return tuple((f, f.metadata["lo"], f.metadata["hi"], f.metadata["lo_open"],
+                  f.metadata["hi_open"]) for f in dataclasses.fields(Params))
+
+
+@functools.lru_cache(maxsize=1)
+def _paper():
+    """The shared `Params.paper()` without overrides."""
+    return Params()
 
 
 def _range_text(f):

@@ -63,6 +63,19 @@ RUNAWAY_ANGLE = 2 * math.pi
 #: A run that reached t_end without a single touch-down in at least NO_STEP_PERIODS pendulum
 #: periods 2 pi sqrt(l/g) did not walk: status "no_steps".
 NO_STEP_PERIODS = 2.0
+_Y_O, _THETA1, _THETA2 = (STATE.index(n) for n in ("y_o", "theta1", "theta2"))
+
+
+def _feet(a: str, b: str) -> slice:
+    """The columns of record layout RECORD_CONTACT holding a (foot 1) and b (foot 2), as a
+    slice: Result.Fn and Result.Ft are views of the recorded forces, not copies."""
+    i, j = _layout.RECORD_CONTACT.index(a), _layout.RECORD_CONTACT.index(b)
+    cols = slice(i, j + 1, j - i)
+    assert list(range(len(_layout.RECORD_CONTACT)))[cols] == [i, j], "RECORD_CONTACT changed"
+    return cols
+
+
+_FN, _FT = _feet("F_n1", "F_n2"), _feet("F_t1", "F_t2")
 
 
 class Event(NamedTuple):
@@ -512,27 +525,32 @@ def _honest(raw, status, params, x0, energies):
     sample); no touch-down at all in a long enough run makes it "no_steps"."""
     if status != "done":
         return status
-    X = raw["x"] if len(raw["x"]) else np.empty((0, len(raw["x_final"])))
-    T = raw["t"]
-    X = np.vstack([X, raw["x_final"][None, :]])
-    T = np.append(T, raw["t_final"])
-    hip_max = x0[1] + RUNAWAY_HIP * params.l
-    bad = (X[:, 1] > hip_max) | (np.abs(X[:, 2:4]) > RUNAWAY_ANGLE).any(axis=1)
+    X, T = raw["x"], raw["t"]
+    n = len(X)
+
+    def sample(i):                  # (t, x) of sample i of the recorded ones and the final state
+        return (float(T[i]), X[i]) if i < n else (float(raw["t_final"]), raw["x_final"])
+
+    hip_max = x0[_Y_O] + RUNAWAY_HIP * params.l
+    # one compiled pass over the samples, no copy of them (issue 23)
+    i = _core.first_runaway(X, hip_max, RUNAWAY_ANGLE) if n else -1
+    if i < 0 and _core.first_runaway(raw["x_final"][None, :], hip_max, RUNAWAY_ANGLE) == 0:
+        i = n
     reason = None
-    if bad.any():
-        i = int(np.argmax(bad))
-        if X[i, 1] > hip_max:
+    if i >= 0:
+        xi = sample(i)[1]
+        if xi[_Y_O] > hip_max:
             reason = ("runaway: the hip rose to y_o = %.4g m, more than %g l above its start "
-                      "(airborne): not walking" % (X[i, 1], RUNAWAY_HIP))
+                      "(airborne): not walking" % (xi[_Y_O], RUNAWAY_HIP))
         else:
             reason = ("runaway: a leg turned past %.3g rad (theta1, theta2 = %.4g, %.4g): not "
-                      "walking" % (RUNAWAY_ANGLE, X[i, 2], X[i, 3]))
+                      "walking" % (RUNAWAY_ANGLE, xi[_THETA1], xi[_THETA2]))
     elif energies is not None and not all(np.isfinite(v).all() for v in energies.values()):
         i = int(np.argmax(~np.isfinite(energies["E"])))
         reason = "the energies are not finite at a finite state (overflow)"
     if reason is not None:
-        i = max(i - 1, 0)                  # the last good sample before the offending one
-        raw["failure"] = {"t": float(T[i]), "x": X[i].copy(), "leg": -1, "reason": reason}
+        t_i, x_i = sample(max(i - 1, 0))   # the last good sample before the offending one
+        raw["failure"] = {"t": t_i, "x": x_i.copy(), "leg": -1, "reason": reason}
         return "diverged"
     period = 2 * math.pi * math.sqrt(params.l / params.g) if params.g > 0 else math.inf
     if raw["event_counts"]["touch_down"] == 0 and raw["t_final"] >= NO_STEP_PERIODS * period:
@@ -549,10 +567,9 @@ def _result(raw, params, variant, method, dt, t_end, wall, on_failure,
         if x0 is not None:
             status = _honest(raw, status, params, x0, energies)
     rc = raw["contact"]
-    ic = {n: i for i, n in enumerate(_layout.RECORD_CONTACT)}
-    if rc is not None:
-        Fn = rc[:, [ic["F_n1"], ic["F_n2"]]]
-        Ft = rc[:, [ic["F_t1"], ic["F_t2"]]]
+    if rc is not None:              # views of the recorded forces (feet 1, 2), no copies
+        Fn = rc[:, _FN]
+        Ft = rc[:, _FT]
     else:
         Fn = Ft = np.zeros((0, 2))
     ie = {n: i for i, n in enumerate(_layout.EVENT)}

@@ -16,6 +16,9 @@ the stiffest forces of the model (docs/stability.md has the measured maps). This
 
 Other contact laws (`pdw.Contact`): the default law's estimate at the run's parameters times a
 per-law, per-method factor fitted on measured limits (`pdw.sim.stepsize_laws`).
+
+Why this module is long: the step maps, the representative states and the check built on them
+share their constants and caches; the presets' limits and the per-law factors are apart.
 """
 from __future__ import annotations
 
@@ -32,6 +35,7 @@ from ..core.integrators import METHODS
 from ..core.model import check_variant, contact_forces, jacobian
 from ..core.params import X0_PAPER, Params
 from .stepsize_laws import LAW_CALIBRATION, LUGRE_SIGMA1, law_factor, law_message, law_of, law_params  # noqa: F401
+from .stepsize_presets import PRESET_DT_MAX, preset_limits
 
 NQ = _core.NQ
 NX = _core.NX
@@ -75,6 +79,17 @@ def _rk(name):
     return np.array(T["A"]), np.array(T["b"])
 
 
+@functools.lru_cache(maxsize=1)
+def _blocks():
+    """[E Z Z], [Z E Z], [Z Z E] (NQ x 3 NQ; E the identity, Z zeros), read-only: the block
+    rows of the second-order step maps, built once (the step-size check builds ~60 maps)."""
+    Z, E = np.zeros((NQ, NQ)), np.eye(NQ)
+    out = (np.hstack([E, Z, Z]), np.hstack([Z, E, Z]), np.hstack([Z, Z, E]))
+    for b in out:
+        b.flags.writeable = False
+    return out
+
+
 def step_matrix(method: str, J, h: float) -> np.ndarray:
     """The one-step map of ``method`` with step ``h`` applied to the linear system x' = J x.
 
@@ -99,15 +114,15 @@ def step_matrix(method: str, J, h: float) -> np.ndarray:
             K.append(J @ X)
         return eye + h * sum(b[i] * K[i] for i in range(len(b)))
     Aq, Bv = J[NQ:, :NQ], J[NQ:, NQ:]
-    Z, E = np.zeros((NQ, NQ)), np.eye(NQ)
+    B0, B1, B2 = _blocks()
     if method == "verlet":
-        vh = np.hstack([Z, E, 0.5 * h * E])
-        q1 = np.hstack([E, Z, Z]) + h * vh
-        a1 = Aq @ q1 + Bv @ (vh + np.hstack([Z, Z, 0.5 * h * E]))
+        vh = B1 + 0.5 * h * B2
+        q1 = B0 + h * vh
+        a1 = Aq @ q1 + Bv @ (vh + 0.5 * h * B2)
         v1 = vh + 0.5 * h * a1
         return np.vstack([q1, v1, a1])
     if method == "cdm":
-        Un, Um1, Um2 = np.hstack([E, Z, Z]), np.hstack([Z, E, Z]), np.hstack([Z, Z, E])
+        Un, Um1, Um2 = B0, B1, B2
         U1 = 2 * Un - Um1 + h * h * (Aq @ Un) + 0.5 * h * (Bv @ (Un - Um2))
         return np.vstack([U1, Un, Um1])
     raise InvalidInputError("no explicit step map for method %r; allowed: cdm, verlet, rk4, dopri5"
@@ -256,6 +271,15 @@ LANDING_FLAGS = (1, 0)
 
 
 def stance_states(params: Params | None = None, variant: str = "paper") -> tuple:
+    """The representative states of `step_limit` (`_stance_states`; computed once per
+    ``params`` and ``variant``): ``(X, flags)``, X (4, 8) a fresh copy."""
+    params = Params.paper() if params is None else params
+    X, flags = _stance_states(params, variant)
+    return X.copy(), list(flags)
+
+
+@functools.lru_cache(maxsize=256)
+def _stance_states(params: Params, variant: str) -> tuple:
     """The representative states of `step_limit`: ``(X, flags)``, X of shape (4, 8): the three
     `STANCE_STATES` (flags (0, 1)) and the landing, `DOUBLE_SUPPORT_STATE` with flags
     `LANDING_FLAGS`; each with the support foot stuck (x_o' set so that its slip velocity is 0
@@ -275,7 +299,9 @@ def stance_states(params: Params | None = None, variant: str = "paper") -> tuple
             x[5] = -(params.l - params.r) * math.sin(x[3]) * x[7]
         out.append(_set_hip_height(x, params, variant, fl, load * params.weight))
         flags.append(fl)
-    return np.array(out), flags
+    X = np.array(out)
+    X.flags.writeable = False
+    return X, tuple(flags)
 
 
 # --------------------------------------------------------------------------------------------
@@ -401,11 +427,25 @@ def _chatter_limit(params: Params, method: str, variant: str) -> float:
     return min(_limits(params, method, variant, features=None)[:len(STANCE_STATES)])
 
 
-def _dt_max(params, method, variant):
+def _dt_max_computed(params, method, variant):
     dt = CALIBRATION[variant][method] * _linear(params, method, variant)[0]
     if _friction_load(params, variant) >= FRICTION_LOAD:
         dt = min(dt, CHATTER_CALIBRATION * _chatter_limit(params, method, variant))
     return dt
+
+
+def _preset_table():
+    """`PRESET_DT_MAX` computed anew (for a change of the model or of the calibration)."""
+    return {(preset, variant): {m: _dt_max_computed(getattr(Params, preset)(), m, variant)
+                                for m in FIXED_STEP}
+            for preset, variant in PRESET_DT_MAX}
+
+
+def _dt_max(params, method, variant):
+    known = preset_limits(params, variant)
+    if known is not None and method in known:
+        return known[method]
+    return _dt_max_computed(params, method, variant)
 
 
 @functools.lru_cache(maxsize=256)
@@ -480,8 +520,9 @@ def check_step(dt: float, params: Params, method: str, variant: str, mode: str =
 
     ``mode``: "warn" (a `pdw.StepSizeWarning` when dt > `step_limit`), "error" (raise
     `pdw.StepSizeError` instead), "off". Adaptive methods are not checked (their dt is only
-    the first trial step). Returns the `StepLimit` when dt exceeds it, else None. Costs ~7 ms
-    per new (params, method, variant), nothing after (cached).
+    the first trial step). Returns the `StepLimit` when dt exceeds it, else None. Costs ~5 ms
+    per new (params, method, variant), nothing after (cached), and nothing for the presets
+    (`PRESET_DT_MAX`).
     """
     if mode not in CHECK_MODES:
         raise InvalidInputError("check_step must be one of %s, got %r"
