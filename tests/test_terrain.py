@@ -158,3 +158,18 @@ def test_derived_jacobian_is_the_derivative_of_the_rhs(variant, ground):
                     - _core.ground_stage(k, cg, x - e, p, 1, 1, anchors)) / (2 * h)
     assert np.abs(f[4:]).max() > 1.0            # forces act
     assert np.abs(J - fd).max() < 1e-8 * np.abs(J).max()
+
+
+def test_scene_ground_table_round_trip_and_run():
+    s = pdw.Scene(preset="paper_steady", stop={"t_end": 0.8}, ground={
+        "kind": "steps", "edges": [0.5], "heights": [-0.004],
+        "patches": [{"s_a": 0.2, "s_b": 0.4, "k_n": 5e4}]})
+    assert isinstance(s.ground, Ground)
+    back = pdw.Scene.from_toml(s.to_toml())
+    assert back == s and back.ground == s.ground
+    r = s.run()
+    direct = pdw.simulate(params=pdw.Params.paper_steady(), t_end=0.8, ground=s.ground)
+    np.testing.assert_array_equal(r.x_final, direct.x_final)
+    assert "[ground]" not in pdw.Scene().to_toml()      # unset: flat, nothing written
+    with pytest.raises(pdw.InvalidInputError, match="scene key 'ground'.*ground.sigma"):
+        pdw.Scene(ground={"kind": "random", "sigma": -1.0})
