@@ -173,3 +173,17 @@ def test_scene_ground_table_round_trip_and_run():
     assert "[ground]" not in pdw.Scene().to_toml()      # unset: flat, nothing written
     with pytest.raises(pdw.InvalidInputError, match="scene key 'ground'.*ground.sigma"):
         pdw.Scene(ground={"kind": "random", "sigma": -1.0})
+
+
+def test_walk_figures_draw_the_ground(tmp_path):
+    matplotlib = pytest.importorskip("matplotlib")
+    matplotlib.use("Agg")
+    from pdw.present import animation, plots
+    g = Ground.steps([0.3], [-0.004], width=0.2).with_patches([dict(s_a=0.1, s_b=0.25, k_n=5e4)])
+    r = pdw.simulate(params=P, t_end=0.6, ground=g, record_every=50)
+    fig = plots.fig_stick(r)
+    ys = [line.get_ydata() for line in fig.axes[0].lines if len(line.get_ydata()) == 1200]
+    assert ys and np.ptp(ys[0]) > 0.004            # the surface drawn is the step's, not a line
+    assert any(line.get_color() == "tab:olive" for line in fig.axes[0].lines)     # the patch
+    animation.animate(r, tmp_path / "walk.gif", duration=0.4, fps=5)
+    assert (tmp_path / "walk.gif").stat().st_size > 0
