@@ -187,3 +187,32 @@ def test_walk_figures_draw_the_ground(tmp_path):
     assert any(line.get_color() == "tab:olive" for line in fig.axes[0].lines)     # the patch
     animation.animate(r, tmp_path / "walk.gif", duration=0.4, fps=5)
     assert (tmp_path / "walk.gif").stat().st_size > 0
+
+
+def test_a_study_scene_with_a_ground_runs_its_points_on_it(tmp_path):
+    """Study points on a shaped [scene.ground] run point by point through simulate(ground=)
+    (never batched on flat ground): each row is the scalar run on that ground."""
+    from pdw.studies import points
+    from pdw.studies.study import parse_study
+    text = """
+name = "ground_study"
+[scene]
+preset = "paper_steady"
+stop = { t_end = 1.5 }
+ground = { kind = "steps", edges = [0.5], heights = [-0.004], width = 0.2 }
+[[axes]]
+name = "k_hip"
+values = [0.9, 1.0]
+[run]
+steady = 1
+"""
+    study = parse_study(text, name="ground_study")
+    assert study.scene.ground == Ground.steps([0.5], [-0.004], width=0.2)
+    assert not points.batchable(study)
+    for index, values in study.points()[:1]:
+        row = points.run_point(study.task(index, values))
+        r = pdw.simulate(params=pdw.Params.paper_steady().replace(k_hip=0.9), t_end=1.5,
+                         method=study.scene.integrator.method, rtol=study.scene.integrator.rtol,
+                         atol=study.scene.integrator.atol, ground=study.scene.ground,
+                         record_every=study.scene.record.every, on_failure="return")
+        assert row["t_final"] == r.t_final and row["status"] == r.status
