@@ -216,3 +216,20 @@ steady = 1
                          atol=study.scene.integrator.atol, ground=study.scene.ground,
                          record_every=study.scene.record.every, on_failure="return")
         assert row["t_final"] == r.t_final and row["status"] == r.status
+
+
+def test_compiled_ground_refuses_a_tampered_table():
+    import dataclasses
+
+    from pdw.core import _core
+    t = Ground.sine(0.01, 0.5).table()
+    for bad in (dict(lut_inv=float("nan")), dict(s_max=t.s_min), dict(lut=t.lut + len(t.cells)),
+                dict(cells=t.cells[:, :5]), dict(arc=t.arc[:-1])):
+        with pytest.raises(ValueError, match="ground table"):
+            _core.CGround(dataclasses.replace(t, **bad))
+    c = t.cells.copy()
+    c[3, 4] = np.inf
+    with pytest.raises(ValueError, match="finite"):
+        _core.CGround(dataclasses.replace(t, cells=c))
+    with pytest.raises(TypeError):
+        _core.ground_stage(0, None, np.zeros(8), np.zeros(_core.NP), 1, 1, np.zeros(4))
