@@ -233,3 +233,18 @@ def test_compiled_ground_refuses_a_tampered_table():
         _core.CGround(dataclasses.replace(t, cells=c))
     with pytest.raises(TypeError):
         _core.ground_stage(0, None, np.zeros(8), np.zeros(_core.NP), 1, 1, np.zeros(4))
+
+
+@pytest.mark.parametrize("contact", [{"normal": "flores", "e": 0.5}, {"friction": "lugre"}],
+                         ids=["flores", "lugre"])
+def test_tilted_plane_with_other_contact_laws(contact):
+    """Every contact law runs on the shaped ground unchanged (surface-frame kinematics); LuGre's
+    bristle states ride along (its Jacobian: central differences)."""
+    d = 0.01
+    kw = dict(t_end=2.0, contact=contact, **dict(TIGHT, rtol=1e-10, atol=1e-12))
+    ref = pdw.simulate(pdw.X0_PAPER, params=P.replace(gamma=P.gamma + d), **kw)
+    g = pdw.simulate(_plane_frame(np.array(pdw.X0_PAPER), d), params=P, ground=Ground.plane(d), **kw)
+    assert ref.status == g.status == "walked" and ref.n_gait_steps == g.n_gait_steps >= 2
+    assert np.abs(ref.gait["P"] - g.gait["P"]).max() < 1e-8
+    assert np.abs(_plane_frame(ref.x_final[:8], d) - g.x_final[:8]).max() < 1e-7
+    assert np.abs(ref.x_final[8:] - g.x_final[8:]).max() < 1e-9 if len(ref.x_final) > 8 else True
