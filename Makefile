@@ -79,6 +79,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_sweep_batch.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_step_maps.py $(UPDATE_DOCS)
 	$(PY) benchmarks/work_precision.py $(UPDATE_DOCS)
+	$(PY) benchmarks/bench_terrain.py $(UPDATE_DOCS)
 
 ## instructions: the instruction-count guard (valgrind's callgrind; benchmarks/instructions.py):
 ## the paper run with and without recording, a first call, 64-walker batches, find_gait,

@@ -21,6 +21,7 @@ Outcome                 how a run ended (Result.outcome; status and stop_reason 
 simulate_batch          N walkers in one call, W lanes in lockstep (docs/ensemble.md): BatchResult
 simulate_many           N walkers: the batch engine when it runs the method, else pdw.simulate
 Contact                 the normal and friction contact laws of a run (docs/contact_laws.md)
+Ground, Patch           the ground as data: shape h(s) and contact patches (docs/terrain.md)
 Scene, run              everything a simulation needs, as one object or TOML file (docs/scenes.md)
 steps                   per-step gait descriptors (docs/model.md section 8)
 hybrid                  the rigid-ground impact-momentum model (docs/model.md section 9): find_gait, ...
@@ -64,6 +65,7 @@ from .core.errors import (
     StepSizeError,
     StepSizeWarning,
 )
+from .core.ground import Ground, Patch
 from .core.integrators import METHODS
 from .core.model import (
     STATE,
@@ -109,5 +111,5 @@ __all__ = [
     "continue_bifurcation", "BifurcationCurve", "plot_branches", "plot_curves",
     "ode_function", "OdeFunction", "load", "load_sweep", "RecordBuffer",
     "Contact", "Progress", "GaitNotFoundError", "Integrator", "Record", "Stop", "Limits",
-    "Outcome",
+    "Outcome", "Ground", "Patch",
 ]

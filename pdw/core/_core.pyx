@@ -57,6 +57,7 @@ cdef extern from "pdw_model.h":
 
 
 include "_opts.pxi"
+include "_ground.pxi"
 
 
 cdef extern from "pdw_sim.h":
@@ -74,6 +75,7 @@ cdef extern from "pdw_sim.h":
         long n_touch_down, n_lift_off
         double ring[1][1]
     ctypedef struct pdw_sim:
+        const pdw_ground *ground
         long poll_every
         const pdw_kernel *kernel
         int nx
@@ -107,9 +109,16 @@ cdef extern from "pdw_sim.h":
         pdw_advance_fn advance
     const pdw_method pdw_methods[]
     const int pdw_nmethods
-    void pdw_discrete_init(const pdw_kernel *k, const double *p, const double *x,
-                           const int *flags0, pdw_discrete *d, double *work) noexcept nogil
+    void pdw_discrete_init(const pdw_kernel *k, const pdw_ground *g, const double *p,
+                           const double *x, const int *flags0, pdw_discrete *d,
+                           double *work) noexcept nogil
     void pdw_gait_init(pdw_gait *g) noexcept nogil
+    void pdw_terrain_rhs(const pdw_kernel *k, const pdw_ground *g, const double *x,
+                         const double *p, const int *flags, const double *anchors,
+                         double *xdot, double *work) noexcept nogil
+    void pdw_terrain_jacobian(const pdw_kernel *k, const pdw_ground *g, const double *x,
+                              const double *p, const int *flags, const double *anchors,
+                              double *J, double *work) noexcept nogil
     enum:
         PDW_STATUS_RECORDS_FULL, PDW_STATUS_POLL
 
@@ -464,7 +473,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         long event_capacity=256, double event_tol=1e-9, bint record_events=True,
         long stop_steps=0, int periodic_k=0, double periodic_tol=0.0, double t_end=0.0,
         long max_steps=0, long poll_every=POLL_EVERY, buffers=None, approach_speeds0=None,
-        int stop_touch_down=0, dict opts=None):
+        int stop_touch_down=0, dict opts=None, CGround ground=None):
     """Run one simulation in compiled code (GIL released). Returns a dict of arrays and status.
 
     The online gait analysis runs for every method: the result's "gait" holds the last
@@ -493,6 +502,8 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     opts: fields of pdw_run_opts by name (`pdw.sim.options.c_options`), set after the
     arguments: an option of the loops that has no argument here (a new stop condition) is a
     field of the struct, a line of _opts.pxi and an entry of this dict.
+    ground: a `CGround` (a shaped or patched ground, docs/terrain.md): the run takes the
+    shaped-ground kernel of pdw_terrain.c; None: flat, today's kernel.
 
     Shapes (checked): x0 (kernel_nx(k),), p (NP,).
     """
@@ -534,6 +545,8 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     cdef pdw_advance_fn advance = pdw_methods[method].advance
     memset(&s, 0, sizeof(pdw_sim))
     s.kernel = _kernel(k)
+    if ground is not None:
+        s.ground = &ground.g
     s.nx = nx
     s.opt.t_end = t_end if t_end > 0 else n_steps * dt   # adaptive methods end exactly at t_end
     s.opt.rtol = rtol
@@ -593,7 +606,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     pdw_gait_init(&s.gait)
     memcpy(s.x, &x0[0], nx * sizeof(double))
     flags0[0] = f1; flags0[1] = f2
-    pdw_discrete_init(s.kernel, s.p, s.x, flags0, &s.disc, s.work)
+    pdw_discrete_init(s.kernel, s.ground, s.p, s.x, flags0, &s.disc, s.work)
     if approach_speeds0 is not None:        # feet that start in support: given approach speeds
         if f1:
             s.disc.anchors[PDW_ANCHOR_V_IN1] = approach_speeds0[0]
@@ -694,3 +707,26 @@ def _real_states(x, bint allow_rows):
 # --- the model object for external solvers (pdw.ode_function) ----------------------------
 
 include "_ode.pxi"
+
+
+def ground_stage(int k, CGround ground not None, const double[::1] x, const double[::1] p, int f1, int f2,
+                 const double[::1] anchors, bint jacobian=False):
+    """f(x) (nx,) or, with jacobian, df/dx (nx, nx) of kernel k on a compiled ground (the
+    shaped-ground kernel, pdw_terrain.c), for tests; anchors (NANCHOR,)."""
+    cdef const pdw_kernel *kern = _kernel(k)
+    cdef int nx = kern.nx
+    cdef int flags[2]
+    cdef double work[PDW_NWORK]
+    cdef double[::1] flat
+    _len("x", x.shape[0], nx)
+    _len("p", p.shape[0], PDW_NP)
+    _len("anchors", anchors.shape[0], PDW_NANCHOR)
+    flags[0] = f1
+    flags[1] = f2
+    out = np.zeros((nx, nx)) if jacobian else np.zeros(nx)
+    flat = out.reshape(-1)
+    if jacobian:
+        pdw_terrain_jacobian(kern, &ground.g, &x[0], &p[0], flags, &anchors[0], &flat[0], work)
+    else:
+        pdw_terrain_rhs(kern, &ground.g, &x[0], &p[0], flags, &anchors[0], &flat[0], work)
+    return out

@@ -9,6 +9,11 @@ verlet) runs in rounds of one step per lane through the scalar integrator's own 
 with its own time, step size, accept/reject and located events (rodas4 in structure-of-arrays
 lanes too). Threads (GIL released) share the batch: each lane takes the next walker from one
 shared counter.
+
+Why this module is long: `simulate_batch` takes every option `simulate` takes (the option
+objects, their old keywords, a ground per walker), each checked here before the compiled
+engine is entered, next to its documentation and its result type `BatchResult` (the chunked
+and recorded runs are in `pdw.sim.chunks`).
 """
 from __future__ import annotations
 
@@ -24,6 +29,7 @@ from numpy.typing import ArrayLike
 
 from ..core import _batch, _layout, checks, interrupt  # type: ignore[attr-defined]
 from ..core.errors import InvalidInputError
+from ..core.ground import Ground
 from ..core.integrators import METHODS
 from ..core.integrators import get as _method_info
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
@@ -224,7 +230,9 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
                    flags0: ArrayLike = (0, 1), threads: int | None = None, lanes: int = LANES,
                    vector: bool = False, executor: Any = None, chunk_size: int | None = None,
                    record: Sequence[int] | None = None, record_every: int = 1,
-                   progress: bool | Progress = False, **_legacy) -> BatchResult:
+                   progress: bool | Progress = False,
+                   ground: Ground | dict | Sequence[Ground | dict | None] | None = None,
+                   **_legacy) -> BatchResult:
     """Simulate N walkers at once: the result of `pdw.simulate` for each, without recording.
 
     Parameters
@@ -286,6 +294,12 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
         a terminal, a `Progress` of the caller's gets N added to its total. The batch then
         runs in chunks (``chunk_size``, default N / 50 but at least one block per thread),
         bitwise the unchunked batch.
+    ground : pdw.Ground, dict, or sequence of N (Ground, dict or None), optional
+        The ground of all walkers, or of each (its own seed, step height, patch;
+        docs/terrain.md). Walkers on a shaped or patched ground run the shaped-ground kernel
+        through the per-lane scalar stages (``vector=False``), and so do the flat walkers of
+        such a batch: every walker bitwise its `simulate` run. Status ``"off_ground"``: the
+        walker left its ground's defined extent.
     **_legacy
         The keywords of before (``rtol=``, ``stop_steps=``, ``max_speed=``, ...) and the
         positional form: they work for one release, each with a `DeprecationWarning` naming
@@ -330,7 +344,9 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
         it_run, st_run = settled.ran()
         kw = dict(x0=x, params=params, variant=variant, integrator=it_run, stop=st_run,
                   limits=lim, flags0=flags0, threads=threads, lanes=lanes, vector=vector,
-                  record=record, record_every=record_every)
+                  record=record, record_every=record_every,
+                  ground=ground if ground is None or isinstance(ground, (Ground, dict))
+                  else _ground_list(ground, n))
         if chunk_size is None:
             chunk_size = max(1, math.ceil(n / 8))
         try:
@@ -390,11 +406,17 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
     if threads < 1:
         raise InvalidInputError("threads must be >= 1, got %d" % threads)
     k = kernel_index(variant, None)
+    grounds = _ground_list(ground, n)
+    if grounds is not None and vector:
+        raise InvalidInputError("vector=True (vector sin/cos) does not apply to walkers on a "
+                                "shaped or patched ground: give vector=False")
+    cground = None if grounds is None else _compiled_grounds(grounds)
     distinct = {}
     for p in plist:
         if id(p) not in distinct:
             distinct[id(p)] = p
-            _stepsize.check_step(dt, p, method, variant, check_step)
+            for ps in _patched(p, grounds):
+                _stepsize.check_step(dt, ps, method, variant, check_step)
     pvec = np.ascontiguousarray([parameter_vector(p) for p in plist])
     ls = np.array([p.l for p in plist], dtype=float)
     hip = np.broadcast_to(0.5 * ls if fall_hip_height is None
@@ -410,7 +432,10 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
     t_stop = t_end if adaptive else n_steps * dt
     opts = dict(method=METHODS.index(method), t_end=t_stop, rtol=rtol, atol=atol, h_max=h_max,
                 event_tol=event_tol, max_steps=budget, isa=_batch.ISAS[batch_isa()],
-                stop_touch_down=stop_touch_down, opts=_opt.c_options(it, st, lim, skip=_opt.RUN_ARGS))
+                stop_touch_down=stop_touch_down,
+                opts=_opt.c_options(it, st, lim, skip=_opt.RUN_ARGS))
+    if cground is not None:         # the per-lane scalar stages: bitwise the scalar runs
+        opts.update(isa=-1, grounds=cground)
     if n:
         args = (k, x, pvec, f0, hip, depth, dt, n_steps, max_speed, stop_steps, periodic_steps,
                 periodic_tol, out, 0, n, lanes, bool(vector))
@@ -433,8 +458,63 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
     if record is not None:
         res.recorded = record_subset(
             res, record, record_every, x, plist if len(plist) == n else plist[0], f0,
-            dict(zip(("integrator", "stop"), settled.ran()), variant=variant, limits=lim))
+            dict(zip(("integrator", "stop"), settled.ran()), variant=variant, limits=lim,
+                 ground=grounds))
     return res
+
+
+def _ground_list(ground, n):
+    """None (every walker on flat ground) or a list of n `pdw.Ground` from ``ground``: None, one
+    Ground (or [ground] dict) for all, or a sequence of n (Ground, dict or None each)."""
+    if ground is None:
+        return None
+    if isinstance(ground, (Ground, dict)):
+        g = Ground.coerce(ground)
+        return None if g.is_flat else [g] * n
+    if isinstance(ground, (str, bytes)):
+        raise InvalidInputError("ground must be a pdw.Ground, a dict or a sequence of N = %d, got "
+                                "%r" % (n, ground))
+    try:
+        gl = list(ground)
+    except TypeError:
+        raise InvalidInputError("ground must be a pdw.Ground, a dict or a sequence of N = %d, got "
+                                "%s" % (n, type(ground).__name__)) from None
+    if len(gl) != n:
+        raise InvalidInputError("ground must be one Ground or a sequence of N = %d, got %d"
+                                % (n, len(gl)))
+    out = []
+    for i, g in enumerate(gl):
+        try:
+            out.append(Ground.coerce(g))
+        except InvalidInputError as e:
+            raise InvalidInputError("ground[%d]: %s" % (i, e)) from None
+    return None if all(g.is_flat for g in out) else out
+
+
+def _compiled_grounds(grounds):
+    """The compiled ground of each walker (None: flat), one per distinct Ground object."""
+    made = {}
+    out = []
+    for g in grounds:
+        if g.is_flat:
+            out.append(None)
+            continue
+        if id(g) not in made:
+            made[id(g)] = _batch.CGround(g.table())
+        out.append(made[id(g)])
+    return out
+
+
+def _patched(p, grounds):
+    """p and p with each distinct ground's patches (the step-size check)."""
+    if grounds is None:
+        return [p]
+    out, seen = [p], set()
+    for g in grounds:
+        if id(g) not in seen and g.patches:
+            seen.add(id(g))
+            out += g.patched_params(p)[1:]
+    return out
 
 
 def _outputs(n):
@@ -450,6 +530,8 @@ def _outputs(n):
 
 def _result(out, dt, t_end, method, variant):
     status = np.array([_STATUS[s] for s in out["status"]], dtype=object)
+    off = (status == "fell") & (out["fail_reason"] == _layout.REASON.index("off_ground"))
+    status[off] = "off_ground"          # the walker left its ground's defined extent
     stop = np.array([_STOP[r] if r else (s if s in ("fell", "diverged", "interrupted") else "t_end")
                      for r, s in zip(out["stop_reason"], status)], dtype=object)
     return BatchResult(

@@ -32,6 +32,7 @@ import numpy as np
 from ..core import _layout
 from ..core.checks import MAX_COUNT, unmasked
 from ..core.errors import InvalidInputError
+from ..core.ground import Ground
 from ..core.integrators import METHODS
 
 #: Smallest step [s] (a smaller one makes the step matrices singular in double precision).
@@ -90,7 +91,7 @@ KINDS = {
     "int?": "an integer", "bool": "true or false", "state": "a list of 8 numbers",
     "flags": "a list of two 0/1 integers", "params": "a table of parameter values",
     "times?": "a list of numbers", "pair?": "a list of two numbers >= 0",
-    "object": "an object",
+    "object": "an object", "ground": "a [ground] table (docs/terrain.md)",
 }
 
 
@@ -130,6 +131,15 @@ def _coerce(value, kind, key):
         return None
     if kind == "object":
         return value
+    if kind == "ground":
+        if value is None or isinstance(value, Ground):
+            return value
+        if not isinstance(value, dict):
+            raise bad()
+        try:
+            return Ground.from_dict(value)
+        except InvalidInputError as e:
+            raise _err(key, "is invalid: %s" % e) from None
     if kind in ("str", "str?"):
         if not isinstance(value, str):
             raise bad()
@@ -241,7 +251,7 @@ class _Section:
         out: dict[str, Any] = {}
         for f in dataclasses.fields(self):  # type: ignore[arg-type]
             v = getattr(self, f.name)
-            if f.metadata["kind"] == "object":
+            if f.metadata["kind"] in ("object", "ground"):
                 v = v.to_dict() if hasattr(v, "to_dict") else None
             if isinstance(v, _Section):
                 out[f.name] = v.to_dict()
@@ -379,7 +389,8 @@ class Limits(_Section):
 
 _TYPES = {"str": "str", "str?": "str, optional", "float": "float", "float?": "float, optional",
           "int": "int", "int?": "int, optional", "bool": "bool", "times?": "array_like, optional",
-          "pair?": "(float, float), optional", "object": "object, optional"}
+          "pair?": "(float, float), optional", "object": "object, optional",
+          "ground": "pdw.Ground or dict, optional"}
 
 
 def _document(cls):

@@ -51,6 +51,11 @@ TOML layout (every key optional; defaults are `Scene()`'s)::
     friction = "coulomb"
     # k, d, e, v_in_min: the law's parameters (unset: the preset's k_n, d_n)
 
+    [ground]                         # the ground (docs/terrain.md); unset: flat
+    kind = "flat"                    # steps, profile, plane, sine, random, sum
+    # the kind's parameters (edges, heights, width; s, h, order; slope; amplitude,
+    # wavelength, phase; sigma, correlation, seed), offset, extent, patches = [{s_a, s_b, k_n, ...}]
+
     [stop]
     t_end = 3.5                      # [s]
     steps = 0                        # stop after this many complete gait steps (0: no limit)
@@ -81,11 +86,11 @@ import os
 import pathlib
 import warnings
 from dataclasses import dataclass
-from typing import Any
 
 from ..core import _layout, _toml
 from ..core.contact import Contact
 from ..core.errors import InvalidInputError
+from ..core.ground import Ground
 from ..core.params import X0_PAPER, Params
 from . import options as _options
 from .options import (  # noqa: F401  (KINDS, _Section, _coerce, _f: their home before)
@@ -197,8 +202,8 @@ class Scene(_Section):
     contact: ContactLaws = _f(ContactLaws(), "contact", "normal and friction contact laws")
     approach_speeds0: tuple | None = _f(None, "pair?", "approach speeds [m/s] of the feet "
                                         "that start in support (default max(-v_y, 0))")
-    ground: Any = _f(None, "object", "the ground under the walker (a Ground; default the "
-                     "paper's slope)")
+    ground: Ground | None = _f(None, "ground", "the ground walked on (pdw.Ground, "
+                               "docs/terrain.md); unset: flat")
 
     def __post_init__(self):
         stop, limits = _move_limits(self.stop, self.limits)

@@ -29,6 +29,7 @@ from ..core.errors import (
     InvalidInputError,
     SingularSystemError,
 )
+from ..core.ground import Ground
 from ..core.integrators import METHODS
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
 from ..core.params import X0_PAPER, Params
@@ -174,6 +175,7 @@ class Result:
     record: _opt.Record | None = None
     stop: _opt.Stop | None = None
     limits: _opt.Limits | None = None
+    ground: Ground | None = None                 # the pdw.Ground walked on (docs/terrain.md)
 
     @property
     def outcome(self) -> _opt.Outcome:
@@ -276,7 +278,8 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
              limits: _opt.Limits | dict | None = None,
              contact: _contact.Contact | dict | str | None = None,
              features: Iterable[str] | None = None, flags0: tuple[int, int] = (0, 1),
-             approach_speeds0: tuple[float, float] | None = None, ground: object = None,
+             approach_speeds0: tuple[float, float] | None = None,
+             ground: Ground | dict | None = None,
              **_legacy) -> Result:
     """Simulate the walker from ``x0`` for ``t_end`` seconds (or run a `pdw.Scene`).
 
@@ -350,9 +353,10 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
     approach_speeds0 : (float, float), optional
         Approach speeds [m/s] (>= 0) of the feet that start in support (the damping of
         lankarani_nikravesh and flores); default max(-v_y(x0), 0) of each.
-    ground : optional
-        The ground under the walker (a Ground, pdw/core/ground.py); None: the paper's slope.
-        Not run by this build yet: any other value is refused.
+    ground : pdw.Ground or dict, optional
+        The ground walked on (shape h(s) and contact patches, docs/terrain.md); default flat
+        (today's kernel, bitwise). A shaped or patched ground runs the shaped-ground kernel;
+        a walker that leaves its defined extent stops with status ``"off_ground"``.
     **_legacy
         The keywords of before (``record_every=``, ``rtol=``, ``stop_steps=``, ...) and the
         positional form ``simulate(x0, t_end, dt, params, variant, method, ...)``: they work
@@ -387,9 +391,6 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
     params = plain.get("params", params)
     variant = plain.get("variant", variant)
     flags0 = plain.get("flags0", flags0)
-    if ground is not None:
-        raise InvalidInputError("ground: this build runs the paper's slope only (ground=None), "
-                                "got %r" % (ground,))
     record_every, record_forces, record_events, record_energies = (
         rec.every, rec.forces, rec.events, rec.energies)
     t_eval, dense_output, out = rec.t_eval, rec.dense_output, rec.out
@@ -465,8 +466,10 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
     if feats != _layout.FEATURES:
         params = params.without(feats)
     p = contact.vector(parameter_vector(params), feats, params)     # validates the law's values
+    ground = Ground.coerce(ground)
     try:        # every contact law: the law's factor on the default estimate (stepsize.py)
-        _stepsize.check_step(dt, params, method, variant, check_step, contact)
+        for ps in ground.patched_params(params):    # and every patch's properties
+            _stepsize.check_step(dt, ps, method, variant, check_step, contact)
     except (np.linalg.LinAlgError, FloatingPointError, OverflowError) as e:
         _stepsize.step_unknown(dt, method, check_step, e)
     v_in0 = None if approach_speeds0 is None else tuple(checks.real_array(
@@ -485,7 +488,9 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
                     event_tol=event_tol, record_events=bool(record_events), stop_steps=stop_steps,
                     periodic_k=periodic_steps, periodic_tol=periodic_tol, t_end=t_end,
                     max_steps=budget, buffers=buffers, approach_speeds0=v_in0,
-                    stop_touch_down=stop_touch_down, opts=_opt.c_options(it, rec, st, lim, skip=_opt.RUN_ARGS))
+                    stop_touch_down=stop_touch_down,
+                    ground=None if ground.is_flat else _core.CGround(ground.table()),
+                    opts=_opt.c_options(it, rec, st, lim, skip=_opt.RUN_ARGS))
     wall = time.perf_counter() - start
     energies = None
     if record_energies and raw["interrupted"] is None:
@@ -499,6 +504,7 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
     res.contact = contact
     res.integrator, res.stop = settled.ran((method, dt, t_end))
     res.record, res.limits = rec, lim
+    res.ground = ground
     if t_eval is not None or dense_output:
         res = _dense.attach(res, t_eval, dense_output, params, variant, feats,
                             _integrators.get(method).order, record_energies, contact)
@@ -581,6 +587,8 @@ def _result(raw, params, variant, method, dt, t_end, wall, on_failure,
         failure = {"t": f["t"], "x": f["x"], "reason": _REASONS.get(f["reason"], f["reason"]),
                    "leg": None if f["leg"] < 0 else f["leg"] + 1}
     public = {"done": "walked", "singular": "diverged"}.get(status, status)
+    if status == "fell" and raw["failure"]["reason"] == _layout.REASON.index("off_ground"):
+        public = "off_ground"           # the walker left the ground's defined extent
     stop = _layout.STOP[raw["stop_reason"]]
     res = Result(t=raw["t"], x=raw["x"], flags=raw["flags"], Fn=Fn, Ft=Ft, events=events,
                  status=public,

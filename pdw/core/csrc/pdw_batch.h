@@ -33,6 +33,11 @@ typedef struct pdw_batch_job {
                                  * = record_events = 0); t_end = n_steps dt for cdm. The fall
                                  * limits above replace opt's per walker */
     int method;                 /* index into pdw_methods (pdw_batch_method) */
+    /* the ground of each walker (docs/terrain.md): NULL (all flat), else (n,) pointers, NULL
+     * entries flat. A walker on a ground runs the shaped-ground kernel through the per-lane
+     * scalar stages (pdw_batch_cdm or pdw_batch_method; _batch.pyx never gives grounds to the
+     * structure-of-arrays loops): bitwise its pdw.simulate run. */
+    const pdw_ground *const *grounds;
     /* --- outputs, per walker (caller-allocated) --- */
     int *status;                /* (n,) PDW_STATUS_* */
     int *stop_reason;           /* (n,) PDW_STOP_* */
