@@ -39,8 +39,11 @@ from . import examples  # package data: the shipped scenes and studies
 from .analysis import cell_mapping, hybrid, limit_cycle
 from .analysis.branch import Bifurcation, Branch
 from .analysis.continuation import continue_gait
+from .analysis.first_passage import FirstPassage, first_passage
 from .analysis.gait_types import Gait
 from .analysis.limit_cycle import find_gait
+from .analysis.markov import MarkovChain, markov_chain
+from .analysis.robustness import GaitSensitivity, MaxStep, gait_sensitivity, max_step
 from .core import __version__  # noqa: F401 (pdw.__version__)
 from .core._layout import INPUT_HASH
 from .core.contact import Contact
@@ -95,4 +98,6 @@ __all__ = [
     "StepSizeWarning", "StepSizeError", "examples", "continue_gait", "Branch", "Bifurcation",
     "ode_function", "OdeFunction", "load", "RecordBuffer",
     "Contact", "Progress",
+    "max_step", "MaxStep", "gait_sensitivity", "GaitSensitivity", "first_passage",
+    "FirstPassage", "markov_chain", "MarkovChain",
 ]

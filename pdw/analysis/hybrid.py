@@ -66,8 +66,8 @@ def _state(y, name="state"):
 _OPTION_RANGES = {"rtol": (0.0, 1.0), "atol": (0.0, None), "h0": (0.0, None),
                   "h_max": (0.0, None), "t_max": (0.0, None), "event_tol": (0.0, None),
                   "min_step_angle": (0.0, np.pi), "fall_angle": (0.0, np.pi),
-                  "dt_out": (0.0, None)}
-_OPEN = {"rtol", "atol", "h0", "h_max", "t_max", "event_tol", "fall_angle"}
+                  "dt_out": (0.0, None), "dh": (None, None), "max_slope": (0.0, None)}
+_OPEN = {"rtol", "atol", "h0", "h_max", "t_max", "event_tol", "fall_angle", "max_slope"}
 
 
 def _options(options):

@@ -34,6 +34,10 @@ cdef extern from "pdw_hybrid_sim.h":
         double dt_out
         int (*poll)(void *ctx) noexcept nogil
         void *poll_ctx
+        double dh
+        double (*ground)(const void *ctx, double s, double *slope) noexcept nogil
+        const void *ground_ctx
+        double max_slope
     ctypedef struct pdw_hybrid_result:
         int status
         double t0, s0
@@ -50,6 +54,7 @@ cdef extern from "pdw_hybrid_sim.h":
         double Fn_min, ratio_max
         long n_steps, n_rejected, n_rhs, n_rec
         int rec_full
+        double h_st, h_touch
     void pdw_hybrid_default_opts(pdw_hybrid_opts *o) noexcept nogil
     int pdw_hybrid_impact(const double *p, const double *y_minus, pdw_hybrid_result *r) noexcept nogil
     int pdw_hybrid_step(const double *p, const double *y0, double t0, double s0,
@@ -64,12 +69,18 @@ cdef extern from "pdw_hybrid_sim.h":
     int pdw_hybrid_step_jac(const double *p, const double *y0, const pdw_hybrid_opts *o,
                             pdw_hybrid_result *r, double *DP) noexcept nogil
     void pdw_hybrid_swing_foot_grad(const double *y, const double *p, double *g) noexcept nogil
+    int pdw_hybrid_step_sens(const double *p, const double *y0, const pdw_hybrid_opts *o,
+                             pdw_hybrid_result *r, double *DP, double *dym_dy0, double *dym_ddh,
+                             double *dT_dy0, double *dT_ddh) noexcept nogil
+    long pdw_hybrid_walk_dh(const double *p, const double *y0, long n_steps,
+                            const double *dh_seq, const pdw_hybrid_opts *o, double *y_out,
+                            double *t_out, int *status) noexcept nogil
 
 
 NY = PDW_NHY
 NFOOT = PDW_NHYFOOT
 STATUS = ("ok", "no_strike", "fell", "singular", "nonfinite", "max_steps", "step_tiny",
-          "interrupted")
+          "interrupted", "tripped")
 cdef int _INTERRUPTED = 7
 
 
@@ -83,7 +94,7 @@ cdef int _py(const double[::1] p, const double[::1] y, str yname="y") except -1:
 
 
 OPTION_NAMES = ("rtol", "atol", "h0", "h_max", "t_max", "event_tol", "min_step_angle",
-                "fall_angle", "max_steps", "dt_out")
+                "fall_angle", "max_steps", "dt_out", "dh", "max_slope")
 
 
 def default_options():
@@ -96,7 +107,8 @@ def default_options():
 cdef dict _opts_dict(pdw_hybrid_opts *o):
     return {"rtol": o.rtol, "atol": o.atol, "h0": o.h0, "h_max": o.h_max, "t_max": o.t_max,
             "event_tol": o.event_tol, "min_step_angle": o.min_step_angle,
-            "fall_angle": o.fall_angle, "max_steps": o.max_steps, "dt_out": o.dt_out}
+            "fall_angle": o.fall_angle, "max_steps": o.max_steps, "dt_out": o.dt_out,
+            "dh": o.dh, "max_slope": o.max_slope}
 
 
 include "_poll.pxi"
@@ -125,6 +137,8 @@ cdef void _fill_opts(pdw_hybrid_opts *o, dict opts, list pending) except *:
         elif k == "fall_angle": o.fall_angle = v
         elif k == "max_steps": o.max_steps = v
         elif k == "dt_out": o.dt_out = v
+        elif k == "dh": o.dh = v
+        elif k == "max_slope": o.max_slope = v
         else:
             raise ValueError("unknown hybrid option %r; allowed: %s" % (k, ", ".join(OPTION_NAMES)))
 
@@ -142,7 +156,7 @@ cdef dict _result_dict(pdw_hybrid_result *r):
         "step_length": r.step_length, "s0_next": r.s0_next, "E0": r.E0, "dE_max": r.dE_max,
         "Fn_min": r.Fn_min, "ratio_max": r.ratio_max,
         "n_steps": r.n_steps, "n_rejected": r.n_rejected, "n_rhs": r.n_rhs, "n_rec": r.n_rec,
-        "rec_full": bool(r.rec_full),
+        "rec_full": bool(r.rec_full), "h_st": r.h_st, "h_touch": r.h_touch,
     }
 
 
@@ -406,3 +420,75 @@ def step_jac(const double[::1] p, const double[::1] y0, dict opts):
         d["status"] = STATUS[st] if 0 <= st < len(STATUS) else str(st)
         DP[:] = np.nan
     return d, DP
+
+
+@_named_buffers
+def step_sens(const double[::1] p, const double[::1] y0, dict opts):
+    """One step, its Jacobian and its sensitivities to the floor offset ``dh``: (result dict,
+    DP (4, 4), dym_dy0 (4, 4), dym_ddh (4,), dT_dy0 (4,), dT_ddh); NaN unless ok."""
+    cdef pdw_hybrid_opts o
+    cdef pdw_hybrid_result r
+    cdef int st
+    cdef double tdh = np.nan
+    _py(p, y0, "y0")
+    cdef list pending = []
+    _fill_opts(&o, opts, pending)
+    DP = np.full((PDW_NHY, PDW_NHY), np.nan)
+    Ym = np.full((PDW_NHY, PDW_NHY), np.nan)
+    ydh = np.full(PDW_NHY, np.nan)
+    Tg = np.full(PDW_NHY, np.nan)
+    cdef double[:, ::1] v = DP, vm = Ym
+    cdef double[::1] vd = ydh, vt = Tg
+    with nogil:
+        st = pdw_hybrid_step_sens(&p[0], &y0[0], &o, &r, &v[0, 0], &vm[0, 0], &vd[0], &vt[0],
+                                  &tdh)
+    _raised(pending)
+    d = _result_dict(&r)
+    if st != 0:
+        d["status"] = STATUS[st] if 0 <= st < len(STATUS) else str(st)
+        for a in (DP, Ym, ydh, Tg):
+            a[...] = np.nan
+        tdh = np.nan
+    return d, DP, Ym, ydh, Tg, tdh
+
+
+@_named_buffers
+def walk_dh_batch(const double[::1] p, const double[:, ::1] y0, const double[:, ::1] dh,
+                  dict opts, long[::1] n_done, int[::1] status, double[:, ::1] y_last,
+                  double[::1] t_sum):
+    """Walker i walks from y0[i] with the floor offsets dh[i, :] (one per step) until a step
+    fails or the row ends: n_done[i] completed steps, status[i] (0: none failed), y_last[i]
+    the state after its last completed step (y0[i] if none), t_sum[i] their duration [s]."""
+    cdef pdw_hybrid_opts o
+    cdef Py_ssize_t i, j, n = y0.shape[0], K = dh.shape[1]
+    _len("p", p.shape[0], PDW_NP)
+    _rows("y0", n, y0.shape[1], n, PDW_NHY)
+    _rows("dh", dh.shape[0], K, n, K)
+    _rows("y_last", y_last.shape[0], y_last.shape[1], n, PDW_NHY)
+    _len("n_done", n_done.shape[0], n)
+    _len("status", status.shape[0], n)
+    _len("t_sum", t_sum.shape[0], n)
+    if K < 1:
+        raise ValueError("dh must have at least one column")
+    cdef list pending = []
+    _fill_opts(&o, opts, pending)
+    yo = np.empty((K, PDW_NHY))
+    to = np.empty(K)
+    cdef double[:, ::1] vy = yo
+    cdef double[::1] vt = to
+    cdef long k, m
+    cdef double ts
+    with nogil:
+        for i in range(n):
+            m = pdw_hybrid_walk_dh(&p[0], &y0[i, 0], K, &dh[i, 0], &o, &vy[0, 0], &vt[0],
+                                   &status[i])
+            n_done[i] = m
+            ts = 0.0
+            for k in range(m):
+                ts += vt[k]
+            t_sum[i] = ts
+            for j in range(PDW_NHY):
+                y_last[i, j] = vy[m - 1, j] if m > 0 else y0[i, j]
+            if status[i] == _INTERRUPTED:
+                break
+    _raised(pending)
