@@ -11,7 +11,7 @@ import pathlib
 
 import sympy as sp
 
-from . import contact_laws, emit_batch, hybrid, layout, stages
+from . import contact_laws, emit_batch, hybrid, layout, stages, terrain
 from . import model as mdl
 from .printer import c_block
 
@@ -85,7 +85,36 @@ def _names(spec=None):
         names[s] = "x[PDW_X_%s]" % s.name.upper()
     for s in (mdl.DELTA, mdl.DELTAD, mdl.VT, mdl.XI, mdl.VIN, mdl.ZB):
         names[s] = s.name
+    for i, g in enumerate(terrain.GND):
+        for f, s in g.items():
+            names[s] = "gnd[%d*PDW_NGROUND + PDW_GROUND_%s]" % (i, f.upper())
     return names
+
+
+def emit_terrain():
+    """C of the shaped-ground stages (derive/terrain.py): the sample points, each variant's
+    kinematics, the ground forces."""
+    names = _names()
+    out = ["/* ---- shaped ground (derive/terrain.py, docs/terrain.md) ---- */\n"]
+    code, _ = c_block([stages._trig(e) for e in terrain.sample_points()],
+                      ["sA[%d]" % i for i in range(2)], names)
+    out.append(_function("void pdw_ground_points(const double *restrict x, const double *restrict trig,\n"
+                         "    const double *restrict p, double *restrict sA)", code))
+    kin_targets = ["kin[%d*PDW_NKIN + PDW_KIN_%s]" % (i, f.upper()) for i in range(2) for f in layout.KIN]
+    for v in mdl.VARIANTS:
+        exprs = [stages._trig(e) for i in range(2) for e in terrain.ground_kinematics(i, v).values()]
+        code, _ = c_block(exprs, kin_targets, names)
+        out.append(_function(
+            "void pdw_%s_ground_kinematics(const double *restrict x, const double *restrict trig,\n"
+            "    const double *restrict p, const double *restrict anchors, const double *restrict gnd,\n"
+            "    double *restrict kin)" % v, "    (void)anchors;\n" + code))
+    exprs = [e for i in range(2) for e in terrain.ground_forces(i)]
+    targets = ["gf[%d*PDW_NGFORCE + PDW_GFORCE_%s]" % (i, f.upper()) for i in range(2)
+               for f in terrain.GROUND_FORCE]
+    code, _ = c_block(exprs, targets, names)
+    out.append(_function("void pdw_ground_forces(const double *restrict contact, const double *restrict gnd,\n"
+                         "    const double *restrict p, double *restrict gf)", code))
+    return "\n".join(out)
 
 
 def _function(signature, body):
@@ -330,6 +359,9 @@ def header(h):
         "/* contact: per-foot contact forces and partials (foot-major) */",
         _enum("CONTACT", layout.CONTACT), "",
         "/* energies */", _enum("ENERGY", layout.ENERGY), "",
+        "/* the compiled ground (pdw_ground.h): one height cell; the ground sampled under a foot */",
+        _enum("GCELL", layout.GROUND_CELL), _enum("GROUND", layout.GROUND),
+        _enum("GFORCE", terrain.GROUND_FORCE), "",
         "/* work: scratch of one right-hand-side evaluation, every stage's output */", _work_enum(), "",
         "/* simulation records: one event row, the recorded contact forces, loop status */",
         _enum("EVENT", layout.EVENT), _enum("REC", layout.RECORD_CONTACT), _enum("STATUS", layout.STATUS),
@@ -352,6 +384,11 @@ def header(h):
         "void pdw_precompute(const double *params, double *p);",
         "void pdw_trig(const double *x, double *trig);\n",
         "\n".join(protos),
+        "\n/* shaped ground (derive/terrain.py): sample points, kinematics per variant, forces */",
+        "void pdw_ground_points(const double *x, const double *trig, const double *p, double *sA);",
+        "\n".join("void pdw_%s_ground_kinematics(const double *x, const double *trig, const double *p,\n"
+                  "    const double *anchors, const double *gnd, double *kin);" % v for v in mdl.VARIANTS),
+        "void pdw_ground_forces(const double *contact, const double *gnd, const double *p, double *gf);",
         "\n#endif /* PDW_MODEL_H */\n",
     ])
 
@@ -418,6 +455,7 @@ def source(h):
                m, m, m, k, k, contact_laws.NORMAL_LAWS.index(spec.normal),
                contact_laws.FRICTION_LAWS.index(spec.friction), spec.nx))
     parts.append("const pdw_kernel pdw_kernels[PDW_NKERNELS] = {\n%s\n};\n" % ",\n".join(table))
+    parts.append(emit_terrain())
     return "\n".join(parts), all_ops
 
 
@@ -439,6 +477,7 @@ def python_layout(h, ops):
         tup("CONTACT_PARAMS", layout.CONTACT_PARAMS), tup("ANCHORS", layout.ANCHORS),
         tup("NORMAL_LAWS", contact_laws.NORMAL_LAWS), tup("FRICTION_LAWS", contact_laws.FRICTION_LAWS),
         tup("KIN", layout.KIN), tup("CONTACT", layout.CONTACT), tup("ENERGY", layout.ENERGY),
+        tup("GROUND_CELL", layout.GROUND_CELL), tup("GROUND", layout.GROUND),
         tup("FEATURES", mdl.FEATURES), tup("VARIANTS", mdl.VARIANTS),
         tup("TRIG", stages.TRIG_NAMES),
         tup("EVENT", layout.EVENT), tup("RECORD_CONTACT", layout.RECORD_CONTACT),

@@ -71,6 +71,19 @@ CONTACT = (
     "dFt_dv",       # partial F_t / partial v_x (includes F_n dmu/dv)
 )
 
+# The compiled ground (pdw/core/ground.py, pdw/core/csrc/pdw_ground.h, docs/terrain.md): one cell
+# of the piecewise-quintic height table, h = sum_j a_j u^j with u = (s - s_k) / w_k on the cell.
+GROUND_CELL = ("s", "inv_w", "a0", "a1", "a2", "a3", "a4", "a5")
+# The ground sampled under one foot (at s = x_A, the foot arc centre's distance along the slope),
+# the inputs of the shaped-ground kinematics (derive/terrain.py).
+GROUND = (
+    "h",        # height of the surface above the mean slope [m]
+    "dh",       # slope h'(s) [-]
+    "ddh",      # h''(s) [1/m]
+    "sigma",    # arc length of the surface from s_min [m] (the consistent variant's anchor)
+    "alpha",    # surface angle atan(h') [rad]
+)
+
 # Energies (docs/model.md section 3).
 ENERGY = ("T", "V_gravity", "V_hip")
 
@@ -135,4 +148,5 @@ def work_layout():
         ("M", NQ * NQ),
         ("f", NQ),
         ("qdd", NQ),
+        ("ground", 2 * len(GROUND)),      # the ground sampled under each foot (shaped ground)
     ]

@@ -17,6 +17,7 @@ simulate, Result        one compiled simulation (support flags, events, status)
 simulate_batch          N walkers in one call, W lanes in lockstep (docs/ensemble.md): BatchResult
 simulate_many           N walkers: the batch engine when it runs the method, else pdw.simulate
 Contact                 the normal and friction contact laws of a run (docs/contact_laws.md)
+Ground, Patch           the ground as data: shape h(s) and contact patches (docs/terrain.md)
 Scene, run              everything a simulation needs, as one object or TOML file (docs/scenes.md)
 steps                   per-step gait descriptors (docs/model.md section 8)
 hybrid                  the rigid-ground impact-momentum model (docs/model.md section 9): find_gait, ...
@@ -57,6 +58,7 @@ from .core.errors import (
     StepSizeError,
     StepSizeWarning,
 )
+from .core.ground import Ground, Patch
 from .core.integrators import METHODS
 from .core.model import (
     STATE,
@@ -97,7 +99,7 @@ __all__ = [
     "limit_cycle", "cell_mapping", "find_gait", "sweep",
     "StepSizeWarning", "StepSizeError", "examples", "continue_gait", "Branch", "Bifurcation",
     "ode_function", "OdeFunction", "load", "RecordBuffer",
-    "Contact", "Progress",
+    "Contact", "Progress", "Ground", "Patch",
     "max_step", "MaxStep", "gait_sensitivity", "GaitSensitivity", "first_passage",
     "FirstPassage", "markov_chain", "MarkovChain",
 ]

@@ -1,0 +1,90 @@
+"""Contact on a shaped ground (docs/model.md section 11, docs/terrain.md).
+
+The ground is h(s) above the mean slope plane, s along the slope (pdw/core/ground.py). For foot i
+with arc centre A_i = H + (l - r) e_i, the ground is sampled once, at s_A = x_A (the point of the
+surface straight below A in the slope frame): h, h' (and for the consistent variant the arc length
+sigma and the surface angle alpha = atan h'). The surface is replaced by its tangent line there
+(**the tangent-line approximation**; exact for planes, error O(r^2 h'' h') for curved ground,
+measured in docs/terrain.md against the exact closest point):
+
+    N = sqrt(1 + h'^2),   n = (-h', 1)/N (outward normal),   t = (1, h')/N (tangent, downhill)
+    gap      g  = n . (A - (s_A, h)) - r = (y_A - h)/N - r          (depth delta = -g)
+    contact  C  = A - r n                                            (the foot's nearest point)
+    velocity v_C = v_A + r thetad t        (the material point at C; k x (-r n) = r t)
+    slip     v_t = t . v_C,   normal rate v_n = n . v_C (= n . v_A; the `paper` variant adds
+             r thetad as its printed Eq. 5 does)
+    xi       paper: (l - r) t . e_i (the contact point measured from the hip's projection on the
+             local surface, Eq. 8 in the surface frame);
+             consistent: S - S0, S = sigma(s_A) + t . (A - P) + r (theta - alpha), P = (s_A, h):
+             the rolling coordinate in surface coordinates (dS/dt = v_t - alpha_dot delta; exact
+             on a plane, where S is the rotated frame's x_o + (l - r) sin theta' + r theta').
+
+The kinematics stage writes these into the flat model's `layout.KIN` fields in the surface frame
+(y_D := g, v_x := v_t, v_y := v_n, x_D := s of C, s := S, xi), so every contact law's force stage
+runs unchanged. The forces F_n (along n) and F_t (along t) act at C; their generalized force is
+the flat dynamics stage's (forces along X, Y at D) applied to F_x = t_x F_t + n_x F_n,
+F_y = t_y F_t + n_y F_n, plus the moment of moving their point from D to C:
+r (y - n) x F = r (h'/N F_y - (1 - 1/N) F_x) on theta_i (`ground_forces`).
+"""
+from __future__ import annotations
+
+import sympy as sp
+
+from . import layout
+from . import model as mdl
+
+# the ground sampled under foot i (layout.GROUND), and one foot's contact forces
+GND = tuple({f: mdl._real("gnd_%s_%d" % (f, i + 1)) for f in layout.GROUND} for i in range(2))
+# outputs of `ground_forces` per foot
+GROUND_FORCE = ("F_x", "F_y", "M_theta")
+
+
+def sample_points():
+    """s_A = x_A of each foot (the arc centre's distance along the slope) [m], foot-major."""
+    l, r = mdl.P["l"], mdl.P["r"]
+    return [mdl.Q[0] + (l - r) * sp.sin(th) for th in mdl.Q[2:]]
+
+
+def ground_kinematics(foot: int, variant: str) -> dict:
+    """The `layout.KIN` fields of foot ``foot`` on the ground sampled in `GND` (module docstring);
+    ``z`` (LuGre) is set by the caller."""
+    if variant not in mdl.VARIANTS:
+        raise ValueError("variant must be one of %s, got %r" % (mdl.VARIANTS, variant))
+    l, r = mdl.P["l"], mdl.P["r"]
+    xo, yo, xdo, ydo = mdl.Q[0], mdl.Q[1], mdl.QD[0], mdl.QD[1]
+    th, thd = mdl.Q[2 + foot], mdl.QD[2 + foot]
+    g = GND[foot]
+    h, dh = g["h"], g["dh"]
+    N = sp.sqrt(1 + dh ** 2)
+    xa, ya = xo + (l - r) * sp.sin(th), yo - (l - r) * sp.cos(th)
+    xad, yad = xdo + (l - r) * sp.cos(th) * thd, ydo + (l - r) * sp.sin(th) * thd
+    vn = (-dh * xad + yad) / N
+    out = {
+        "x_D": xa + r * dh / N,
+        "y_D": (ya - h) / N - r,
+        "v_x": (xad + dh * yad) / N + r * thd,
+        "v_y": vn + r * thd if variant == "paper" else vn,
+        # the rolling coordinate; the paper variant's forces do not use it (its xi is Eq. 8's),
+        # so it keeps the flat model's x_A + r theta there and needs no sigma, alpha
+        "s": (g["sigma"] + dh * (ya - h) / N + r * (th - g["alpha"]) if variant == "consistent"
+              else xa + r * th),
+    }
+    if variant == "paper":
+        out["xi"] = (l - r) * (sp.sin(th) - dh * sp.cos(th)) / N
+    else:
+        out["xi"] = out["s"] - mdl.ANCHOR[foot]
+    out["v_in"] = mdl.V_IN[foot]
+    out["z"] = sp.S.Zero
+    return {k: out[k] for k in layout.KIN}
+
+
+def ground_forces(foot: int):
+    """(F_x, F_y, M_theta) of foot ``foot``: its surface-frame forces F_n, F_t as slope-frame
+    components at D, and the moment r (y - n) x F of moving them from D to C."""
+    r = mdl.P["r"]
+    dh = GND[foot]["dh"]
+    N = sp.sqrt(1 + dh ** 2)
+    fn, ft = mdl.F_N[foot], mdl.F_T[foot]
+    fx = (ft - dh * fn) / N
+    fy = (dh * ft + fn) / N
+    return [fx, fy, r * (dh / N * fy - (1 - 1 / N) * fx)]

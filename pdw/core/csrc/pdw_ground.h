@@ -1,0 +1,112 @@
+/* The compiled ground (docs/terrain.md): its height h(s) above the mean slope, h'(s), h''(s), its
+ * arc length and its contact patches, read from caller-allocated const tables (built by
+ * pdw/core/ground.py's GroundTable; no globals, no allocation). Every function is inline so that
+ * the time loops (pdw_terrain.c) and the hybrid loop can reuse it.
+ *
+ * Height: cells k = 0..n-1 on knots s_0 < ... < s_n, each row (layout GROUND_CELL)
+ *     [s_k, 1/w_k, a_0 .. a_5],   h(s) = sum_j a_j u^j,  u = (s - s_k)/w_k in [0, 1],
+ * a piecewise quintic (C2 where the shape is). The cell is found in O(1): lut[j] is the cell
+ * containing s_min + j/lut_inv, then a short forward scan.
+ * Patches: rows [s_a, s_b, v_1 .. v_f] (NaN: field not set), field i sets p[field[i]]; within
+ * blend/2 of an edge the value is blended by the C2 smoothstep.
+ * Off the defined extent [s_min, s_max] the end cells' polynomials continue (used only inside
+ * trial steps): the loops check every accepted state (pdw_ground_inside) and stop with
+ * PDW_REASON_OFF_GROUND, never extrapolating silently. */
+#ifndef PDW_GROUND_H
+#define PDW_GROUND_H
+
+#include <math.h>
+#include "pdw_model.h"
+
+typedef struct pdw_ground {
+    double s_min, s_max;        /* defined extent [m] */
+    long n_cells;
+    const double *cells;        /* (n_cells, PDW_NGCELL) */
+    const double *arc;          /* (n_cells, 6): the arc length sigma(s) in the same form */
+    long n_lut;
+    double lut_inv;             /* lut bins per metre */
+    const long *lut;            /* (n_lut,) */
+    int n_patches, n_fields;
+    const int *fields;          /* (n_fields,) PDW_P_* indices the patches set */
+    const double *patches;      /* (n_patches, 2 + n_fields) */
+    double blend;               /* patch-edge blend width [m] */
+    int n_zones;
+    const double *zones;        /* (n_zones,) sorted blend-zone boundaries [m] (events) */
+} pdw_ground;
+
+/* The cell containing s (the end cells beyond the extent). */
+static inline long pdw_ground_cell(const pdw_ground *g, double s)
+{
+    double jf = (s - g->s_min) * g->lut_inv;
+    long j = jf <= 0.0 ? 0 : (jf >= (double)(g->n_lut - 1) ? g->n_lut - 1 : (long)jf);
+    long k = g->lut[j];
+    while (k + 1 < g->n_cells && s >= g->cells[(k + 1)*PDW_NGCELL + PDW_GCELL_S]) ++k;
+    while (k > 0 && s < g->cells[k*PDW_NGCELL + PDW_GCELL_S]) --k;
+    return k;
+}
+
+/* h, h', h'' at s into out[0..2]. */
+static inline void pdw_ground_eval(const pdw_ground *g, double s, double *out)
+{
+    const double *c = g->cells + pdw_ground_cell(g, s)*PDW_NGCELL;
+    const double iw = c[PDW_GCELL_INV_W], u = (s - c[PDW_GCELL_S]) * iw;
+    const double *a = c + PDW_GCELL_A0;
+    out[0] = a[0] + u*(a[1] + u*(a[2] + u*(a[3] + u*(a[4] + u*a[5]))));
+    out[1] = (a[1] + u*(2.0*a[2] + u*(3.0*a[3] + u*(4.0*a[4] + u*5.0*a[5])))) * iw;
+    out[2] = (2.0*a[2] + u*(6.0*a[3] + u*(12.0*a[4] + u*20.0*a[5]))) * iw * iw;
+}
+
+/* The arc length sigma(s) [m] from s_min. */
+static inline double pdw_ground_arc(const pdw_ground *g, double s)
+{
+    const long k = pdw_ground_cell(g, s);
+    const double *c = g->cells + k*PDW_NGCELL, *a = g->arc + k*6;
+    const double u = (s - c[PDW_GCELL_S]) * c[PDW_GCELL_INV_W];
+    return a[0] + u*(a[1] + u*(a[2] + u*(a[3] + u*(a[4] + u*a[5]))));
+}
+
+/* Is s inside the defined extent? */
+static inline int pdw_ground_inside(const pdw_ground *g, double s)
+{
+    return s >= g->s_min && s <= g->s_max;
+}
+
+/* Weight of a patch [s_a, s_b] at s: 0 outside, 1 inside, the C2 smoothstep across each edge's
+ * blend zone [edge - blend/2, edge + blend/2]. */
+static inline double pdw_ground_window(double s, double s_a, double s_b, double blend)
+{
+    double w = 1.0;
+    const double ua = (s - (s_a - 0.5*blend)) / blend, ub = ((s_b + 0.5*blend) - s) / blend;
+    if (ua <= 0.0 || ub <= 0.0) return 0.0;
+    if (ua < 1.0) w *= ua*ua*ua*(10.0 + ua*(-15.0 + 6.0*ua));
+    if (ub < 1.0) w *= ub*ub*ub*(10.0 + ub*(-15.0 + 6.0*ub));
+    return w;
+}
+
+/* The parameter vector at s: p_out = p with the patches' fields blended in (p_out may be p's copy;
+ * only the patched fields are written). */
+static inline void pdw_ground_params(const pdw_ground *g, double s, const double *p, double *p_out)
+{
+    for (int f = 0; f < g->n_fields; ++f) {
+        const int idx = g->fields[f];
+        double v = p[idx];
+        for (int i = 0; i < g->n_patches; ++i) {
+            const double *row = g->patches + i*(2 + g->n_fields);
+            const double pv = row[2 + f];
+            if (pv != pv) continue;                                 /* NaN: not set here */
+            const double w = pdw_ground_window(s, row[0], row[1], g->blend);
+            if (w > 0.0) v += w * (pv - p[idx]);
+        }
+        p_out[idx] = v;
+    }
+}
+
+/* The blend zone of s: the number of zone boundaries <= s (a change is an event). */
+static inline int pdw_ground_zone(const pdw_ground *g, double s)
+{
+    int z = 0;
+    while (z < g->n_zones && g->zones[z] <= s) ++z;
+    return z;
+}
+
+#endif /* PDW_GROUND_H */
