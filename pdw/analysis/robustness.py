@@ -156,6 +156,9 @@ class MaxStep:
         result is then the first failure's bracket).
     gait : Gait
         The undisturbed gait.
+    stable : bool
+        False when the gait's largest Floquet multiplier has modulus >= 1: it returns from no
+        disturbance, so ``height`` is 0 and no trial is run.
     """
 
     height: float
@@ -168,8 +171,12 @@ class MaxStep:
     trials: list = field(default_factory=list)
     monotone: bool = True
     gait: Any = None
+    stable: bool = True
 
     def __repr__(self) -> str:
+        if not self.stable:
+            return "MaxStep(%s, %s: the gait is unstable, height 0)" % (self.model,
+                                                                      self.direction)
         return ("MaxStep(%s, %s: height=%.6g m, bracket=(%.6g, %.6g), steps_to_return=%d, "
                 "%d trials)" % (self.model, self.direction, self.height, self.bracket[0],
                                 self.bracket[1], self.steps_to_return, len(self.trials)))
@@ -283,6 +290,10 @@ def max_step(params=None, *, direction="down", model="hybrid", h_max=None, h_tol
             return _hybrid_trials(params, gait, heights, direction, budget, return_tol,
                                   threads, options)
 
+    if max(abs(np.asarray(gait.multipliers))) >= 1.0:
+        return MaxStep(height=0.0, bracket=(0.0, 0.0), steps_to_return=-1, direction=direction,
+                       model=model, return_tol=return_tol, budget=budget, trials=[],
+                       monotone=True, gait=gait, stable=False)
     trials = []
     ok = lambda t: t["survived"] and t["returned"]      # noqa: E731
     lo, hi = 0.0, h_max
@@ -485,6 +496,10 @@ def gait_sensitivity(params=None, *, indicators=("step_time",), model="hybrid", 
     B = _hybrid.impact_jac(p, np.ascontiguousarray(res["y_minus"])) @ ydh
     C, D = _indicator_rows(params, names, res, DP, Ym, ydh, Tg, Tdh, B)
     A = DP
+    if max(abs(np.asarray(gait.multipliers))) >= 1.0:        # unstable: infinite norm
+        inf = {n: math.inf for n in names}
+        return GaitSensitivity(norm=math.inf, per_indicator=inf, indicators=names, A=A,
+                               B=B[:, None], C=C, D=D, method="exact", gait=gait)
     norm = h2_norm(A, B[:, None], C, D)
     per = {n: h2_norm(A, B[:, None], C[i:i + 1], D[i:i + 1]) for i, n in enumerate(names)}
     chk = {}

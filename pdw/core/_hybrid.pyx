@@ -35,7 +35,7 @@ cdef extern from "pdw_hybrid_sim.h":
         int (*poll)(void *ctx) noexcept nogil
         void *poll_ctx
         double dh
-        double (*ground)(const void *ctx, double s, double *slope) noexcept nogil
+        int (*ground)(const void *ctx, double s, double *h, double *slope) noexcept nogil
         const void *ground_ctx
         double max_slope
     ctypedef struct pdw_hybrid_result:
@@ -77,10 +77,70 @@ cdef extern from "pdw_hybrid_sim.h":
                             double *t_out, int *status) noexcept nogil
 
 
+cdef extern from "pdw_ground.h":
+    ctypedef struct pdw_ground:
+        double s_min, s_max
+        long n_cells
+        const double *cells
+        const double *arc
+        long n_lut
+        double lut_inv
+        const long *lut
+        int n_patches, n_fields
+        const int *fields
+        const double *patches
+        double blend
+        int n_zones
+        const double *zones
+    void pdw_ground_eval(const pdw_ground *g, double s, double *out) noexcept nogil
+    int pdw_ground_inside(const pdw_ground *g, double s) noexcept nogil
+
+
+cdef int _ground_h(const void *ctx, double s, double *h, double *slope) noexcept nogil:
+    """The hybrid loop's ground hook over a compiled pdw.Ground (pdw_ground.h)."""
+    cdef double out[3]
+    cdef const pdw_ground *g = <const pdw_ground *> ctx
+    pdw_ground_eval(g, s, out)
+    h[0] = out[0]
+    if slope != NULL:
+        slope[0] = out[1]
+    return 0 if pdw_ground_inside(g, s) else 1
+
+
+cdef class GroundRef:
+    """A `pdw.core.ground_table.GroundTable`'s height cells as the C struct the hybrid loop
+    reads (its arrays kept alive here; patches are not used: the hybrid ground is rigid)."""
+    cdef pdw_ground g
+    cdef object keep
+
+    def __cinit__(self, table):
+        cells = np.ascontiguousarray(table.cells, dtype=np.float64)
+        lut = np.ascontiguousarray(table.lut, dtype=np.int_)
+        if cells.ndim != 2 or cells.shape[0] < 1 or lut.shape[0] < 1:
+            raise ValueError("a ground table needs at least one cell and one lookup bin")
+        self.keep = (cells, lut)
+        cdef double[:, ::1] vc = cells
+        cdef long[::1] vl = lut
+        memset(&self.g, 0, sizeof(self.g))
+        self.g.s_min = table.s_min
+        self.g.s_max = table.s_max
+        self.g.n_cells = cells.shape[0]
+        self.g.cells = &vc[0, 0]
+        self.g.n_lut = lut.shape[0]
+        self.g.lut_inv = table.lut_inv
+        self.g.lut = &vl[0]
+
+    def h(self, double s):
+        """(h, dh/ds, inside) at s, through the hook the loop calls."""
+        cdef double hh = 0.0, sl = 0.0
+        cdef int off = _ground_h(&self.g, s, &hh, &sl)
+        return hh, sl, not off
+
+
 NY = PDW_NHY
 NFOOT = PDW_NHYFOOT
 STATUS = ("ok", "no_strike", "fell", "singular", "nonfinite", "max_steps", "step_tiny",
-          "interrupted", "tripped")
+          "interrupted", "tripped", "off_ground")
 cdef int _INTERRUPTED = 7
 
 
@@ -122,10 +182,13 @@ cdef object _raised(list pending, partial=None):
         raise exc
 
 
-cdef void _fill_opts(pdw_hybrid_opts *o, dict opts, list pending) except *:
+cdef void _fill_opts(pdw_hybrid_opts *o, dict opts, list pending, GroundRef ground=None) except *:
     pdw_hybrid_default_opts(o)
     o.poll = _poll
     o.poll_ctx = <void *> pending
+    if ground is not None:
+        o.ground = _ground_h
+        o.ground_ctx = <const void *> &ground.g
     for k, v in opts.items():
         if k == "rtol": o.rtol = v
         elif k == "atol": o.atol = v
@@ -264,15 +327,16 @@ def solve(double[:, ::1] A, double[::1] b):
 
 @_named_buffers
 def step(const double[::1] p, const double[::1] y0, dict opts, double t0=0.0, double s0=0.0,
-         long rec_cap=0):
-    """One step of the hybrid map. Returns (result dict, rec_t, rec_y)."""
+         long rec_cap=0, GroundRef ground=None):
+    """One step of the hybrid map (on ``ground`` if given). Returns (result dict, rec_t,
+    rec_y)."""
     cdef pdw_hybrid_opts o
     cdef pdw_hybrid_result r
     _py(p, y0, "y0")
     if rec_cap < 0:
         raise ValueError("rec_cap must be >= 0, got %d" % rec_cap)
     cdef list pending = []
-    _fill_opts(&o, opts, pending)
+    _fill_opts(&o, opts, pending, ground)
     rec_t = np.zeros(max(rec_cap, 1))
     rec_y = np.zeros((max(rec_cap, 1), PDW_NHY))
     cdef double[::1] vt = rec_t
@@ -310,14 +374,15 @@ def step_batch(const double[::1] p, const double[:, ::1] y0, dict opts, double[:
 
 @_named_buffers
 def walk(const double[::1] p, const double[::1] y0, double s0, long n_steps, dict opts,
-         long rec_cap):
-    """n_steps steps; returns (list of result dicts, rec_t, rec_y, rec_step)."""
+         long rec_cap, GroundRef ground=None):
+    """n_steps steps (on ``ground`` if given); returns (list of result dicts, rec_t, rec_y,
+    rec_step)."""
     cdef pdw_hybrid_opts o
     _py(p, y0, "y0")
     if rec_cap < 0:
         raise ValueError("rec_cap must be >= 0, got %d" % rec_cap)
     cdef list pending = []
-    _fill_opts(&o, opts, pending)
+    _fill_opts(&o, opts, pending, ground)
     if n_steps < 1:
         raise ValueError("n_steps must be >= 1, got %d" % n_steps)
     results = np.zeros(n_steps * sizeof(pdw_hybrid_result), dtype=np.uint8)
@@ -455,7 +520,7 @@ def step_sens(const double[::1] p, const double[::1] y0, dict opts):
 @_named_buffers
 def walk_dh_batch(const double[::1] p, const double[:, ::1] y0, const double[:, ::1] dh,
                   dict opts, long[::1] n_done, int[::1] status, double[:, ::1] y_last,
-                  double[::1] t_sum):
+                  double[::1] t_sum, list grounds=None):
     """Walker i walks from y0[i] with the floor offsets dh[i, :] (one per step) until a step
     fails or the row ends: n_done[i] completed steps, status[i] (0: none failed), y_last[i]
     the state after its last completed step (y0[i] if none), t_sum[i] their duration [s]."""
@@ -472,6 +537,16 @@ def walk_dh_batch(const double[::1] p, const double[:, ::1] y0, const double[:, 
         raise ValueError("dh must have at least one column")
     cdef list pending = []
     _fill_opts(&o, opts, pending)
+    if grounds is not None and len(grounds) != n:
+        raise ValueError("grounds must list %d GroundRef, got %d" % (n, len(grounds)))
+    gbuf = np.zeros(max(n, 1), dtype=np.uintp)
+    cdef size_t[::1] vg = gbuf
+    cdef GroundRef gr
+    cdef int has_g = grounds is not None
+    if has_g:
+        for i in range(n):
+            gr = grounds[i]
+            vg[i] = <size_t> &gr.g
     yo = np.empty((K, PDW_NHY))
     to = np.empty(K)
     cdef double[:, ::1] vy = yo
@@ -480,6 +555,9 @@ def walk_dh_batch(const double[::1] p, const double[:, ::1] y0, const double[:, 
     cdef double ts
     with nogil:
         for i in range(n):
+            if has_g:
+                o.ground = _ground_h
+                o.ground_ctx = <const void *> vg[i]
             m = pdw_hybrid_walk_dh(&p[0], &y0[i, 0], K, &dh[i, 0], &o, &vy[0, 0], &vt[0],
                                    &status[i])
             n_done[i] = m

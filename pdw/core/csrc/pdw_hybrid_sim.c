@@ -224,8 +224,11 @@ typedef struct floor_ctx {
 static double gap(const floor_ctx *F, const double *foot, double *slope)
 {
     double level = F->o->dh;
-    if (F->o->ground)
-        level += F->o->ground(F->o->ground_ctx, F->s0 + foot[PDW_HYFOOT_X_SW], slope) - F->h_st;
+    if (F->o->ground) {
+        double h = 0.0;
+        F->o->ground(F->o->ground_ctx, F->s0 + foot[PDW_HYFOOT_X_SW], &h, slope);
+        level += h - F->h_st;
+    }
     return foot[PDW_HYFOOT_Y_SW] - level;
 }
 
@@ -254,9 +257,11 @@ int pdw_hybrid_step(const double *p, const double *y0, double t0, double s0,
     memcpy(y, y0, sizeof y);
     r->status = PDW_HYBRID_OK;
     floor_ctx F = {o, s0, 0.0};
+    int off = 0;
     if (o->ground)
-        F.h_st = o->ground(o->ground_ctx, s0 - p[PDW_P_R]*y0[PDW_HY_THETA_ST], NULL);
+        off = o->ground(o->ground_ctx, s0 - p[PDW_P_R]*y0[PDW_HY_THETA_ST], &F.h_st, NULL);
     r->h_st = F.h_st;
+    if (off) { r->status = PDW_HYBRID_OFF_GROUND; return r->status; }
     if (o->poll && o->poll(o->poll_ctx)) { r->status = PDW_HYBRID_INTERRUPTED; return r->status; }
     if (!finite4(y)) { r->status = PDW_HYBRID_NONFINITE; return r->status; }
     f(&S, y, k1);
@@ -334,8 +339,12 @@ int pdw_hybrid_step(const double *p, const double *y0, double t0, double s0,
             r->s0_next = r->x_touch + p[PDW_P_R]*y[PDW_HY_THETA_SW];
             r->h_touch = r->h_st + o->dh;
             if (o->ground) {
-                double slope = 0.0;
-                r->h_touch = o->ground(o->ground_ctx, r->x_touch, &slope) + o->dh;
+                double slope = 0.0, h = 0.0;
+                if (o->ground(o->ground_ctx, r->x_touch, &h, &slope)) {
+                    r->status = PDW_HYBRID_OFF_GROUND;
+                    break;
+                }
+                r->h_touch = h + o->dh;
                 if (fabs(slope) > o->max_slope) { r->status = PDW_HYBRID_TRIPPED; break; }
             }
             r->status = pdw_hybrid_impact(p, y, r);
@@ -395,12 +404,13 @@ long pdw_hybrid_walk_dh(const double *p, const double *y0, long n_steps, const d
 {
     pdw_hybrid_opts ok = *o;
     pdw_hybrid_result r;
-    double y[NY];
+    double y[NY], s = 0.0;
     memcpy(y, y0, sizeof y);
     *status = PDW_HYBRID_OK;
     for (long k = 0; k < n_steps; ++k) {
         ok.dh = dh_seq[k];
-        pdw_hybrid_step(p, y, 0.0, 0.0, &ok, &r, NULL, NULL, 0);
+        pdw_hybrid_step(p, y, 0.0, s, &ok, &r, NULL, NULL, 0);
+        s = r.s0_next;
         if (r.status == PDW_HYBRID_OK && r.old_foot_down) r.status = PDW_HYBRID_FELL;
         if (r.status != PDW_HYBRID_OK) { *status = r.status; return k; }
         memcpy(y, r.y_plus, sizeof y);

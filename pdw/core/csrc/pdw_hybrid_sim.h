@@ -36,15 +36,17 @@ typedef struct pdw_hybrid_opts {
     void *poll_ctx;
     /* The ground (docs/hybrid.md, "On a shaped ground"). Heel strike is when the armed swing
      * foot's contact point reaches the ground under it: y_sw = level, with
-     *   level = dh + (ground ? ground(ground_ctx, s0 + x_sw, NULL) - h_st : 0),
+     *   level = dh + (ground ? h(s0 + x_sw) - h_st : 0),
      * h_st the ground's height at the stance foot's touch-down point; the stance foot rolls on
      * the mean slope plane at its own level. dh = 0 and ground = NULL: flat, bitwise the
      * model without these fields. */
     double dh;                /* ground under the swing foot relative to the stance foot's
                                  level for the whole step [m] (a step-down: dh < 0) */
-    double (*ground)(const void *ctx, double s, double *slope);
-                              /* height h(s) [m] above the mean slope plane at s [m], and
-                                 dh/ds into *slope when slope != NULL; NULL: flat */
+    int (*ground)(const void *ctx, double s, double *h, double *slope);
+                              /* height h(s) [m] above the mean slope plane at s [m] into *h,
+                                 dh/ds into *slope when slope != NULL; returns nonzero when s
+                                 is outside the ground's defined extent (a strike or a stance
+                                 there stops the step: PDW_HYBRID_OFF_GROUND); NULL: flat */
     const void *ground_ctx;
     double max_slope;         /* a strike where |dh/ds| > max_slope is a trip (the foot hit
                                  a riser): status PDW_HYBRID_TRIPPED */
@@ -61,7 +63,8 @@ enum {
     PDW_HYBRID_MAX_STEPS = 5,     /* max_steps integrator steps without heel strike */
     PDW_HYBRID_STEP_TINY = 6,     /* step size underflow */
     PDW_HYBRID_INTERRUPTED = 7,   /* opts->poll asked to stop (Ctrl-C) */
-    PDW_HYBRID_TRIPPED = 8        /* the swing foot struck a riser (|dh/ds| > max_slope) */
+    PDW_HYBRID_TRIPPED = 8,       /* the swing foot struck a riser (|dh/ds| > max_slope) */
+    PDW_HYBRID_OFF_GROUND = 9     /* a foot outside the ground's defined extent */
 };
 
 typedef struct pdw_hybrid_result {
@@ -142,7 +145,8 @@ int pdw_hybrid_step_sens(const double *p, const double *y0, const pdw_hybrid_opt
                          pdw_hybrid_result *r, double *DP, double *dym_dy0, double *dym_ddh,
                          double *dT_dy0, double *dT_ddh);
 
-/* n_steps steps from y0 (s0 = 0) with the floor offset dh_seq[k] at step k (o->dh ignored);
+/* n_steps steps from y0 (s0 = 0, on o->ground if set) with the floor offset dh_seq[k] at
+ * step k (o->dh ignored; a failed step, or one whose old foot does not leave, ends the walk);
  * y_out (n_steps x 4) the post-impact states, t_out (n_steps) the stance durations. Returns
  * the completed steps; *status the failing step's status (PDW_HYBRID_OK if none). */
 long pdw_hybrid_walk_dh(const double *p, const double *y0, long n_steps, const double *dh_seq,
