@@ -185,8 +185,9 @@ def first_passage(params=None, *, sigma=None, ground=None, walkers=400, max_step
         Runs the chunks (``submit``); None: ``threads`` threads here.
     path : str or Path, optional
         A CSV file of finished walkers: appended as chunks finish; read back (and only the
-        missing walkers run) when it exists. Its first line records the arguments; a file
-        of another study is refused.
+        missing walkers run) when it exists. Its first line records what a walker's outcome
+        depends on (not ``walkers``: a study extended by more walkers runs only the new ones);
+        a file of another study is refused.
     confidence : float
         Of the interval (`mfpt_estimate`).
     gait : Gait, optional
@@ -221,10 +222,11 @@ def first_passage(params=None, *, sigma=None, ground=None, walkers=400, max_step
     gait = _rb._hybrid_gait(params, gait, options)
     size = (max(1, -(-walkers // (4 * threads))) if chunk_size is None
             else checks.count("chunk_size", chunk_size, lo=1, hi=10 ** 9))
-    meta = dict(model=model, sigma=sigma, seed=seed, walkers=walkers, max_steps=max_steps,
+    meta = dict(model=model, sigma=sigma, seed=seed, max_steps=max_steps,
                 params=params.as_dict(), options={k: float(v) for k, v in options.items()},
                 gait=[float(v) for v in gait.state])
     done = _read(path, meta) if path is not None else {}
+    meta["walkers"] = walkers
     todo = [(lo, min(walkers, lo + size)) for lo in range(0, walkers, size)
             if not all(i in done for i in range(lo, min(walkers, lo + size)))]
     kw = dict(params=params, y0=np.array(gait.state), sigma=sigma, seed=seed,

@@ -5,7 +5,8 @@ random step height dh (i.i.d. N(0, sigma^2), the ground under the landing foot r
 stance foot) give the next state y' = P(y, dh) or a failure. `markov_chain` discretizes it as
 Byl & Tedrake do ("Metastable walking machines", Sec. 4): a mesh of the states reachable from
 the gait, built outward from the gait's state one generation at a time, and the step-height
-distribution as ``n_dh`` values with the weights of the Gauss-Hermite rule (`dh_nodes`). The mesh is a grid of cells of side ``resolution`` in the scaled coordinates
+distribution as ``n_dh`` values: the conditional means of equal-width bins, weighted by the
+bins' probabilities (`dh_nodes`). The mesh is a grid of cells of side ``resolution`` in the scaled coordinates
 u = (theta_st, theta_sw, thetad_st / w, thetad_sw / w), w = sqrt(g / l); each cell is
 represented by the first reachable state that fell in it, and a transition goes to the cell of
 the next state. A failing step goes to the absorbing state. With Q the transient block of the
@@ -109,16 +110,23 @@ class MarkovChain:
         return steps, failed
 
 
-def dh_nodes(sigma, n_dh):
-    """``n_dh`` step heights [m] and their probabilities: the Gauss-Hermite rule of
-    N(0, sigma^2) (nodes sigma x_j, weights w_j / sqrt(2 pi) of the probabilists' rule; exact
-    for polynomials of degree < 2 n_dh, and reaching the tails: with 15 nodes |dh| up to
-    6.4 sigma, where the falls come from)."""
-    x, wt = np.polynomial.hermite_e.hermegauss(n_dh)
-    return sigma * x, wt / math.sqrt(2.0 * math.pi)
+def dh_nodes(sigma, n_dh, span=5.0):
+    """``n_dh`` step heights [m] and their probabilities: N(0, sigma^2) cut into n_dh bins of
+    equal width on [-span sigma, span sigma] (the outer bins reach to infinity), each bin
+    represented by its conditional mean and weighted by its probability. Probabilities are
+    preserved bin by bin, so the chance of a step height beyond a failure threshold is right to
+    within one bin (an equal-probability rule loses the tails where the falls come from; a
+    Gauss-Hermite rule puts large weights on few tail nodes)."""
+    from scipy.stats import norm
+
+    e = np.linspace(-span, span, n_dh + 1)
+    e[0], e[-1] = -np.inf, np.inf
+    P = np.diff(norm.cdf(e))
+    mean = (norm.pdf(e[:-1]) - norm.pdf(e[1:])) / P        # E[x | bin] of N(0, 1)
+    return sigma * mean, P
 
 
-def markov_chain(params=None, *, sigma, n_dh=15, resolution=0.02, max_cells=20000, gait=None,
+def markov_chain(params=None, *, sigma, n_dh=41, resolution=0.01, max_cells=20000, gait=None,
                  threads=2, **options) -> MarkovChain:
     """Byl & Tedrake's Markov-chain MFPT of the hybrid walker with i.i.d. step heights.
 
