@@ -54,6 +54,9 @@ cdef extern from "pdw_model.h":
     void pdw_trig(const double *x, double *trig) noexcept nogil
 
 
+include "_ground.pxi"
+
+
 cdef extern from "pdw_sim.h":
     ctypedef struct pdw_discrete:
         int flags[2]
@@ -69,6 +72,7 @@ cdef extern from "pdw_sim.h":
         long n_touch_down, n_lift_off
         double ring[1][1]
     ctypedef struct pdw_sim:
+        const pdw_ground *ground
         long poll_every
         long max_steps
         const pdw_kernel *kernel
@@ -117,8 +121,9 @@ cdef extern from "pdw_sim.h":
         pdw_advance_fn advance
     const pdw_method pdw_methods[]
     const int pdw_nmethods
-    void pdw_discrete_init(const pdw_kernel *k, const double *p, const double *x,
-                           const int *flags0, pdw_discrete *d, double *work) noexcept nogil
+    void pdw_discrete_init(const pdw_kernel *k, const pdw_ground *g, const double *p,
+                           const double *x, const int *flags0, pdw_discrete *d,
+                           double *work) noexcept nogil
     void pdw_gait_init(pdw_gait *g) noexcept nogil
     enum:
         PDW_STATUS_RECORDS_FULL, PDW_STATUS_POLL
@@ -420,7 +425,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         long event_capacity=256, double event_tol=1e-9, bint record_events=True,
         long stop_steps=0, int periodic_k=0, double periodic_tol=0.0, double t_end=0.0,
         long max_steps=0, long poll_every=POLL_EVERY, buffers=None, approach_speeds0=None,
-        int stop_touch_down=0):
+        int stop_touch_down=0, CGround ground=None):
     """Run one simulation in compiled code (GIL released). Returns a dict of arrays and status.
 
     The online gait analysis runs for every method: the result's "gait" holds the last
@@ -442,6 +447,9 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
 
     approach_speeds0: (v1, v2) [m/s] replaces the approach speeds of the feet that start in
     support (default: pdw_discrete_init's max(-v_y, 0)).
+
+    ground: a `CGround` (a shaped or patched ground, docs/terrain.md): the run takes the
+    shaped-ground kernel of pdw_terrain.c; None: flat, today's kernel.
 
     Shapes (checked): x0 (kernel_nx(k),), p (NP,).
     """
@@ -472,6 +480,8 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     cdef pdw_advance_fn advance = pdw_methods[method].advance
     memset(&s, 0, sizeof(pdw_sim))
     s.kernel = _kernel(k)
+    if ground is not None:
+        s.ground = &ground.g
     s.nx = nx
     s.t_end = t_end if t_end > 0 else n_steps * dt   # adaptive methods end exactly at t_end
     s.rtol = rtol
@@ -531,7 +541,7 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     pdw_gait_init(&s.gait)
     memcpy(s.x, &x0[0], nx * sizeof(double))
     flags0[0] = f1; flags0[1] = f2
-    pdw_discrete_init(s.kernel, s.p, s.x, flags0, &s.disc, s.work)
+    pdw_discrete_init(s.kernel, s.ground, s.p, s.x, flags0, &s.disc, s.work)
     if approach_speeds0 is not None:        # feet that start in support: given approach speeds
         if f1:
             s.disc.anchors[PDW_ANCHOR_V_IN1] = approach_speeds0[0]

@@ -311,6 +311,17 @@ class Ground:
             return self.extent
         return (-math.inf, math.inf) if self.is_flat else DEFAULT_EXTENT
 
+    def patched_params(self, params) -> list:
+        """``params`` and, for each patch, ``params`` with the patch's `pdw.Params` fields (for
+        the step-size check of fixed-step methods)."""
+        names = set(params.as_dict())
+        out = [params]
+        for p in self.patches:
+            ch = {k: v for k, v in p.values if k in names}
+            if ch:
+                out.append(params.replace(**ch))
+        return out
+
     # ---- evaluation ------------------------------------------------------------------------------
     def evaluate(self, s):
         """(h, h', h'') at s [m] (array-like): the exact shape, in NumPy ([m], [-], [1/m])."""

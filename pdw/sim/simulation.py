@@ -29,6 +29,7 @@ from ..core.errors import (
     InvalidInputError,
     SingularSystemError,
 )
+from ..core.ground import Ground
 from ..core.integrators import METHODS
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
 from ..core.params import X0_PAPER, Params
@@ -58,6 +59,8 @@ _REASONS = {
     5: "the step's linear system was singular",
     6: "the adaptive step size underflowed (the error test never passed)",
     7: "the step budget (max_steps) was used up before t_end",
+    8: "the walker left the ground's defined extent (the hip came within a leg length of "
+       "Ground.s_range's ends; docs/terrain.md)",
 }
 #: Smallest step [s] (a smaller one makes the step matrices singular in double precision).
 DT_MIN = 1e-12
@@ -157,6 +160,7 @@ class Result:
     sol: object = None
     provenance: dict | None = None
     contact: _contact.Contact | None = None      # the pdw.Contact simulated (laws, parameters)
+    ground: Ground | None = None                 # the pdw.Ground walked on (docs/terrain.md)
 
     @property
     def walked(self) -> bool:
@@ -249,7 +253,7 @@ _DEFAULTS = dict(t_end=3.5, dt=1e-4, params=None, variant="paper", method="cdm",
                  features=None, record_events=True, record_energies=False, stop_steps=0,
                  periodic_steps=0, periodic_tol=1e-3, check_step="warn", t_eval=None,
                  dense_output=False, out=None, max_steps=None,
-                 contact=None, approach_speeds0=None, stop_touch_down=0)
+                 contact=None, approach_speeds0=None, stop_touch_down=0, ground=None)
 
 
 def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float = 1e-4,
@@ -266,7 +270,7 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
              out: RecordBuffer | None = None, max_steps: int | None = None,
              contact: _contact.Contact | dict | str | None = None,
              approach_speeds0: tuple[float, float] | None = None,
-             stop_touch_down: int = 0) -> Result:
+             stop_touch_down: int = 0, ground: Ground | dict | None = None) -> Result:
     """Simulate the walker from ``x0`` for ``t_end`` seconds (or run a `pdw.Scene`).
 
     ``simulate(scene)`` runs the scene (as `pdw.run`); no other argument may be given then.
@@ -364,6 +368,10 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
     approach_speeds0 : (float, float), optional
         Approach speeds [m/s] (>= 0) of the feet that start in support (the damping of
         lankarani_nikravesh and flores); default max(-v_y(x0), 0) of each.
+    ground : pdw.Ground or dict, optional
+        The ground walked on (shape h(s) and contact patches, docs/terrain.md); default flat
+        (today's kernel, bitwise). A shaped or patched ground runs the shaped-ground kernel;
+        a walker that leaves its defined extent stops with status ``"off_ground"``.
 
     Returns
     -------
@@ -445,8 +453,10 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
     if feats != _layout.FEATURES:
         params = params.without(feats)
     p = contact.vector(parameter_vector(params), feats, params)     # validates the law's values
+    ground = Ground.coerce(ground)
     try:        # every contact law: the law's factor on the default estimate (stepsize.py)
-        _stepsize.check_step(dt, params, method, variant, check_step, contact)
+        for ps in ground.patched_params(params):    # and every patch's properties
+            _stepsize.check_step(dt, ps, method, variant, check_step, contact)
     except (np.linalg.LinAlgError, FloatingPointError, OverflowError) as e:
         _stepsize.step_unknown(dt, method, check_step, e)
     v_in0 = None if approach_speeds0 is None else tuple(checks.real_array(
@@ -465,7 +475,8 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
                     event_tol=event_tol, record_events=bool(record_events), stop_steps=stop_steps,
                     periodic_k=periodic_steps, periodic_tol=periodic_tol, t_end=t_end,
                     max_steps=budget, buffers=buffers, approach_speeds0=v_in0,
-                    stop_touch_down=stop_touch_down)
+                    stop_touch_down=stop_touch_down,
+                    ground=None if ground.is_flat else _core.CGround(ground.table()))
     wall = time.perf_counter() - start
     energies = None
     if record_energies and raw["interrupted"] is None:
@@ -477,6 +488,7 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float = 3.5, dt: float
     res = _result(raw, params, variant, method, dt, t_end, wall, on_failure, feats,
                   bool(record_events), energies, x)
     res.contact = contact
+    res.ground = ground
     if t_eval is not None or dense_output:
         res = _dense.attach(res, t_eval, dense_output, params, variant, feats,
                             _integrators.get(method).order, record_energies, contact)
@@ -555,6 +567,8 @@ def _result(raw, params, variant, method, dt, t_end, wall, on_failure,
         failure = {"t": f["t"], "x": f["x"], "reason": _REASONS.get(f["reason"], f["reason"]),
                    "leg": None if f["leg"] < 0 else f["leg"] + 1}
     public = {"done": "walked", "singular": "diverged"}.get(status, status)
+    if status == "fell" and raw["failure"]["reason"] == 8:
+        public = "off_ground"           # the walker left the ground's defined extent
     stop = _layout.STOP[raw["stop_reason"]]
     res = Result(t=raw["t"], x=raw["x"], flags=raw["flags"], Fn=Fn, Ft=Ft, events=events,
                  status=public,

@@ -64,7 +64,7 @@ static void load_walker(const pdw_batch_job *job, long i, pdw_sim *s)
     memcpy(s->x, job->x0 + i*PDW_NX, PDW_NX * sizeof(double));
     flags0[0] = job->flags0[2*i];
     flags0[1] = job->flags0[2*i + 1];
-    pdw_discrete_init(s->kernel, s->p, s->x, flags0, &s->disc, s->work);
+    pdw_discrete_init(s->kernel, s->ground, s->p, s->x, flags0, &s->disc, s->work);
 }
 
 static int start(const pdw_batch_job *job, long i, pdw_sim *s)

@@ -17,7 +17,7 @@ void pdw_cdm_start(pdw_sim *s)
 {
     const double dt = s->dt;
     double xdot[PDW_NX_MAX];
-    s->kernel->rhs(s->x, s->p, s->disc.flags, s->disc.anchors, xdot, s->work);
+    pdw_sim_rhs(s, s->x, xdot, s->work);
     for (int i = 0; i < PDW_NQ; ++i)
         s->u_prev[i] = s->x[i] - dt*s->x[PDW_NQ + i] + 0.5*dt*dt*xdot[PDW_NQ + i];
     s->started = 1;
@@ -114,8 +114,13 @@ int pdw_cdm_advance(pdw_sim *s)
             if (r > 0) { pdw_record_final(s, t); return s->status; }   /* a stop condition */
         }
         if (pdw_check_feet(s, t)) return s->status;
-        k->contact(kin, s->disc.flags, s->p, contact);
-        k->cdm_terms(s->x, trig, s->p, contact, M, C, QmG);
+        if (s->ground) {            /* shaped ground (pdw_terrain.c) */
+            pdw_sim_contact(s, s->work);
+            pdw_terrain_cdm_terms(k, s->x, trig, s->p, contact, s->work + PDW_WORK_GROUND, M, C, QmG);
+        } else {
+            k->contact(kin, s->disc.flags, s->p, contact);
+            k->cdm_terms(s->x, trig, s->p, contact, M, C, QmG);
+        }
         if (s->n > 0) pdw_record(s, t);  /* sample 0 was recorded at the start */
         if (pdw_cdm_update(s, M, C, QmG, t)) return s->status;
     }

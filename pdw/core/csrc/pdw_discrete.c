@@ -4,18 +4,26 @@
 #include <string.h>
 #include "pdw_sim.h"
 
-static void kinematics(const pdw_kernel *k, const double *p, const double *x,
+static void kinematics(const pdw_kernel *k, const pdw_ground *g, const double *p, const double *x,
                        const double *anchors, double *work)
 {
     pdw_trig(x, work + PDW_WORK_TRIG);
-    k->kinematics(x, work + PDW_WORK_TRIG, p, anchors, work + PDW_WORK_KIN);
+    if (g) pdw_terrain_kinematics(k, g, x, work + PDW_WORK_TRIG, p, anchors, work + PDW_WORK_KIN,
+                                  work + PDW_WORK_GROUND);
+    else k->kinematics(x, work + PDW_WORK_TRIG, p, anchors, work + PDW_WORK_KIN);
 }
 
-void pdw_discrete_init(const pdw_kernel *k, const double *p, const double *x,
+/* The blend zone of foot i's contact point (support), -1 (swing or no patches). */
+static inline int zone_of(const pdw_ground *g, int support, const double *ki)
+{
+    return g && g->n_zones > 0 && support ? pdw_ground_zone(g, ki[PDW_KIN_X_D]) : -1;
+}
+
+void pdw_discrete_init(const pdw_kernel *k, const pdw_ground *g, const double *p, const double *x,
                        const int flags0[2], pdw_discrete *d, double *work)
 {
     const double zero[PDW_NANCHOR] = {0.0};
-    kinematics(k, p, x, zero, work);
+    kinematics(k, g, p, x, zero, work);
     for (int i = 0; i < 2; ++i) {
         const double *ki = work + PDW_WORK_KIN + i*PDW_NKIN;
         d->flags[i] = flags0[i] ? 1 : 0;
@@ -24,6 +32,7 @@ void pdw_discrete_init(const pdw_kernel *k, const double *p, const double *x,
         /* approach speed of a foot that starts in contact: its penetration rate, if any (the
          * laws that use it take at least v_in_min) */
         d->anchors[PDW_ANCHOR_V_IN1 + i] = d->flags[i] ? fmax(-ki[PDW_KIN_V_Y], 0.0) : 0.0;
+        d->zone[i] = zone_of(g, d->flags[i], ki);
     }
 }
 
@@ -146,7 +155,7 @@ int pdw_update_flags_trig(pdw_sim *s, double t)
     double *kin = s->work + PDW_WORK_KIN;
     int changed = 0, stop = PDW_STOP_NONE;
     if (!pdw_events_room(s, 2)) return -1;
-    s->kernel->kinematics(s->x, s->work + PDW_WORK_TRIG, s->p, d->anchors, kin);
+    pdw_sim_kinematics(s, s->x, d->anchors, s->work);
     for (int i = 0; i < 2; ++i) {
         const double *ki = kin + i*PDW_NKIN, *kj = kin + (1 - i)*PDW_NKIN;
         const double y = ki[PDW_KIN_Y_D], vy = ki[PDW_KIN_V_Y];
@@ -173,7 +182,9 @@ int pdw_update_flags_trig(pdw_sim *s, double t)
         }
     }
     /* a new anchor changes xi: refresh the kinematics (trig stays valid) */
-    if (changed) s->kernel->kinematics(s->x, s->work + PDW_WORK_TRIG, s->p, d->anchors, kin);
+    if (changed) pdw_sim_kinematics(s, s->x, d->anchors, s->work);
+    if (s->ground)
+        for (int i = 0; i < 2; ++i) d->zone[i] = zone_of(s->ground, d->flags[i], kin + i*PDW_NKIN);
     if (stop != PDW_STOP_NONE) {
         s->stop_reason = stop;
         s->status = stop == PDW_STOP_PERIODIC ? PDW_STATUS_PERIODIC : PDW_STATUS_DONE;
@@ -185,7 +196,7 @@ int pdw_update_flags_trig(pdw_sim *s, double t)
 void pdw_record_final(pdw_sim *s, double t)
 {
     if (s->record_every <= 0 || s->n % s->record_every != 0) return;
-    s->kernel->contact(s->work + PDW_WORK_KIN, s->disc.flags, s->p, s->work + PDW_WORK_CONTACT);
+    pdw_sim_contact(s, s->work);
     pdw_record_now(s, t);
 }
 
@@ -216,6 +227,13 @@ int pdw_check_state(pdw_sim *s, const double *xnew, double t)
         fail(s, PDW_STATUS_FELL, PDW_REASON_HIP_LOW, -1, t);
         return 1;
     }
+    /* shaped ground: the hip within a leg length of the defined extent's ends (a foot could
+     * otherwise reach past them) */
+    if (s->ground && (xnew[PDW_X_X_O] - s->p[PDW_P_L] < s->ground->s_min
+                      || xnew[PDW_X_X_O] + s->p[PDW_P_L] > s->ground->s_max)) {
+        fail(s, PDW_STATUS_FELL, PDW_REASON_OFF_GROUND, -1, t);
+        return 1;
+    }
     return 0;
 }
 
@@ -225,7 +243,7 @@ int pdw_switch_pending(const pdw_sim *s, const double *x, double *work)
     const pdw_discrete *d = &s->disc;
     const double *kin = work + PDW_WORK_KIN;
     int mask = 0;
-    kinematics(s->kernel, s->p, x, d->anchors, work);
+    kinematics(s->kernel, s->ground, s->p, x, d->anchors, work);
     for (int i = 0; i < 2; ++i) {
         const double *ki = kin + i*PDW_NKIN, *kj = kin + (1 - i)*PDW_NKIN;
         const double y = ki[PDW_KIN_Y_D], vy = ki[PDW_KIN_V_Y];
@@ -238,6 +256,9 @@ int pdw_switch_pending(const pdw_sim *s, const double *x, double *work)
         else if (y > 0.0) armed = 1;
         if (armed != d->armed[i] || (armed && y < 0.0 && vy < 0.0)) mask |= 1 << i;
     }
+    if (s->ground && s->ground->n_zones > 0)         /* a support foot entered another blend zone */
+        for (int i = 0; i < 2; ++i)
+            if (zone_of(s->ground, d->flags[i], kin + i*PDW_NKIN) != d->zone[i]) mask |= 1 << i;
     return mask;
 }
 

@@ -12,8 +12,8 @@
  * Off the defined extent [s_min, s_max] the end cells' polynomials continue (used only inside
  * trial steps): the loops check every accepted state (pdw_ground_inside) and stop with
  * PDW_REASON_OFF_GROUND, never extrapolating silently. */
-#ifndef PDW_GROUND_H
-#define PDW_GROUND_H
+#ifndef PDW_GROUND_EVAL_H
+#define PDW_GROUND_EVAL_H
 
 #include <math.h>
 #include "pdw_model.h"
@@ -109,4 +109,4 @@ static inline int pdw_ground_zone(const pdw_ground *g, double s)
     return z;
 }
 
-#endif /* PDW_GROUND_H */
+#endif /* PDW_GROUND_EVAL_H */

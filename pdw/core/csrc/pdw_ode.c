@@ -53,10 +53,9 @@ double pdw_err_norm(const pdw_sim *s, const double *x, const double *xnew, const
 /* Contact forces of s->x into s->work (for the recorded sample), then store the sample. */
 static void sample(pdw_sim *s)
 {
-    const pdw_kernel *k = s->kernel;
     pdw_trig(s->x, s->work + PDW_WORK_TRIG);
-    k->kinematics(s->x, s->work + PDW_WORK_TRIG, s->p, s->disc.anchors, s->work + PDW_WORK_KIN);
-    k->contact(s->work + PDW_WORK_KIN, s->disc.flags, s->p, s->work + PDW_WORK_CONTACT);
+    pdw_sim_kinematics(s, s->x, s->disc.anchors, s->work);
+    pdw_sim_contact(s, s->work);
     pdw_record_now(s, s->t);
 }
 

@@ -20,7 +20,7 @@
 /* f(x) for the loop's current flags and anchors; counts one evaluation in s->n_rhs. */
 static inline void pdw_ode_f(pdw_sim *s, const double *x, double *f)
 {
-    s->kernel->rhs(x, s->p, s->disc.flags, s->disc.anchors, f, s->work);
+    pdw_sim_rhs(s, x, f, s->work);
     s->n_rhs++;
 }
 

@@ -80,7 +80,7 @@ static double rodas4_step(pdw_sim *s, void *vctx, const double *fx, double h, in
     const int nx = s->nx;
     (void)fnew; (void)fnew_valid;
     if (new_point) {
-        s->kernel->jacobian(s->x, s->p, s->disc.flags, s->disc.anchors, c->J, s->work);
+        pdw_sim_jacobian(s, s->x, c->J, s->work);
         s->n_jac++;
         c->lu_h = 0.0;
     }

@@ -9,6 +9,7 @@
 
 #include <string.h>
 #include "pdw_model.h"
+#include "pdw_terrain.h"
 
 /* Discrete state carried by every loop (docs/model.md sections 5 and 6). */
 typedef struct pdw_discrete {
@@ -17,6 +18,9 @@ typedef struct pdw_discrete {
     double anchors[PDW_NANCHOR];  /* per foot, captured at touch-down (layout ANCHORS): the rolling
                                    * coordinate s_i (consistent variant's xi), then the approach
                                    * speed -v_y (Lankarani-Nikravesh and Flores damping) */
+    int zone[2];        /* shaped ground with patches: the blend zone of each support foot's
+                         * contact point (pdw_ground_zone; -1 swing); a change is an event that
+                         * adaptive methods locate (docs/terrain.md) */
 } pdw_discrete;
 
 /* Why and where a loop failed. */
@@ -34,7 +38,9 @@ enum {
     PDW_REASON_HIP_LOW = 3,       /* hip below fall_hip_height */
     PDW_REASON_FOOT_DEEP = 4,     /* a foot deeper than fall_depth below the ground */
     PDW_REASON_SINGULAR = 5,      /* singular step matrix */
-    PDW_REASON_STEP_SIZE = 6      /* adaptive step size underflow (error test never passed) */
+    PDW_REASON_STEP_SIZE = 6,     /* adaptive step size underflow (error test never passed) */
+    PDW_REASON_OFF_GROUND = 8     /* the walker left the ground's defined extent (shaped ground;
+                                   * 7 is PDW_REASON_BUDGET below) */
 };
 
 /* Online gait analysis (docs/model.md section 8): the per-step descriptors of pdw/sim/gait.py, computed
@@ -127,7 +133,43 @@ typedef struct pdw_sim {
     long since_poll;            /* iterations since the last poll */
     long max_steps;             /* adaptive methods: fail (PDW_REASON_BUDGET) once accepted +
                                  * rejected steps reach this; 0: no budget */
+    /* --- the ground (docs/terrain.md) --- */
+    const pdw_ground *ground;   /* NULL: flat (today's kernel, bitwise); else the shaped-ground
+                                 * kernel of pdw_terrain.c on this caller-owned table */
 } pdw_sim;
+
+/* The stages of s's model: today's kernel on flat ground, the shaped-ground kernel on a ground.
+ * Every loop calls these; with s->ground == NULL each is the kernel's own call. */
+static inline void pdw_sim_kinematics(const pdw_sim *s, const double *x, const double *anchors,
+                                      double *work)
+{
+    if (s->ground)
+        pdw_terrain_kinematics(s->kernel, s->ground, x, work + PDW_WORK_TRIG, s->p, anchors,
+                               work + PDW_WORK_KIN, work + PDW_WORK_GROUND);
+    else s->kernel->kinematics(x, work + PDW_WORK_TRIG, s->p, anchors, work + PDW_WORK_KIN);
+}
+
+static inline void pdw_sim_contact(const pdw_sim *s, double *work)
+{
+    if (s->ground)
+        pdw_terrain_contact(s->kernel, s->ground, work + PDW_WORK_KIN, s->disc.flags, s->p,
+                            work + PDW_WORK_CONTACT, 0);
+    else s->kernel->contact(work + PDW_WORK_KIN, s->disc.flags, s->p, work + PDW_WORK_CONTACT);
+}
+
+static inline void pdw_sim_rhs(const pdw_sim *s, const double *x, double *xdot, double *work)
+{
+    if (s->ground)
+        pdw_terrain_rhs(s->kernel, s->ground, x, s->p, s->disc.flags, s->disc.anchors, xdot, work);
+    else s->kernel->rhs(x, s->p, s->disc.flags, s->disc.anchors, xdot, work);
+}
+
+static inline void pdw_sim_jacobian(const pdw_sim *s, const double *x, double *J, double *work)
+{
+    if (s->ground)
+        pdw_terrain_jacobian(s->kernel, s->ground, x, s->p, s->disc.flags, s->disc.anchors, J, work);
+    else s->kernel->jacobian(x, s->p, s->disc.flags, s->disc.anchors, J, work);
+}
 
 /* Copy a state of s's size (s->nx); the common size PDW_NX as a compile-time constant, so that
  * the copy stays inline in the time loops. */
@@ -153,8 +195,9 @@ static inline int pdw_records_room(const pdw_sim *s)
     return s->record_every <= 0 || s->n_rec + 2 <= s->rec_capacity;
 }
 
-/* Initialise the discrete state for x0 and initial flags: anchors of support legs at x0. */
-void pdw_discrete_init(const pdw_kernel *k, const double *p, const double *x,
+/* Initialise the discrete state for x0 and initial flags: anchors of support legs at x0
+ * (kinematics on ground g; NULL: flat). */
+void pdw_discrete_init(const pdw_kernel *k, const pdw_ground *g, const double *p, const double *x,
                        const int flags0[2], pdw_discrete *d, double *work);
 
 /* Update flags and arming once from s->x (docs/model.md section 5); each flag change is an event:

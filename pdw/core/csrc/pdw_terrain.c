@@ -1,0 +1,114 @@
+/* The shaped-ground kernel (pdw_terrain.h; docs/terrain.md). */
+#include <math.h>
+#include <string.h>
+#include "pdw_terrain.h"
+#include "pdw_linalg.h"
+
+void pdw_terrain_kinematics(const pdw_kernel *k, const pdw_ground *g, const double *x,
+                            const double *trig, const double *p, const double *anchors,
+                            double *kin, double *gnd)
+{
+    double sA[2], e[3];
+    pdw_ground_points(x, trig, p, sA);
+    for (int i = 0; i < 2; ++i) {
+        double *gi = gnd + i*PDW_NGROUND;
+        pdw_ground_eval(g, sA[i], e);
+        gi[PDW_GROUND_H] = e[0];
+        gi[PDW_GROUND_DH] = e[1];
+        gi[PDW_GROUND_DDH] = e[2];
+        if (k->variant == 1) {          /* consistent: the rolling coordinate needs sigma, alpha */
+            gi[PDW_GROUND_SIGMA] = pdw_ground_arc(g, sA[i]);
+            gi[PDW_GROUND_ALPHA] = atan(e[1]);
+        } else {
+            gi[PDW_GROUND_SIGMA] = 0.0;
+            gi[PDW_GROUND_ALPHA] = 0.0;
+        }
+    }
+    if (k->variant == 1) pdw_consistent_ground_kinematics(x, trig, p, anchors, gnd, kin);
+    else pdw_paper_ground_kinematics(x, trig, p, anchors, gnd, kin);
+    for (int i = 0; i < 2; ++i)
+        kin[i*PDW_NKIN + PDW_KIN_Z] = k->nx > PDW_NX ? x[PDW_X_Z1 + i] : 0.0;
+}
+
+void pdw_terrain_contact(const pdw_kernel *k, const pdw_ground *g, const double *kin,
+                         const int *flags, const double *p, double *contact, int partials)
+{
+    void (*stage)(const double *, const int *, const double *, double *) =
+        partials ? k->contact_partials : k->contact;
+    if (g->n_patches == 0) { stage(kin, flags, p, contact); return; }
+    double pi[PDW_NP], ci[2*PDW_NCONTACT];
+    for (int i = 0; i < 2; ++i) {
+        const int fl[2] = {i == 0 ? flags[0] : 0, i == 1 ? flags[1] : 0};
+        memcpy(pi, p, sizeof pi);
+        pdw_ground_params(g, kin[i*PDW_NKIN + PDW_KIN_X_D], p, pi);
+        stage(kin, fl, pi, ci);
+        memcpy(contact + i*PDW_NCONTACT, ci + i*PDW_NCONTACT, PDW_NCONTACT * sizeof(double));
+    }
+}
+
+void pdw_terrain_forces(const double *contact, const double *gnd, const double *p, double *cw,
+                        double *moment)
+{
+    double gf[2*PDW_NGFORCE];
+    pdw_ground_forces(contact, gnd, p, gf);
+    memcpy(cw, contact, 2*PDW_NCONTACT * sizeof(double));
+    for (int i = 0; i < 2; ++i) {
+        cw[i*PDW_NCONTACT + PDW_CONTACT_F_N] = gf[i*PDW_NGFORCE + PDW_GFORCE_F_Y];
+        cw[i*PDW_NCONTACT + PDW_CONTACT_F_T] = gf[i*PDW_NGFORCE + PDW_GFORCE_F_X];
+        moment[i] = gf[i*PDW_NGFORCE + PDW_GFORCE_M_THETA];
+    }
+}
+
+void pdw_terrain_rhs(const pdw_kernel *k, const pdw_ground *g, const double *x, const double *p,
+                     const int *flags, const double *anchors, double *xdot, double *work)
+{
+    double *trig = work + PDW_WORK_TRIG, *kin = work + PDW_WORK_KIN;
+    double *contact = work + PDW_WORK_CONTACT, *M = work + PDW_WORK_M;
+    double *f = work + PDW_WORK_F, *qdd = work + PDW_WORK_QDD, *gnd = work + PDW_WORK_GROUND;
+    double cw[2*PDW_NCONTACT], moment[2];
+    pdw_trig(x, trig);
+    pdw_terrain_kinematics(k, g, x, trig, p, anchors, kin, gnd);
+    pdw_terrain_contact(k, g, kin, flags, p, contact, 0);
+    pdw_terrain_forces(contact, gnd, p, cw, moment);
+    k->dynamics(x, trig, p, cw, M, f);
+    f[PDW_X_THETA1] += moment[0];
+    f[PDW_X_THETA2] += moment[1];
+    pdw_solve_dblock(M, f, qdd);
+    for (int i = 0; i < PDW_NQ; ++i) { xdot[i] = x[PDW_NQ + i]; xdot[PDW_NQ + i] = qdd[i]; }
+    if (k->nx > PDW_NX)
+        for (int i = 0; i < 2; ++i) xdot[PDW_X_Z1 + i] = contact[i*PDW_NCONTACT + PDW_CONTACT_ZDOT];
+}
+
+/* Central differences, step sqrt(eps) max(1, |x_j|) (the reasons are LuGre's, in
+ * derive/emit.py); leaves work at x. */
+void pdw_terrain_jacobian(const pdw_kernel *k, const pdw_ground *g, const double *x,
+                          const double *p, const int *flags, const double *anchors, double *J,
+                          double *work)
+{
+    const int nx = k->nx;
+    double xp[PDW_NX_MAX], fp[PDW_NX_MAX], fm[PDW_NX_MAX];
+    for (int j = 0; j < nx; ++j) xp[j] = x[j];
+    for (int j = 0; j < nx; ++j) {
+        const double h = 1.4901161193847656e-08 * fmax(1.0, fabs(x[j]));
+        xp[j] = x[j] + h;
+        const double hp = xp[j] - x[j];
+        pdw_terrain_rhs(k, g, xp, p, flags, anchors, fp, work);
+        xp[j] = x[j] - h;
+        const double hm = x[j] - xp[j];
+        pdw_terrain_rhs(k, g, xp, p, flags, anchors, fm, work);
+        xp[j] = x[j];
+        for (int i = 0; i < nx; ++i) J[i*nx + j] = (fp[i] - fm[i]) / (hp + hm);
+    }
+    pdw_terrain_rhs(k, g, x, p, flags, anchors, fp, work);
+}
+
+void pdw_terrain_cdm_terms(const pdw_kernel *k, const double *x, const double *trig,
+                           const double *p, const double *contact, const double *gnd, double *M,
+                           double *C, double *QmG)
+{
+    double cw[2*PDW_NCONTACT], moment[2];
+    pdw_terrain_forces(contact, gnd, p, cw, moment);
+    k->cdm_terms(x, trig, p, cw, M, C, QmG);
+    QmG[PDW_X_THETA1] += moment[0];
+    QmG[PDW_X_THETA2] += moment[1];
+}

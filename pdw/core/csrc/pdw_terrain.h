@@ -1,0 +1,42 @@
+/* The shaped-ground kernel (docs/terrain.md, docs/model.md section 11): any pdw_kernel's contact
+ * laws and mechanics on a pdw_ground, composed from the derived shaped-ground stages of
+ * generated/pdw_model.c (derive/terrain.py). Every array is caller-allocated; nothing here
+ * allocates. The time loops reach these through pdw_sim.h's pdw_sim_* dispatch, which keeps
+ * today's kernel (bitwise, at no cost) when a run's ground is flat (pdw_sim.ground == NULL). */
+#ifndef PDW_TERRAIN_H
+#define PDW_TERRAIN_H
+
+#include "pdw_model.h"
+#include "pdw_ground.h"
+
+/* kin (2 PDW_NKIN, in the local surface frame: y_D the gap along the normal, v_x the slip, v_y the
+ * normal rate) and gnd (2 PDW_NGROUND: the ground sampled under each foot) of x; trig given. */
+void pdw_terrain_kinematics(const pdw_kernel *k, const pdw_ground *g, const double *x,
+                            const double *trig, const double *p, const double *anchors,
+                            double *kin, double *gnd);
+
+/* The kernel's contact stage (forces, or with partials = 1 forces and partials) with each foot's
+ * parameters at its contact point (the patches of g, blended; none: one call, as the kernel). */
+void pdw_terrain_contact(const pdw_kernel *k, const pdw_ground *g, const double *kin,
+                         const int *flags, const double *p, double *contact, int partials);
+
+/* The surface-frame forces of contact as the slope-frame forces the flat dynamics stage takes
+ * (cw: a copy of contact with F_n := F_y, F_t := F_x) and the moments moment[i] to add to the
+ * theta_i rows of f (or Q_f - G). */
+void pdw_terrain_forces(const double *contact, const double *gnd, const double *p, double *cw,
+                        double *moment);
+
+/* f(x) and df/dx (central differences, as LuGre's kernels) on the ground; work: PDW_NWORK. */
+void pdw_terrain_rhs(const pdw_kernel *k, const pdw_ground *g, const double *x, const double *p,
+                     const int *flags, const double *anchors, double *xdot, double *work);
+void pdw_terrain_jacobian(const pdw_kernel *k, const pdw_ground *g, const double *x,
+                          const double *p, const int *flags, const double *anchors, double *J,
+                          double *work);
+
+/* The central difference method's M, C, Q_f - G on the ground from contact (surface frame) and
+ * gnd of x (trig given). */
+void pdw_terrain_cdm_terms(const pdw_kernel *k, const double *x, const double *trig,
+                           const double *p, const double *contact, const double *gnd, double *M,
+                           double *C, double *QmG);
+
+#endif /* PDW_TERRAIN_H */
