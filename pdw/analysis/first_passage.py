@@ -29,6 +29,9 @@ from ..core.errors import InvalidInputError
 from . import robustness as _rb
 
 _COLUMNS = ("walker", "steps", "failed", "status")
+#: statuses a file of finished walkers may hold (the hybrid step's, pdw.simulate's)
+_STATUSES = frozenset(_hybrid.STATUS) | {"walked", "periodic", "fell", "diverged", "off_ground",
+                                         "no_steps", "interrupted"}
 
 
 @dataclass
@@ -173,8 +176,8 @@ def first_passage(params=None, *, sigma=None, ground=None, walkers=400, max_step
         Byl & Tedrake's stochastic terrain). Walker i draws them from ``[seed, i]``
         (`dh_sequence`).
     ground : pdw.Ground, optional
-        Continuous model: a ``Ground.random(sigma=..., ...)``; walker i walks its own ground of
-        seed ``seed + i`` (needs terrain's per-walker grounds, docs/robustness.md).
+        Continuous model: a ``Ground.random(sigma=..., ...)``; walker i walks its own ground,
+        the same but of seed ``seed + i`` (`pdw.analysis.robustness_continuous.chunk`).
     walkers, max_steps : int
         Walkers, and the steps after which a walker still walking is censored.
     model : {"hybrid", "continuous"}
@@ -208,29 +211,41 @@ def first_passage(params=None, *, sigma=None, ground=None, walkers=400, max_step
     seed = checks.count("seed", seed, lo=0, hi=2 ** 63 - 1)
     threads = checks.count("threads", threads, lo=1, hi=1024)
     if model == "continuous":
+        from ..core.ground import Ground
         from . import robustness_continuous as _rc
-        return _rc.first_passage(params, ground=ground, walkers=walkers, max_steps=max_steps,
-                                 seed=seed, chunk_size=chunk_size, executor=executor,
-                                 threads=threads, path=path, confidence=confidence, gait=gait,
-                                 progress=progress, **options)
-    if ground is not None:
-        raise InvalidInputError("first_passage(model='hybrid') takes sigma (random step "
-                                "heights), not ground")
-    if sigma is None:
-        raise InvalidInputError("first_passage(model='hybrid') needs sigma [m] >= 0")
-    sigma = checks.number("sigma", sigma, lo=0.0)
-    gait = _rb._hybrid_gait(params, gait, options)
+
+        if sigma is not None:
+            raise InvalidInputError("first_passage(model='continuous') takes ground = "
+                                    "pdw.Ground.random(sigma=...), not sigma")
+        if not isinstance(ground, Ground) or ground.kind != "random":
+            raise InvalidInputError("first_passage(model='continuous') needs ground = "
+                                    "pdw.Ground.random(sigma=..., ...), got %r" % (ground,))
+        gait = _rc.continuous_gait(params, gait)
+        chunk = _rc.chunk
+        kw = dict(params=params, gait=gait, ground=ground, seed=seed, max_steps=max_steps,
+                  options=dict(options))
+        dist = dict(ground=ground.to_dict())
+    else:
+        if ground is not None:
+            raise InvalidInputError("first_passage(model='hybrid') takes sigma (random step "
+                                    "heights), not ground")
+        if sigma is None:
+            raise InvalidInputError("first_passage(model='hybrid') needs sigma [m] >= 0")
+        sigma = checks.number("sigma", sigma, lo=0.0)
+        gait = _rb._hybrid_gait(params, gait, options)
+        chunk = _hybrid_chunk
+        kw = dict(params=params, y0=np.array(gait.state), sigma=sigma, seed=seed,
+                  max_steps=max_steps, options=dict(options))
+        dist = dict(sigma=sigma)
     size = (max(1, -(-walkers // (4 * threads))) if chunk_size is None
             else checks.count("chunk_size", chunk_size, lo=1, hi=10 ** 9))
-    meta = dict(model=model, sigma=sigma, seed=seed, max_steps=max_steps,
+    meta = dict(model=model, **dist, seed=seed, max_steps=max_steps,
                 params=params.as_dict(), options={k: float(v) for k, v in options.items()},
-                gait=[float(v) for v in gait.state])
+                gait=[float(v) for v in np.ravel(gait.state)])
     done = _read(path, meta) if path is not None else {}
     meta["walkers"] = walkers
     todo = [(lo, min(walkers, lo + size)) for lo in range(0, walkers, size)
             if not all(i in done for i in range(lo, min(walkers, lo + size)))]
-    kw = dict(params=params, y0=np.array(gait.state), sigma=sigma, seed=seed,
-              max_steps=max_steps, options=dict(options))
 
     def finish(lohi, out):
         steps, failed, status = out
@@ -244,12 +259,12 @@ def first_passage(params=None, *, sigma=None, ground=None, walkers=400, max_step
 
     if executor is None:
         def task(lohi):
-            out = _hybrid_chunk(lo=lohi[0], hi=lohi[1], **kw)
+            out = chunk(lo=lohi[0], hi=lohi[1], **kw)
             return lohi, out
         for lohi, out in interrupt.thread_map(task, todo, threads):
             finish(lohi, out)
     else:
-        futs = [(lohi, executor.submit(_hybrid_chunk, lo=lohi[0], hi=lohi[1], **kw))
+        futs = [(lohi, executor.submit(chunk, lo=lohi[0], hi=lohi[1], **kw))
                 for lohi in todo]
         for lohi, f in futs:
             finish(lohi, f.result())
@@ -283,7 +298,7 @@ def _read(path, meta) -> dict:
     out = {}
     for n, line in enumerate(lines[2:], start=3):
         parts = line.split(",")
-        if len(parts) != len(_COLUMNS) or parts[3] not in _hybrid.STATUS:
+        if len(parts) != len(_COLUMNS) or parts[3] not in _STATUSES:
             continue            # a line cut by a kill: that walker runs again
         try:
             out[int(parts[0])] = (int(parts[1]), parts[2] == "1", parts[3])

@@ -1,21 +1,188 @@
-"""The robustness measures for the continuous (compliant) model: a step or rough ground as a
-`pdw.Ground` under `pdw.simulate_batch` (docs/robustness.md). Needs the Ground of issue 22
-items 1, 2 and 7 (the terrain work); until it is in this tree every entry point says so."""
+"""The robustness measures for the continuous (compliant) model (docs/robustness.md, "The
+compliant model"): the step or the rough ground is a `pdw.Ground` under `pdw.simulate`.
+
+* The gait: `pdw.find_gait` (the touch-down section; leg 2 has just touched down at s = 0,
+  flags (1, 1)). A walk starts there with ``flags0=(1, 1)``; its steps are `pdw.steps` of the
+  run (``L`` footprint spacing, ``cycle`` touch-down to touch-down).
+* A step of height H: ``Ground.step(edge, -H or +H)`` with the edge halfway between the stance
+  foot (s = 0) and the gait's next footprint (s = L), smoothed over ``edge_width``.
+* The trials of a `max_step` round run on threads (the compiled loop releases the GIL), one
+  `pdw.simulate` each. (One `simulate_batch` with a ground per walker replaces them once the
+  ensemble engine takes per-walker grounds, issue 22 item 7.)
+* The gait sensitivity norm: central differences of the touch-down map in the section
+  coordinates and in the floor height, at two steps (h and h/2); a warning when the two norms
+  differ by more than ``rel_check``. (An exact monodromy of the compliant model is not in this
+  tree; these are finite differences, and the docs say so.)
+"""
 from __future__ import annotations
 
+import warnings
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..core import interrupt
 from ..core.errors import InvalidInputError
+from ..core.ground import Ground
+from ..sim.gait import steps as _steps
+from ..sim.simulation import simulate
+from . import limit_cycle as _lc
+from . import robustness as _rb
 
-_NEEDS = ("model='continuous' needs pdw.Ground and per-walker grounds in simulate_batch "
-          "(issue 22 items 1, 2, 7), which this build does not have yet; use model='hybrid'")
-
-
-def step_trials_fn(params, **kw):
-    raise InvalidInputError("max_step: " + _NEEDS)
-
-
-def gait_sensitivity(params, names, **kw):
-    raise InvalidInputError("gait_sensitivity: " + _NEEDS)
+#: integrator tolerances of the walks (rodas4)
+WALK = dict(method="rodas4", rtol=1e-8, atol=1e-10)
 
 
-def first_passage(params, **kw):
-    raise InvalidInputError("first_passage: " + _NEEDS)
+def continuous_gait(params, gait=None):
+    """The continuous model's period-one gait (`pdw.find_gait`), checked."""
+    if gait is None:
+        return _lc.find_gait(params)
+    if getattr(gait, "model", None) != "continuous":
+        raise InvalidInputError("gait must be a continuous pdw.Gait (pdw.find_gait), got %r"
+                                % (gait,))
+    return gait
+
+
+def walk(params, gait, ground, n_steps, **options):
+    """Walk ``n_steps`` steps from the gait's touch-down state on ``ground``: (status, L (k,),
+    T (k,)), the step lengths [m] and touch-down-to-touch-down times [s] of the complete steps
+    (the first is the step from the gait's state)."""
+    t_end = (n_steps + 1.5) * gait.period
+    kw = {**WALK, **options}
+    res = simulate(np.asarray(gait.state, dtype=float), t_end=t_end, params=params,
+                   flags0=(1, 1), on_failure="return", ground=ground, **kw)
+    st = _steps(res)
+    L = np.asarray(st["L"], dtype=float)
+    T = np.asarray(st["cycle"], dtype=float)
+    return res.status, L, T
+
+
+def edge_at(gait):
+    """The step edge's position [m]: halfway from the stance foot (s = 0) to the next
+    footprint."""
+    return 0.5 * gait.step_length
+
+
+@dataclass
+class _Trials:
+    gait: Any
+    fn: Any
+
+    def __call__(self, heights):
+        return self.fn(heights)
+
+
+def step_trials_fn(params, *, direction, budget, return_tol, gait=None, executor=None,
+                   ground=None, threads=2, edge_width=0.01, **options):
+    """The trial function of `max_step` for the continuous model: heights -> trial dicts."""
+    if ground is not None:
+        raise InvalidInputError("max_step(model='continuous') builds its own step ground; "
+                                "ground must be None")
+    gait = continuous_gait(params, gait)
+    sign = -1.0 if direction == "down" else 1.0
+    edge = edge_at(gait)
+
+    def one(h):
+        g = Ground.step(edge, sign * h, width=edge_width)
+        status, L, T = walk(params, gait, g, budget + 1, **options)
+        # the first complete step is the one onto the new level; the walk must reach budget
+        surv = status in ("walked", "periodic") and len(L) >= budget - 1
+        ret, k = False, -1
+        if surv:
+            ret, k = _rb.returned(L, T, gait.step_length, gait.period, return_tol)
+        return dict(height=float(h), survived=bool(surv), returned=bool(ret),
+                    steps_to_return=int(k), status=str(status))
+
+    def run(heights):
+        hs = [float(h) for h in heights]
+        if executor is not None:
+            return [f.result() for f in [executor.submit(one, h) for h in hs]]
+        return interrupt.thread_map(one, hs, max(1, min(threads, len(hs))))
+
+    return _Trials(gait=gait, fn=run)
+
+
+def _section_step(z, params, ground, **options):
+    """One touch-down map step from section point z on ``ground`` (`pdw.analysis.poincare.step`,
+    its tight tolerances): (z', touch-down-to-touch-down time [s], step length [m])."""
+    from .poincare import step
+
+    out = step(z, params, ground=ground, **options)
+    if out["status"] != "ok":
+        raise InvalidInputError("gait_sensitivity (continuous): a finite-difference step "
+                                "failed (%s)" % out["status"])
+    return out["z"], out["period"], out["step_length"]
+
+
+def gait_sensitivity(params, names, *, gait=None, fd_step=1e-6, rel_check=1e-3, **options):
+    """The gait sensitivity norm of the continuous model by central differences (step time and
+    step length indicators), cross-checked at two steps."""
+    for n in names:
+        if n not in ("step_time", "step_length", "speed"):
+            raise InvalidInputError("gait_sensitivity(model='continuous') takes the indicators "
+                                    "step_time, step_length, speed; got %r" % n)
+    gait = continuous_gait(params, gait)
+    z0 = np.asarray(gait.details["z"], dtype=float)
+    edge = edge_at(gait)
+
+    def system(h):
+        def F(z, e):
+            g = None if e == 0.0 else Ground.step(edge, e, width=0.01)
+            zn, T, L = _section_step(z, params, g, **options)
+            v = {"step_time": T, "step_length": L, "speed": L / T}
+            return np.concatenate([zn, [v[n] for n in names]])
+        nz = len(z0)
+        cols = []
+        for j in range(nz + 1):
+            dz = np.zeros(nz)
+            if j < nz:
+                dz[j] = h
+                a, b = F(z0 + dz, 0.0), F(z0 - dz, 0.0)
+            else:
+                a, b = F(z0, h), F(z0, -h)
+            cols.append((a - b) / (2 * h))
+        J = np.array(cols).T
+        return J[:nz, :nz], J[:nz, nz:], J[nz:, :nz], J[nz:, nz:]
+
+    A, B, C, D = system(fd_step)
+    norm = _rb.h2_norm(A, B, C, D)
+    A2, B2, C2, D2 = system(0.5 * fd_step)
+    norm2 = _rb.h2_norm(A2, B2, C2, D2)
+    rel = abs(norm - norm2) / max(abs(norm), 1e-300)
+    if rel > rel_check:
+        warnings.warn("gait_sensitivity (continuous): the finite-difference norms at steps %g "
+                      "and %g differ by %.2g (relative): the linearization is not resolved"
+                      % (fd_step, 0.5 * fd_step, rel), stacklevel=3)
+    per = {n: _rb.h2_norm(A, B, C[i:i + 1], D[i:i + 1]) for i, n in enumerate(names)}
+    return _rb.GaitSensitivity(norm=norm, per_indicator=per, indicators=tuple(names), A=A, B=B,
+                               C=C, D=D, method="fd",
+                               check={"fd_norm_half_step": norm2, "rel_diff": rel,
+                                      "fd_step": fd_step}, gait=gait)
+
+
+def walker_ground(ground, seed, i, max_steps, step_length):
+    """Walker i's own random ground: ``ground`` with seed ``seed + i``, defined from -2 m to
+    1.25 (max_steps + 4) step lengths (a walker still walking when it leaves the extent is
+    censored there, never extrapolated)."""
+    spec = dict(ground.spec)
+    ext = (-2.0, 1.25 * (max_steps + 4) * step_length)
+    return Ground.random(spec["sigma"], spec["correlation"], seed=int(seed) + int(i),
+                         modes=spec["modes"], offset=ground.offset, extent=ext)
+
+
+def chunk(params, gait, ground, seed, lo, hi, max_steps, options):
+    """Walkers lo..hi-1 of the continuous model on their own random grounds: (steps, failed,
+    status), as `pdw.analysis.first_passage._hybrid_chunk` (module level: executors take it).
+    A walker's first-passage time counts its complete steps plus the failing one; one that
+    walks ``max_steps`` steps, or leaves its ground's extent, is censored at its steps."""
+    steps, failed, status = [], [], []
+    for i in range(lo, hi):
+        g = walker_ground(ground, seed, i, max_steps, gait.step_length)
+        st, L, _ = walk(params, gait, g, max_steps, **options)
+        n = len(L)
+        fell = st not in ("walked", "periodic", "off_ground")
+        steps.append(min(n + 1, max_steps) if fell else min(n, max_steps))
+        failed.append(fell)
+        status.append(st if fell else "ok")
+    return np.array(steps, dtype=np.int64), np.array(failed), np.array(status)
