@@ -285,3 +285,54 @@ def test_cli_robustness_writes_csv_json_figure_and_exits_2_on_a_bad_spec(tmp_pat
     spec.write_text('name = "gsn"\nmeasure = "gait_sensitivity"\n[options]\nindicator = 1\n')
     assert main(["robustness", str(spec), "--out", str(tmp_path / "o")]) == 2
     assert "options.indicator" in capsys.readouterr().err
+
+
+# --- the compliant model --------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def cgait():
+    return pdw.find_gait(P)
+
+
+def test_max_step_continuous_bracket_is_checked_by_direct_walks(cgait):
+    from pdw.analysis import robustness_continuous as RC
+
+    m = pdw.max_step(P, model="continuous", gait=cgait, budget=30, h_tol=2e-4,
+                     trials_per_round=4)
+    assert 0.002 < m.height < 0.02 and m.bracket[1] - m.bracket[0] <= 2e-4
+    edge = RC.edge_at(cgait)
+    for h, ok in ((m.height, True), (m.bracket[1], False)):
+        st, L, T = RC.walk(P, cgait, pdw.Ground.step(edge, -h, width=0.01), 31)
+        good = st == "walked" and R.returned(L, T, cgait.step_length, cgait.period, 1e-3)[0]
+        assert good == ok
+
+
+def test_gait_sensitivity_continuous_matches_a_direct_step_down_response(cgait):
+    from pdw.analysis import robustness_continuous as RC
+
+    G = pdw.gait_sensitivity(P, model="continuous", gait=cgait,
+                             indicators=("step_time", "step_length"))
+    assert G.method == "fd" and G.check["rel_diff"] < 1e-3
+    e = 1e-4
+    st, L, T = RC.walk(P, cgait, pdw.Ground.step(RC.edge_at(cgait), e, width=0.01), 40,
+                       rtol=1e-11, atol=1e-12)
+    resp = np.concatenate([(T - cgait.period) / e, (L - cgait.step_length) / e])
+    assert G.norm == pytest.approx(math.sqrt((resp ** 2).sum()), rel=0.02)
+
+
+def test_first_passage_continuous_each_walker_its_own_ground_and_resume(cgait, tmp_path):
+    from pdw.analysis import robustness_continuous as RC
+
+    g = pdw.Ground.random(0.0025, 0.1)
+    kw = dict(model="continuous", ground=g, walkers=6, max_steps=25, gait=cgait, seed=5)
+    a = pdw.first_passage(P, chunk_size=6, threads=1, **kw)
+    b = pdw.first_passage(P, chunk_size=2, path=tmp_path / "c.csv", **kw)
+    assert np.array_equal(a.steps, b.steps) and a.failures > 0
+    # walker 3 by hand: its own ground, seed 5 + 3
+    st, L, _ = RC.walk(P, cgait, RC.walker_ground(g, 5, 3, 25, cgait.step_length), 25)
+    expect = min(len(L) + 1, 25) if st not in ("walked", "off_ground") else min(len(L), 25)
+    assert a.steps[3] == expect
+    c = pdw.first_passage(P, path=tmp_path / "c.csv", **kw)
+    assert c.meta["resumed"] == 6 and np.array_equal(c.steps, a.steps)
+    with pytest.raises(pdw.InvalidInputError, match="Ground.random"):
+        pdw.first_passage(P, model="continuous", ground=pdw.Ground.flat(), gait=cgait)

@@ -10,8 +10,10 @@ compliant model"): the step or the rough ground is a `pdw.Ground` under `pdw.sim
   `pdw.simulate` each. (One `simulate_batch` with a ground per walker replaces them once the
   ensemble engine takes per-walker grounds, issue 22 item 7.)
 * The gait sensitivity norm: central differences of the touch-down map in the section
-  coordinates and in the floor height, at two steps (h and h/2); a warning when the two norms
-  differ by more than ``rel_check``. (An exact monodromy of the compliant model is not in this
+  coordinates and in the floor heights, at two steps (h and h/2); a warning when the two norms
+  differ by more than ``rel_check``. The state is augmented by the previous step's floor
+  height: during the double support the trailing foot still stands on it, so on compliant
+  ground a disturbance acts on two steps (tested against the summed response of a walk). (An exact monodromy of the compliant model is not in this
   tree; these are finite differences, and the docs say so.)
 """
 from __future__ import annotations
@@ -55,6 +57,13 @@ def walk(params, gait, ground, n_steps, **options):
     st = _steps(res)
     L = np.asarray(st["L"], dtype=float)
     T = np.asarray(st["cycle"], dtype=float)
+    # pdw.steps skips the run's first step (its stance foot's touch-down, at t = 0, is not an
+    # event of the run): it is the first touch-down, its footprint measured from the stance
+    # foot's contact point at s = 0 (the section's frame)
+    td = next((e for e in res.events if e.kind == "touch_down"), None)
+    if td is not None and (len(T) == 0 or td.t < st["t_touch_down"][0] - 0.5 * gait.period):
+        L = np.concatenate([[td.x_D], L])
+        T = np.concatenate([[td.t], T])
     return res.status, L, T
 
 
@@ -126,24 +135,39 @@ def gait_sensitivity(params, names, *, gait=None, fd_step=1e-6, rel_check=1e-3, 
     z0 = np.asarray(gait.details["z"], dtype=float)
     edge = edge_at(gait)
 
+    def F(z, e_prev, e):
+        g = None
+        if e_prev != 0.0 or e != 0.0:       # trailing foot's ground, the stance's, the landing's
+            g = Ground.steps([-edge, edge], [e_prev, e], width=0.01, offset=-e_prev)
+        zn, T, L = _section_step(z, params, g, **options)
+        v = {"step_time": T, "step_length": L, "speed": L / T}
+        return np.concatenate([zn, [v[n] for n in names]])
+
     def system(h):
-        def F(z, e):
-            g = None if e == 0.0 else Ground.step(edge, e, width=0.01)
-            zn, T, L = _section_step(z, params, g, **options)
-            v = {"step_time": T, "step_length": L, "speed": L / T}
-            return np.concatenate([zn, [v[n] for n in names]])
+        """The augmented linear system in x = (z, e_prev): the disturbance of the previous
+        step stays under the trailing foot during the double support, so it enters the next
+        step too (a compliant-ground effect the hybrid model does not have)."""
         nz = len(z0)
         cols = []
-        for j in range(nz + 1):
+        for j in range(nz + 2):
             dz = np.zeros(nz)
             if j < nz:
                 dz[j] = h
-                a, b = F(z0 + dz, 0.0), F(z0 - dz, 0.0)
+                a, b = F(z0 + dz, 0.0, 0.0), F(z0 - dz, 0.0, 0.0)
+            elif j == nz:
+                a, b = F(z0, h, 0.0), F(z0, -h, 0.0)
             else:
-                a, b = F(z0, h), F(z0, -h)
+                a, b = F(z0, 0.0, h), F(z0, 0.0, -h)
             cols.append((a - b) / (2 * h))
-        J = np.array(cols).T
-        return J[:nz, :nz], J[:nz, nz:], J[nz:, :nz], J[nz:, nz:]
+        J = np.array(cols).T                 # rows: z' (nz), indicators; cols: z, e_prev, e
+        A = np.zeros((nz + 1, nz + 1))
+        A[:nz, :nz + 1] = J[:nz, :nz + 1]
+        B = np.zeros((nz + 1, 1))
+        B[:nz, 0] = J[:nz, nz + 1]
+        B[nz, 0] = 1.0                       # e becomes the next step's e_prev
+        C = J[nz:, :nz + 1]
+        D = J[nz:, nz + 1:]
+        return A, B, C, D
 
     A, B, C, D = system(fd_step)
     norm = _rb.h2_norm(A, B, C, D)
