@@ -65,7 +65,7 @@ def main():
     load0 = os.getloadavg()
     lines = ["Robustness of the hybrid walker (Params.paper_steady(), rigid ground)",
              "load average at start %.2f %.2f %.2f" % load0]
-    n = 6 if QUICK else 15
+    n = 6 if QUICK else 11
     ks = np.linspace(0.5, 1.5, n)
     gs = np.linspace(0.012, 0.04, n)
     gk, gg = {}, {}
@@ -74,7 +74,7 @@ def main():
 
     # MFPT against sigma for three k_hip
     sig = np.array([1.4, 1.6, 1.8, 2.0, 2.5]) * 1e-3
-    walkers = 150 if QUICK else 600
+    walkers = 150 if QUICK else 400
     lines += ["", "MFPT [steps] (95 %% CI), i.i.d. step heights N(0, sigma^2), %d walkers, "
               "censored at 3000 steps" % walkers]
     mf = {}
@@ -87,14 +87,13 @@ def main():
             lines.append("k_hip %.2f sigma %.1f mm: %s" % (k, s * 1e3, fp))
 
     # Markov chain against Monte Carlo
-    lines += ["", "Markov chain (Gauss-Hermite step heights, cells of side res) vs Monte Carlo, "
+    lines += ["", "Markov chain (n_dh step-height bins, cells of side res) vs Monte Carlo, "
               "sigma 2 mm, k_hip 0.95"]
     g = pdw.hybrid.find_gait(BASE)
     fp = pdw.first_passage(BASE, sigma=0.002, walkers=600 if QUICK else 4000, max_steps=3000,
                            gait=g, seed=11)
     lines.append("Monte Carlo: %s" % fp)
-    for n_dh, res in ([(9, 0.02)] if QUICK else [(9, 0.02), (9, 0.01), (9, 0.005),
-                                                   (15, 0.01)]):
+    for n_dh, res in ([(21, 0.02)] if QUICK else [(21, 0.02), (41, 0.02), (21, 0.01)]):
         w0 = time.time()
         mc = pdw.markov_chain(BASE, sigma=0.002, n_dh=n_dh, resolution=res, gait=g,
                               max_cells=300000)
