@@ -72,6 +72,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_sweep_batch.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_step_maps.py $(UPDATE_DOCS)
 	$(PY) benchmarks/work_precision.py $(UPDATE_DOCS)
+	$(PY) benchmarks/bench_terrain.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_mfpt.py $(UPDATE_DOCS)
 
 ## study: slow studies (marked slow in tests/), written to out/ (UPDATE_DOCS as for bench)

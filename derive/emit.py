@@ -108,6 +108,13 @@ def emit_terrain():
             "void pdw_%s_ground_kinematics(const double *restrict x, const double *restrict trig,\n"
             "    const double *restrict p, const double *restrict anchors, const double *restrict gnd,\n"
             "    double *restrict kin)" % v, "    (void)anchors;\n" + code))
+    for v in mdl.VARIANTS:
+        code, _ = c_block(terrain.ground_jacobian(v), ["A[%d] += " % i for i in range(32)], names)
+        code = code.replace("] +=  = ", "] += ")
+        out.append(_function(
+            "void pdw_%s_ground_jacobian(const double *restrict x, const double *restrict trig,\n"
+            "    const double *restrict p, const double *restrict contact,\n"
+            "    const double *restrict gnd, double *restrict A)" % v, code))
     exprs = [e for i in range(2) for e in terrain.ground_forces(i)]
     targets = ["gf[%d*PDW_NGFORCE + PDW_GFORCE_%s]" % (i, f.upper()) for i in range(2)
                for f in terrain.GROUND_FORCE]
@@ -389,6 +396,8 @@ def header(h):
         "\n".join("void pdw_%s_ground_kinematics(const double *x, const double *trig, const double *p,\n"
                   "    const double *anchors, const double *gnd, double *kin);" % v for v in mdl.VARIANTS),
         "void pdw_ground_forces(const double *contact, const double *gnd, const double *p, double *gf);",
+        "\n".join("void pdw_%s_ground_jacobian(const double *x, const double *trig, const double *p,\n"
+                  "    const double *contact, const double *gnd, double *A);" % v for v in mdl.VARIANTS),
         "\n#endif /* PDW_MODEL_H */\n",
     ])
 

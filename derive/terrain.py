@@ -88,3 +88,50 @@ def ground_forces(foot: int):
     fx = (ft - dh * fn) / N
     fy = (dh * ft + fn) / N
     return [fx, fy, r * (dh / N * fy - (1 - 1 / N) * fx)]
+
+
+def _ground_slopes(g):
+    """d/ds of each sampled ground value (the chain rule through s_A): h' , h'', sigma' = N,
+    alpha' = h''/(1 + h'^2); h'' itself does not enter the kinematics."""
+    dh, ddh = g["dh"], g["ddh"]
+    return {"h": dh, "dh": ddh, "sigma": sp.sqrt(1 + dh ** 2), "alpha": ddh / (1 + dh ** 2),
+            "ddh": sp.S.Zero}
+
+
+def _total_gradient(e, g, slope, dsA):
+    """d e/dx with the ground values g sampled at s_A(x): partials in x plus the chain rule."""
+    return sp.Matrix([[sp.diff(e, xj) + sum(sp.diff(e, g[k]) * slope[k] for k in layout.GROUND)
+                       * dsA[j] for j, xj in enumerate(mdl.X)]])
+
+
+def ground_jacobian(variant: str):
+    """The ground's part of A = df/dx (4x8, row-major 32), to add to the mechanics kernel's
+    dynamics_jacobian evaluated with the slope-frame forces (F_N := F_y, F_T := F_x) and every
+    contact partial set to 0 (which gives df/dx at fixed forces minus (dM/dx) qdd): for each
+    foot, the forces' total gradient -- through the contact partials (symbols), the surface-frame
+    kinematics and the ground sampled at s_A(x) (h, h', h'', chain rule) -- times the columns of
+    f for F_x and F_y, plus the moment's gradient on theta_i. The patches' dependence on s is
+    left out (the Jacobian is exact off the blend zones)."""
+    from . import stages  # the contact partial symbols (stages imports this module's callers)
+    sym = stages.contact_partial_symbols()
+    f = stages.forcing(stages.KernelSpec(variant))
+    x = mdl.X
+    A = sp.zeros(layout.NQ, len(x))
+    sA = sample_points()
+    for i in range(2):
+        g = GND[i]
+        slope = _ground_slopes(g)
+        dsA = [sp.diff(sA[i], xj) for xj in x]
+        kin = ground_kinematics(i, variant)
+        grad = [_total_gradient(e, g, slope, dsA) for e in
+                (-kin["y_D"], -kin["v_y"], kin["xi"], kin["v_x"])]
+        dFn = sym[i, "dFn_ddelta"] * grad[0] + sym[i, "dFn_ddeltad"] * grad[1]
+        dFt = sym[i, "dFt_dxi"] * grad[2] + sym[i, "dFt_dv"] * grad[3] + sym[i, "mu"] * dFn
+        ddh_dx = sp.Matrix([[slope["dh"] * dsA[j] for j in range(len(x))]])
+        fn, ft, dh = mdl.F_N[i], mdl.F_T[i], g["dh"]
+        fx, fy, mom = (sp.diff(e, fn) * dFn + sp.diff(e, ft) * dFt + sp.diff(e, dh) * ddh_dx
+                       for e in ground_forces(i))
+        # the flat forcing's columns for the forces along X (F_T) and Y (F_N) at D
+        A += f.diff(mdl.F_T[i]) * fx + f.diff(mdl.F_N[i]) * fy
+        A[2 + i, :] += mom
+    return [stages._trig(e) for e in A]

@@ -133,3 +133,28 @@ def test_result_carries_its_ground():
     g = Ground.step(1.0, -0.004)
     r = pdw.simulate(params=P, ground=g, t_end=0.2)
     assert r.ground == g
+
+
+@pytest.mark.parametrize("variant", ["paper", "consistent"])
+@pytest.mark.parametrize("ground", [Ground.sine(0.01, 0.7), Ground.random(0.003, 0.1, seed=4, extent=(-1, 3)),
+                                    Ground.step(0.35, -0.01, width=0.05)], ids=lambda g: g.kind)
+def test_derived_jacobian_is_the_derivative_of_the_rhs(variant, ground):
+    """The shaped-ground Jacobian (derive/terrain.py ground_jacobian) against central differences
+    of the shaped-ground right-hand side, feet in contact on the slope of the ground."""
+    from pdw.core import _core
+    from pdw.core.model import kernel_index, parameter_vector
+    k = kernel_index(variant, None)
+    p = parameter_vector(P)
+    cg = _core.CGround(ground.table())
+    x = np.array(pdw.X0_PAPER) + np.array([0.3, -0.003, 0.01, -0.02, 0.05, 0.01, 0.1, 0.2])
+    anchors = np.array([0.1, 0.25, 0.0, 0.0])
+    f = _core.ground_stage(k, cg, x, p, 1, 1, anchors)
+    J = _core.ground_stage(k, cg, x, p, 1, 1, anchors, True)
+    fd = np.zeros_like(J)
+    for j in range(8):
+        e = np.zeros(8)
+        e[j] = h = 1e-7 * max(1.0, abs(x[j]))
+        fd[:, j] = (_core.ground_stage(k, cg, x + e, p, 1, 1, anchors)
+                    - _core.ground_stage(k, cg, x - e, p, 1, 1, anchors)) / (2 * h)
+    assert np.abs(f[4:]).max() > 1.0            # forces act
+    assert np.abs(J - fd).max() < 1e-8 * np.abs(J).max()

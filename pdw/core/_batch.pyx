@@ -27,6 +27,9 @@ cdef extern from "pdw_model.h":
     const pdw_kernel pdw_kernels[]
 
 
+include "_ground.pxi"
+
+
 cdef extern from "pdw_sim.h":
     ctypedef struct pdw_sim:
         int status
@@ -55,6 +58,7 @@ cdef extern from "pdw_batch.h":
         double t_end
         double rtol, atol, h_max, event_tol
         long max_steps
+        const pdw_ground **grounds
         int *status
         int *stop_reason
         int *flags_final
@@ -149,7 +153,7 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
               dict out, long i0, long i1, int lanes, bint vector, int method=0,
               double t_end=0.0, double rtol=1e-6, double atol=1e-8, double h_max=0.0,
               double event_tol=1e-9, long max_steps=0, int isa=0, int stop_touch_down=0,
-              long[::1] next_walker=None):
+              long[::1] next_walker=None, grounds=None):
     """Advance walkers [i0, i1) with `lanes` lanes (GIL released), writing rows of `out`.
 
     method: index into the compiled method table (pdw.core.integrators.METHODS); 0 (cdm) takes
@@ -163,6 +167,9 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     thread keeps busy until the batch runs out; None: the range is this call's alone.
     isa: the lane loop of cdm and rodas4, a value of ISAS (-1: per-lane scalar stages; an
     unsupported one falls back to it).
+    grounds: None (every walker on flat ground), or N entries, each a `CGround` (that walker's
+    shaped or patched ground, docs/terrain.md) or None (flat); needs isa = -1 and vector False
+    (the per-lane scalar stages, bitwise the scalar runs).
 
     x0 (N, 8); p (N, NP) or (1, NP) (one vector for all); flags0 (N, 2) intc; hip, depth (N,).
     out: the dict of output arrays made by pdw.sim.batch (status, stop_reason, flags_final,
@@ -245,9 +252,19 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
         raise ValueError("method id %d out of range [0, %d)" % (method, pdw_nmethods))
     if max_steps < 0 or not (event_tol > 0) or not (rtol > 0) or not (atol > 0):
         raise ValueError("max_steps must be >= 0 and rtol, atol, event_tol > 0")
+    if grounds is not None:
+        if len(grounds) != n:
+            raise ValueError("grounds must have N = %d entries, got %d" % (n, len(grounds)))
+        if isa >= 0 or vector:
+            raise ValueError("walkers on a ground run the per-lane scalar stages: isa must be "
+                             "-1 and vector False")
+        for r in range(n):
+            if grounds[r] is not None and not isinstance(grounds[r], CGround):
+                raise ValueError("grounds[%d] must be a CGround or None" % r)
     if n == 0 or i0 == i1:
         return 0
     cdef pdw_batch_job job
+    job.grounds = NULL
     job.kernel = &pdw_kernels[k]
     job.n = n
     job.x0 = &x0[0, 0]
@@ -294,18 +311,34 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     cdef list pending = []
     job.poll = _poll
     job.poll_ctx = <void *> pending
+    cdef const pdw_ground **gp = NULL
+    cdef CGround cg
+    if grounds is not None:
+        gp = <const pdw_ground **> malloc(n * sizeof(pdw_ground *))
+        if gp == NULL:
+            raise MemoryError()
+        for r in range(n):
+            if grounds[r] is None:
+                gp[r] = NULL
+            else:
+                cg = grounds[r]
+                gp[r] = &cg.g
+        job.grounds = gp
     cdef pdw_sim *sims = <pdw_sim *> malloc(lanes * sizeof(pdw_sim))
     if sims == NULL:
+        free(gp)
         raise MemoryError()
     cdef pdw_soa_state *soa = NULL
     # 64-byte aligned: the first 8 lanes of a row are one cache line
     if posix_memalign(<void **> &soa, 64, sizeof(pdw_soa_state)) != 0:
         free(sims)
+        free(gp)
         raise MemoryError()
     cdef pdw_ros_soa *ros = NULL
     if method != 0 and isa >= 0 and posix_memalign(<void **> &ros, 64, sizeof(pdw_ros_soa)) != 0:
         free(sims)
         free(soa)
+        free(gp)
         raise MemoryError()
     cdef long done
     try:
@@ -323,6 +356,7 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
         free(sims)
         free(soa)
         free(ros)
+        free(gp)
     with _lane_lock:
         _lane_steps[0] += lane_steps
     if pending:             # Ctrl-C (or a cancelled pool): the rows written so far stay

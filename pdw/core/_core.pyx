@@ -125,6 +125,12 @@ cdef extern from "pdw_sim.h":
                            const double *x, const int *flags0, pdw_discrete *d,
                            double *work) noexcept nogil
     void pdw_gait_init(pdw_gait *g) noexcept nogil
+    void pdw_terrain_rhs(const pdw_kernel *k, const pdw_ground *g, const double *x,
+                         const double *p, const int *flags, const double *anchors,
+                         double *xdot, double *work) noexcept nogil
+    void pdw_terrain_jacobian(const pdw_kernel *k, const pdw_ground *g, const double *x,
+                              const double *p, const int *flags, const double *anchors,
+                              double *J, double *work) noexcept nogil
     enum:
         PDW_STATUS_RECORDS_FULL, PDW_STATUS_POLL
 
@@ -640,3 +646,26 @@ def _real_states(x, bint allow_rows):
 # --- the model object for external solvers (pdw.ode_function) ----------------------------
 
 include "_ode.pxi"
+
+
+def ground_stage(int k, CGround ground, const double[::1] x, const double[::1] p, int f1, int f2,
+                 const double[::1] anchors, bint jacobian=False):
+    """f(x) (nx,) or, with jacobian, df/dx (nx, nx) of kernel k on a compiled ground (the
+    shaped-ground kernel, pdw_terrain.c), for tests; anchors (NANCHOR,)."""
+    cdef const pdw_kernel *kern = _kernel(k)
+    cdef int nx = kern.nx
+    cdef int flags[2]
+    cdef double work[PDW_NWORK]
+    cdef double[::1] flat
+    _len("x", x.shape[0], nx)
+    _len("p", p.shape[0], PDW_NP)
+    _len("anchors", anchors.shape[0], PDW_NANCHOR)
+    flags[0] = f1
+    flags[1] = f2
+    out = np.zeros((nx, nx)) if jacobian else np.zeros(nx)
+    flat = out.reshape(-1)
+    if jacobian:
+        pdw_terrain_jacobian(kern, &ground.g, &x[0], &p[0], flags, &anchors[0], &flat[0], work)
+    else:
+        pdw_terrain_rhs(kern, &ground.g, &x[0], &p[0], flags, &anchors[0], &flat[0], work)
+    return out

@@ -301,8 +301,9 @@ class Ground:
     # ---- properties ------------------------------------------------------------------------------
     @property
     def is_flat(self) -> bool:
-        """Flat, at height 0, no patches: today's kernel runs it (bitwise today's model)."""
-        return self.kind == "flat" and self.offset == 0.0 and not self.patches
+        """Flat, at height 0, no patches, unbounded: today's kernel runs it (bitwise today's
+        model). A flat ground with an extent runs the shaped kernel (it can be left)."""
+        return self.kind == "flat" and self.offset == 0.0 and not self.patches and self.extent is None
 
     @property
     def s_range(self) -> tuple:

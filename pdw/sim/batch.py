@@ -20,6 +20,7 @@ import numpy as np
 
 from ..core import _batch, _layout, checks, interrupt
 from ..core.errors import InvalidInputError
+from ..core.ground import Ground
 from ..core.integrators import METHODS
 from ..core.integrators import get as _method_info
 from ..core.model import STATE, check_variant, kernel_index, parameter_vector
@@ -181,7 +182,7 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
                    periodic_steps=0, periodic_tol=1e-3, fall_hip_height=None, fall_depth=None,
                    max_speed=1e3, check_step="warn", rtol=1e-6, atol=1e-8, h_max=None,
                    event_tol=1e-9, max_steps=None, *, executor=None, chunk_size=None,
-                   record=None, record_every=1, stop_touch_down=0) -> BatchResult:
+                   record=None, record_every=1, stop_touch_down=0, ground=None) -> BatchResult:
     """Simulate N walkers at once: the result of `pdw.simulate` for each, without recording.
 
     Parameters
@@ -239,6 +240,12 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
     stop_touch_down : {0, 1, 2}
         As `simulate`: stop each walker at the first touch-down of leg 1 or 2 (``stop_reason``
         ``"touch_down"``, ``x_final`` the event's state); 0: off.
+    ground : pdw.Ground, dict, or sequence of N (Ground, dict or None), optional
+        The ground of all walkers, or of each (its own seed, step height, patch;
+        docs/terrain.md). Walkers on a shaped or patched ground run the shaped-ground kernel
+        through the per-lane scalar stages (``vector=False``), and so do the flat walkers of
+        such a batch: every walker bitwise its `simulate` run. Status ``"off_ground"``: the
+        walker left its ground's defined extent.
 
     Returns
     -------
@@ -261,7 +268,9 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
                   periodic_tol=periodic_tol, fall_hip_height=fall_hip_height,
                   fall_depth=fall_depth, max_speed=max_speed, check_step=check_step,
                   rtol=rtol, atol=atol, h_max=h_max, event_tol=event_tol, max_steps=max_steps,
-                  record=record, record_every=record_every, stop_touch_down=stop_touch_down)
+                  record=record, record_every=record_every, stop_touch_down=stop_touch_down,
+                  ground=ground if ground is None or isinstance(ground, (Ground, dict))
+                  else _ground_list(ground, n))
         if chunk_size is None:
             chunk_size = max(1, math.ceil(n / 8))
         return run_chunked(simulate_batch, kw, executor, chunk_size)
@@ -312,11 +321,17 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
     if threads < 1:
         raise InvalidInputError("threads must be >= 1, got %d" % threads)
     k = kernel_index(variant, None)
+    grounds = _ground_list(ground, n)
+    if grounds is not None and vector:
+        raise InvalidInputError("vector=True (vector sin/cos) does not apply to walkers on a "
+                                "shaped or patched ground: give vector=False")
+    cground = None if grounds is None else _compiled_grounds(grounds)
     distinct = {}
     for p in plist:
         if id(p) not in distinct:
             distinct[id(p)] = p
-            _stepsize.check_step(dt, p, method, variant, check_step)
+            for ps in _patched(p, grounds):
+                _stepsize.check_step(dt, ps, method, variant, check_step)
     pvec = np.ascontiguousarray([parameter_vector(p) for p in plist])
     ls = np.array([p.l for p in plist], dtype=float)
     hip = np.broadcast_to(0.5 * ls if fall_hip_height is None
@@ -333,6 +348,8 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
     opts = dict(method=METHODS.index(method), t_end=t_stop, rtol=rtol, atol=atol, h_max=h_max,
                 event_tol=event_tol, max_steps=budget, isa=_batch.ISAS[batch_isa()],
                 stop_touch_down=stop_touch_down)
+    if cground is not None:         # the per-lane scalar stages: bitwise the scalar runs
+        opts.update(isa=-1, grounds=cground)
     if n:
         args = (k, x, pvec, f0, hip, depth, dt, n_steps, max_speed, stop_steps, periodic_steps,
                 periodic_tol, out, 0, n, lanes, bool(vector))
@@ -360,8 +377,62 @@ def simulate_batch(x0, t_end=3.5, dt=1e-4, params=None, variant="paper", method=
                  fall_hip_height=fall_hip_height, fall_depth=fall_depth, max_speed=max_speed,
                  check_step=check_step, rtol=rtol, atol=atol,
                  h_max=None if h_max == 0.0 else h_max, event_tol=event_tol,
-                 max_steps=max_steps, stop_touch_down=stop_touch_down))
+                 max_steps=max_steps, stop_touch_down=stop_touch_down, ground=grounds))
     return res
+
+
+def _ground_list(ground, n):
+    """None (every walker on flat ground) or a list of n `pdw.Ground` from ``ground``: None, one
+    Ground (or [ground] dict) for all, or a sequence of n (Ground, dict or None each)."""
+    if ground is None:
+        return None
+    if isinstance(ground, (Ground, dict)):
+        g = Ground.coerce(ground)
+        return None if g.is_flat else [g] * n
+    if isinstance(ground, (str, bytes)):
+        raise InvalidInputError("ground must be a pdw.Ground, a dict or a sequence of N = %d, got "
+                                "%r" % (n, ground))
+    try:
+        gl = list(ground)
+    except TypeError:
+        raise InvalidInputError("ground must be a pdw.Ground, a dict or a sequence of N = %d, got "
+                                "%s" % (n, type(ground).__name__)) from None
+    if len(gl) != n:
+        raise InvalidInputError("ground must be one Ground or a sequence of N = %d, got %d"
+                                % (n, len(gl)))
+    out = []
+    for i, g in enumerate(gl):
+        try:
+            out.append(Ground.coerce(g))
+        except InvalidInputError as e:
+            raise InvalidInputError("ground[%d]: %s" % (i, e)) from None
+    return None if all(g.is_flat for g in out) else out
+
+
+def _compiled_grounds(grounds):
+    """The compiled ground of each walker (None: flat), one per distinct Ground object."""
+    made = {}
+    out = []
+    for g in grounds:
+        if g.is_flat:
+            out.append(None)
+            continue
+        if id(g) not in made:
+            made[id(g)] = _batch.CGround(g.table())
+        out.append(made[id(g)])
+    return out
+
+
+def _patched(p, grounds):
+    """p and p with each distinct ground's patches (the step-size check)."""
+    if grounds is None:
+        return [p]
+    out, seen = [p], set()
+    for g in grounds:
+        if id(g) not in seen and g.patches:
+            seen.add(id(g))
+            out += g.patched_params(p)[1:]
+    return out
 
 
 def _outputs(n):
@@ -377,6 +448,7 @@ def _outputs(n):
 
 def _result(out, dt, t_end, method, variant):
     status = np.array([_STATUS[s] for s in out["status"]], dtype=object)
+    status[(status == "fell") & (out["fail_reason"] == 8)] = "off_ground"   # left the ground
     stop = np.array([_STOP[r] if r else (s if s in ("fell", "diverged", "interrupted") else "t_end")
                      for r, s in zip(out["stop_reason"], status)], dtype=object)
     return BatchResult(

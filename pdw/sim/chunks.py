@@ -134,6 +134,8 @@ def run_chunked(fn, kw, executor, chunk_size, progress=None):
             c["params"] = list(params[lo:hi])
         if flags0.ndim == 2:
             c["flags0"] = flags0[lo:hi]
+        if isinstance(kw.get("ground"), (list, tuple)):     # one Ground per walker
+            c["ground"] = list(kw["ground"][lo:hi])
         if "record" in kw:
             c["record"] = [i - lo for i in record if lo <= i < hi] or None
         tasks.append(c)
@@ -170,6 +172,9 @@ def record_subset(b, record, record_every, x0, params, flags0, options) -> dict:
         raise InvalidInputError("record_every must be >= 1 for recorded walkers, got %d" % every)
     plist = _plist(params, n)
     f0 = np.broadcast_to(np.asarray(flags0), (n, 2))
-    kw = {k: v for k, v in options.items() if k not in _NOT_SIMULATE}
+    kw = {k: v for k, v in options.items() if k not in _NOT_SIMULATE and k != "ground"}
+    grounds = options.get("ground")         # None, or each walker's Ground (simulate_batch)
     return {i: simulate(x0[i], params=plist[i], flags0=tuple(int(v) for v in f0[i]),
-                        record_every=every, on_failure="return", **kw) for i in idx}
+                        record_every=every, on_failure="return",
+                        **(kw if grounds is None else dict(kw, ground=grounds[i])))
+            for i in idx}

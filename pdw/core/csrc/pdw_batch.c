@@ -61,6 +61,7 @@ static void load_walker(const pdw_batch_job *job, long i, pdw_sim *s)
     s->stop_touch_down = job->stop_touch_down;
     s->periodic_tol = job->periodic_tol;
     pdw_gait_init(&s->gait);
+    s->ground = job->grounds ? job->grounds[i] : NULL;
     memcpy(s->x, job->x0 + i*PDW_NX, PDW_NX * sizeof(double));
     flags0[0] = job->flags0[2*i];
     flags0[1] = job->flags0[2*i + 1];
@@ -91,8 +92,13 @@ static int step(pdw_sim *s)
     const double t = s->n * dt;
     if (s->n > 0 && pdw_update_flags_trig(s, t) > 0) return 0;     /* a stop condition */
     if (pdw_check_feet(s, t)) return 0;
-    k->contact(kin, s->disc.flags, s->p, contact);
-    k->cdm_terms(s->x, trig, s->p, contact, M, C, QmG);
+    if (s->ground) {            /* shaped ground: as pdw_cdm_advance (pdw_terrain.c) */
+        pdw_sim_contact(s, s->work);
+        pdw_terrain_cdm_terms(k, s->x, trig, s->p, contact, s->work + PDW_WORK_GROUND, M, C, QmG);
+    } else {
+        k->contact(kin, s->disc.flags, s->p, contact);
+        k->cdm_terms(s->x, trig, s->p, contact, M, C, QmG);
+    }
     if (pdw_cdm_update(s, M, C, QmG, t)) return 0;
     if (s->n < s->n_steps) return 1;
     /* final flags at t_end (scalar trig, as pdw_cdm_advance) */

@@ -41,6 +41,11 @@ typedef struct pdw_batch_job {
     double t_end;               /* end time [s] (adaptive methods end exactly here) */
     double rtol, atol, h_max, event_tol;  /* adaptive methods; dt is the first step */
     long max_steps;             /* adaptive methods' step budget (accepted + rejected); 0: none */
+    /* the ground of each walker (docs/terrain.md): NULL (all flat), else (n,) pointers, NULL
+     * entries flat. A walker on a ground runs the shaped-ground kernel through the per-lane
+     * scalar stages (pdw_batch_cdm or pdw_batch_method; _batch.pyx never gives grounds to the
+     * structure-of-arrays loops): bitwise its pdw.simulate run. */
+    const pdw_ground *const *grounds;
     /* --- outputs, per walker (caller-allocated) --- */
     int *status;                /* (n,) PDW_STATUS_* */
     int *stop_reason;           /* (n,) PDW_STOP_* */

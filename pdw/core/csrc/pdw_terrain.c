@@ -79,13 +79,43 @@ void pdw_terrain_rhs(const pdw_kernel *k, const pdw_ground *g, const double *x, 
         for (int i = 0; i < 2; ++i) xdot[PDW_X_Z1 + i] = contact[i*PDW_NCONTACT + PDW_CONTACT_ZDOT];
 }
 
-/* Central differences, step sqrt(eps) max(1, |x_j|) (the reasons are LuGre's, in
- * derive/emit.py); leaves work at x. */
+/* The smooth Coulomb law's kernels: the derived Jacobian, the mechanics kernel's
+ * dynamics_jacobian at the slope-frame forces with every contact partial 0, plus the ground's
+ * part (derive/terrain.py ground_jacobian), solved with M as the generated kernels do. LuGre's
+ * (nx > PDW_NX): central differences, step sqrt(eps) max(1, |x_j|) (the reasons are LuGre's, in
+ * derive/emit.py). Leaves work at x. */
 void pdw_terrain_jacobian(const pdw_kernel *k, const pdw_ground *g, const double *x,
                           const double *p, const int *flags, const double *anchors, double *J,
                           double *work)
 {
     const int nx = k->nx;
+    if (nx == PDW_NX) {
+        double xdot[PDW_NX], A[PDW_NQ*PDW_NX], col[PDW_NQ], sol[PDW_NQ], fac[PDW_DBLOCK_NFAC];
+        double cw[2*PDW_NCONTACT], moment[2];
+        double *contact = work + PDW_WORK_CONTACT, *gnd = work + PDW_WORK_GROUND;
+        pdw_terrain_rhs(k, g, x, p, flags, anchors, xdot, work);
+        pdw_terrain_contact(k, g, work + PDW_WORK_KIN, flags, p, contact, 1);
+        pdw_terrain_forces(contact, gnd, p, cw, moment);
+        for (int i = 0; i < 2; ++i) {
+            double *c = cw + i*PDW_NCONTACT;
+            c[PDW_CONTACT_DFN_DDELTA] = c[PDW_CONTACT_DFN_DDELTAD] = 0.0;
+            c[PDW_CONTACT_DFT_DXI] = c[PDW_CONTACT_DFT_DV] = c[PDW_CONTACT_MU] = 0.0;
+        }
+        k->dynamics_jacobian(x, work + PDW_WORK_TRIG, p, cw, work + PDW_WORK_QDD, A);
+        if (k->variant == 1)
+            pdw_consistent_ground_jacobian(x, work + PDW_WORK_TRIG, p, contact, gnd, A);
+        else
+            pdw_paper_ground_jacobian(x, work + PDW_WORK_TRIG, p, contact, gnd, A);
+        pdw_dblock_factor(work + PDW_WORK_M, fac);
+        for (int i = 0; i < PDW_NX*PDW_NX; ++i) J[i] = 0.0;
+        for (int i = 0; i < PDW_NQ; ++i) J[i*PDW_NX + PDW_NQ + i] = 1.0;
+        for (int j = 0; j < PDW_NX; ++j) {
+            for (int i = 0; i < PDW_NQ; ++i) col[i] = A[i*PDW_NX + j];
+            pdw_dblock_solve(work + PDW_WORK_M, fac, col, sol);
+            for (int i = 0; i < PDW_NQ; ++i) J[(PDW_NQ + i)*PDW_NX + j] = sol[i];
+        }
+        return;
+    }
     double xp[PDW_NX_MAX], fp[PDW_NX_MAX], fm[PDW_NX_MAX];
     for (int j = 0; j < nx; ++j) xp[j] = x[j];
     for (int j = 0; j < nx; ++j) {

@@ -1,0 +1,70 @@
+"""What a ground costs per step (docs/terrain.md, issue 22): CPU time per integration step of the
+walker on flat ground (no ground, and ``Ground()``: the same kernel) and on shaped and patched
+grounds (the shaped-ground kernel of pdw_terrain.c), for cdm (the paper's method, dt 1e-4) and
+rodas4 (rtol 1e-8). Each round runs every configuration once, interleaved; the ratios are the
+medians over rounds of (configuration / no ground) in the same round. The 1-minute load average
+is printed with the result.
+
+    .venv/bin/python benchmarks/bench_terrain.py [rounds]        (default 7)
+"""
+import os
+import sys
+import time
+
+import numpy as np
+
+import pdw
+from pdw import Ground
+
+sys.path.insert(0, os.path.dirname(__file__))
+from _results import publish  # noqa: E402
+
+P = pdw.Params.paper_steady()
+GROUNDS = {
+    "none": None,
+    "Ground()": Ground(),
+    "plane 0": Ground.plane(0.0),
+    "steps": Ground.steps([0.6, 1.4], [-0.003, 0.002]),
+    "sine": Ground.sine(0.001, 0.8),
+    "random": Ground.random(0.0005, 0.1, seed=1, extent=(-1.0, 5.0)),
+    "patches": Ground.flat(extent=(-2.0, 50.0)).with_patches(
+        [dict(s_a=0.3, s_b=0.6, k_n=8e4), dict(s_a=1.0, s_b=1.4, mu_s=0.45)]),
+}
+METHODS = {
+    "cdm": dict(method="cdm", t_end=2.0),
+    "rodas4": dict(method="rodas4", t_end=2.0, rtol=1e-8, atol=1e-10),
+}
+
+
+def cpu_per_step(ground, opts):
+    t0 = time.process_time()
+    r = pdw.simulate(params=P, record_every=0, on_failure="return", ground=ground, **opts)
+    return (time.process_time() - t0) / max(r.n_steps, 1), r
+
+
+def main(rounds=7):
+    for g in GROUNDS.values():          # build the tables once, outside the timings
+        if g is not None and not g.is_flat:
+            g.table()
+    lines = ["bench_terrain: CPU time per integration step, paper_steady, t_end 2 s; median of "
+             "%d interleaved rounds; ratio to no ground in the same round" % rounds]
+    for mname, opts in METHODS.items():
+        per = {k: [] for k in GROUNDS}
+        info = {}
+        for _ in range(rounds):
+            for k, g in GROUNDS.items():
+                c, r = cpu_per_step(g, opts)
+                per[k].append(c)
+                info[k] = (r.status, r.n_gait_steps, r.n_steps)
+        base = np.array(per["none"])
+        lines.append("%s:" % mname)
+        for k in GROUNDS:
+            ratio = np.median(np.array(per[k]) / base)
+            lines.append("  %-9s %8.3f us/step  ratio %.3f  (%s, %d gait steps, %d steps)"
+                         % (k, 1e6 * np.median(per[k]), ratio, *info[k]))
+    lines.append("load average (1 min) %.2f on %d CPUs" % (os.getloadavg()[0], os.cpu_count() or 1))
+    publish("bench_terrain.txt", lines)
+
+
+if __name__ == "__main__":
+    main(int(sys.argv[1]) if len(sys.argv) > 1 else 7)
