@@ -6,9 +6,10 @@ compliant model"): the step or the rough ground is a `pdw.Ground` under `pdw.sim
   run (``L`` footprint spacing, ``cycle`` touch-down to touch-down).
 * A step of height H: ``Ground.step(edge, -H or +H)`` with the edge halfway between the stance
   foot (s = 0) and the gait's next footprint (s = L), smoothed over ``edge_width``.
-* The trials of a `max_step` round run on threads (the compiled loop releases the GIL), one
-  `pdw.simulate` each. (One `simulate_batch` with a ground per walker replaces them once the
-  ensemble engine takes per-walker grounds, issue 22 item 7.)
+* The trials of a `max_step` round are the walkers of one `pdw.simulate_batch` (each walker
+  its own step ground; bitwise its `pdw.simulate` run), and so are the walkers of a chunk of
+  `first_passage` (each its own random ground). The batch keeps each walker's last
+  `STEP_RING` steps (`BatchResult.steps`), which is what "returned" looks at.
 * The gait sensitivity norm: central differences of the touch-down map in the section
   coordinates and in the floor heights, at two steps (h and h/2); a warning when the two norms
   differ by more than ``rel_check``. The state is augmented by the previous step's floor
@@ -24,9 +25,9 @@ from typing import Any
 
 import numpy as np
 
-from ..core import interrupt
 from ..core.errors import InvalidInputError
 from ..core.ground import Ground
+from ..sim.batch import simulate_batch
 from ..sim.gait import steps as _steps
 from ..sim.simulation import simulate
 from . import limit_cycle as _lc
@@ -44,6 +45,17 @@ def continuous_gait(params, gait=None):
         raise InvalidInputError("gait must be a continuous pdw.Gait (pdw.find_gait), got %r"
                                 % (gait,))
     return gait
+
+
+def batch(params, gait, grounds, n_steps, *, threads=2, executor=None, **options):
+    """`pdw.simulate_batch` of len(grounds) walkers from the gait's touch-down state, walker i
+    on grounds[i], for ``n_steps`` gait periods and a half (as `walk`)."""
+    n = len(grounds)
+    x0 = np.repeat(np.asarray(gait.state, dtype=float)[None, :], n, axis=0)
+    kw = {**WALK, **options}
+    return simulate_batch(x0, t_end=(n_steps + 1.5) * gait.period, params=params,
+                          flags0=(1, 1), threads=threads, executor=executor, ground=list(grounds),
+                          **kw)
 
 
 def walk(params, gait, ground, n_steps, **options):
@@ -92,22 +104,23 @@ def step_trials_fn(params, *, direction, budget, return_tol, gait=None, executor
     sign = -1.0 if direction == "down" else 1.0
     edge = edge_at(gait)
 
-    def one(h):
-        g = Ground.step(edge, sign * h, width=edge_width)
-        status, L, T = walk(params, gait, g, budget + 1, **options)
-        # the first complete step is the one onto the new level; the walk must reach budget
-        surv = status in ("walked", "periodic") and len(L) >= budget - 1
-        ret, k = False, -1
-        if surv:
-            ret, k = _rb.returned(L, T, gait.step_length, gait.period, return_tol)
-        return dict(height=float(h), survived=bool(surv), returned=bool(ret),
-                    steps_to_return=int(k), status=str(status))
-
     def run(heights):
         hs = [float(h) for h in heights]
-        if executor is not None:
-            return [f.result() for f in [executor.submit(one, h) for h in hs]]
-        return interrupt.thread_map(one, hs, max(1, min(threads, len(hs))))
+        b = batch(params, gait, [Ground.step(edge, sign * h, width=edge_width) for h in hs],
+                  budget + 1, threads=threads, executor=executor, **options)
+        out = []
+        for i, h in enumerate(hs):
+            n = int(b.n_touch_down[i])          # steps taken (each ends in a touch-down)
+            surv = b.status[i] in ("walked", "periodic") and n >= budget
+            ret, k = False, -1
+            if surv:
+                st = b.steps(i)                 # the last STEP_RING complete steps
+                ret, k = _rb.returned(st["L"], st["cycle"], gait.step_length, gait.period,
+                                      return_tol)
+                k = k + n - len(st) if ret else -1
+            out.append(dict(height=h, survived=bool(surv), returned=bool(ret),
+                            steps_to_return=int(k), status=str(b.status[i])))
+        return out
 
     return _Trials(gait=gait, fn=run)
 
@@ -198,15 +211,12 @@ def walker_ground(ground, seed, i, max_steps, step_length):
 def chunk(params, gait, ground, seed, lo, hi, max_steps, options):
     """Walkers lo..hi-1 of the continuous model on their own random grounds: (steps, failed,
     status), as `pdw.analysis.first_passage._hybrid_chunk` (module level: executors take it).
-    A walker's first-passage time counts its complete steps plus the failing one; one that
-    walks ``max_steps`` steps, or leaves its ground's extent, is censored at its steps."""
-    steps, failed, status = [], [], []
-    for i in range(lo, hi):
-        g = walker_ground(ground, seed, i, max_steps, gait.step_length)
-        st, L, _ = walk(params, gait, g, max_steps, **options)
-        n = len(L)
-        fell = st not in ("walked", "periodic", "off_ground")
-        steps.append(min(n + 1, max_steps) if fell else min(n, max_steps))
-        failed.append(fell)
-        status.append(st if fell else "ok")
-    return np.array(steps, dtype=np.int64), np.array(failed), np.array(status)
+    One `pdw.simulate_batch` (a ground per walker). A walker's first-passage time counts its
+    steps (touch-downs) plus the failing one; one that walks ``max_steps`` steps, or leaves its
+    ground's extent, is censored at its steps."""
+    grounds = [walker_ground(ground, seed, i, max_steps, gait.step_length) for i in range(lo, hi)]
+    b = batch(params, gait, grounds, max_steps, threads=1, **options)
+    n = np.asarray(b.n_touch_down, dtype=np.int64)      # steps taken
+    fell = ~np.isin(b.status, ("walked", "periodic", "off_ground"))
+    steps = np.where(fell, np.minimum(n + 1, max_steps), np.minimum(n, max_steps))
+    return steps, fell, np.where(fell, b.status, "ok")
