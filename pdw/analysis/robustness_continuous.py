@@ -31,7 +31,7 @@ from ..sim.batch import simulate_batch
 from ..sim.gait import steps as _steps
 from ..sim.simulation import simulate
 from . import limit_cycle as _lc
-from . import robustness as _rb
+from . import robustness_core as _rb
 
 #: integrator tolerances of the walks (rodas4)
 WALK = dict(method="rodas4", rtol=1e-8, atol=1e-10)
