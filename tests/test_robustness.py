@@ -256,7 +256,11 @@ def test_robustness_spec_validation_names_the_key():
         ok + '[sweep]\nparameter = "k_hip"\nvalues = [0.5, "x"]\n': r"sweep.values\[1\]",
         ok + '[sweep]\nparameter = "k_hip"\nstart = 0.5\nstop = 1.0\n': "sweep.num",
         ok + '[sweep]\nparameter = "m_h"\nvalues = [1.0, -2.0]\n': "sweep.values",
-        ok + '[ground]\nkind = "random"\nsigma = -0.01\n': "sigma",
+        'name = "x"\nmeasure = "first_passage"\nmodel = "continuous"\n[ground]\n'
+        'kind = "random"\nsigma = -0.01\n': "sigma",
+        ok + '[ground]\nkind = "random"\nsigma = 0.01\n': "only measure",
+        'name = "x"\nmeasure = "first_passage"\n': "options.sigma",
+        'name = "x"\nmeasure = "first_passage"\nmodel = "continuous"\n': "ground",
         'name = "x"\nmeasure = "markov_chain"\nmodel = "continuous"\n': "markov_chain",
     }
     for text, match in bad.items():

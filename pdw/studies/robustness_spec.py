@@ -177,10 +177,26 @@ def parse_spec(text, path=None) -> RobustnessSpec:
             values = list(np.linspace(_num("sweep.start", sweep["start"]),
                                       _num("sweep.stop", sweep["stop"]), num))
     ground = None
+    wants_ground = measure == "first_passage" and model == "continuous"
     if "ground" in d:
+        if not wants_ground:
+            raise InvalidInputError("ground: only measure = 'first_passage' with model = "
+                                    "'continuous' takes a [ground] table (max_step and "
+                                    "gait_sensitivity build their own step; the hybrid model's "
+                                    "first_passage and markov_chain take options.sigma)")
         from ..core.ground import Ground
 
         ground = Ground.from_dict(d["ground"])
+        if ground.kind != "random":
+            raise InvalidInputError("ground.kind must be 'random' for first_passage, got %r"
+                                    % ground.kind)
+    elif wants_ground:
+        raise InvalidInputError("ground: first_passage with model = 'continuous' needs a "
+                                "[ground] table of kind = 'random' (sigma, correlation)")
+    if measure in ("first_passage", "markov_chain") and model == "hybrid" \
+            and "sigma" not in options:
+        raise InvalidInputError("options.sigma [m] is missing: the hybrid model's %s needs "
+                                "the step heights' standard deviation" % measure)
     spec = RobustnessSpec(name=name, title=title, measure=measure, model=model, preset=preset,
                           params=params, options=options, parameter=parameter, values=values,
                           ground=ground, source=text, path=path)
