@@ -205,18 +205,29 @@ def figures(rows, grid, mats, khips, mf, sig):
     fig.tight_layout()
     fig.savefig(FIGURES / "robustness_compliant_mfpt.png", dpi=110)
     plt.close(fig)
+    fig_mat(grid, mats, khips)
+
+
+def fig_mat(grid, mats, khips):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
     fig, a = plt.subplots(figsize=(5.5, 3.8))
     show = np.where(grid < 0, np.nan, np.minimum(grid, 40))
     im = a.imshow(show, origin="lower", aspect="auto", cmap="viridis")
     for i in range(len(khips)):
         for j in range(len(mats)):
-            a.text(j, i, "F" if grid[i, j] < 0 else "%d" % grid[i, j], ha="center",
-                   va="center", color="w", fontsize=8)
+            v = grid[i, j]
+            a.text(j, i, "-" if np.isnan(v) else "F" if v < 0 else "%d" % v, ha="center",
+                   va="center", color="w" if v >= 0 else "k", fontsize=8)
     a.set_xticks(range(len(mats)), ["%.0e" % m for m in mats])
     a.set_yticks(range(len(khips)), ["%.2f" % k for k in khips])
     a.set_xlabel("mat k_n [N/m^1.5] (d_n = 10 k_n)")
     a.set_ylabel("k_hip [N m/rad]")
-    a.set_title("hard -> soft mat -> hard: steps to re-converge (F: fell)", fontsize=9)
+    a.set_title("hard -> soft mat -> hard: steps to re-converge (F: fell, -: no gait)",
+                fontsize=9)
     fig.colorbar(im, ax=a)
     fig.tight_layout()
     fig.savefig(FIGURES / "robustness_compliant_mat.png", dpi=110)
