@@ -80,6 +80,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_step_maps.py $(UPDATE_DOCS)
 	$(PY) benchmarks/work_precision.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_terrain.py $(UPDATE_DOCS)
+	$(PY) benchmarks/bench_mfpt.py $(UPDATE_DOCS)
 
 ## instructions: the instruction-count guard (valgrind's callgrind; benchmarks/instructions.py):
 ## the paper run with and without recording, a first call, 64-walker batches, find_gait,
@@ -101,6 +102,8 @@ study: $(STAMP)
 	$(PY) benchmarks/step_edge_grid.py $(UPDATE_DOCS)
 	$(PY) benchmarks/step_limits_laws.py $(UPDATE_DOCS)
 	$(PY) benchmarks/basin_study.py 400 200 $(UPDATE_DOCS)
+	$(PY) benchmarks/robustness_studies.py $(UPDATE_DOCS)
+	$(PY) benchmarks/robustness_compliant.py $(UPDATE_DOCS)
 
 ## sanitize: the compiled core built with AddressSanitizer + UndefinedBehaviorSanitizer (in
 ## build/sanitize, the normal build untouched), and the tests of the compiled boundary, the loops

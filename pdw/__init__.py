@@ -50,8 +50,11 @@ from .analysis import cell_mapping, hybrid, limit_cycle
 from .analysis.branch import Bifurcation, Branch
 from .analysis.codim2 import BifurcationCurve, continue_bifurcation
 from .analysis.continuation import continue_gait
+from .analysis.first_passage import FirstPassage, first_passage
 from .analysis.gait_types import Gait, GaitNotFoundError
 from .analysis.limit_cycle import find_gait
+from .analysis.markov import MarkovChain, markov_chain
+from .analysis.robustness import GaitSensitivity, MaxStep, gait_sensitivity, max_step
 from .core import __version__  # noqa: F401 (pdw.__version__)
 from .core._layout import INPUT_HASH
 from .core.contact import Contact
@@ -112,4 +115,6 @@ __all__ = [
     "ode_function", "OdeFunction", "load", "load_sweep", "RecordBuffer",
     "Contact", "Progress", "GaitNotFoundError", "Integrator", "Record", "Stop", "Limits",
     "Outcome", "Ground", "Patch",
+    "max_step", "MaxStep", "gait_sensitivity", "GaitSensitivity", "first_passage",
+    "FirstPassage", "markov_chain", "MarkovChain",
 ]

@@ -25,7 +25,8 @@ def ref(gait):
 
 def test_options_are_the_c_defaults():
     assert set(H.DEFAULT_OPTIONS) == {"rtol", "atol", "h0", "h_max", "t_max", "event_tol",
-                                      "min_step_angle", "fall_angle", "max_steps", "dt_out"}
+                                      "min_step_angle", "fall_angle", "max_steps", "dt_out",
+                                      "dh", "max_slope"}
 
 
 def test_tolerances(gait, ref):

@@ -66,8 +66,8 @@ def _state(y, name="state"):
 _OPTION_RANGES = {"rtol": (0.0, 1.0), "atol": (0.0, None), "h0": (0.0, None),
                   "h_max": (0.0, None), "t_max": (0.0, None), "event_tol": (0.0, None),
                   "min_step_angle": (0.0, np.pi), "fall_angle": (0.0, np.pi),
-                  "dt_out": (0.0, None)}
-_OPEN = {"rtol", "atol", "h0", "h_max", "t_max", "event_tol", "fall_angle"}
+                  "dt_out": (0.0, None), "dh": (None, None), "max_slope": (0.0, None)}
+_OPEN = {"rtol", "atol", "h0", "h_max", "t_max", "event_tol", "fall_angle", "max_slope"}
 
 
 def _options(options):
@@ -83,6 +83,28 @@ def _options(options):
             lo, hi = _OPTION_RANGES[k]
             out[k] = checks.number(k, v, lo=lo, hi=hi, lo_open=k in _OPEN)
     return out
+
+
+def ground_ref(ground):
+    """The compiled hook of a `pdw.Ground` for the hybrid loop, or None for a flat ground (any
+    offset and patches: the rigid ground has no contact parameters, and only height
+    differences matter), which runs the flat code path bitwise. docs/hybrid.md, "On a shaped
+    ground": the stance foot rolls on a level parallel to the mean slope at the height of its
+    touch-down point, and the heel strike is when the swing foot reaches the ground under it.
+    A tilted plane is refused (it is the walker on another slope: change ``gamma``)."""
+    if ground is None:
+        return None
+    from ..core.ground import Ground
+
+    g = Ground.coerce(ground)
+    if g.kind == "flat":
+        return None
+    kinds = [q.kind for q in g.parts] if g.kind == "sum" else [g.kind]
+    if "plane" in kinds:
+        raise InvalidInputError("ground: the hybrid model takes no tilted plane (its stance foot "
+                                "rolls on levels parallel to the mean slope); use "
+                                "Params(gamma=gamma + slope) instead")
+    return _hybrid.GroundRef(g.table())
 
 
 # --- the reduced model, pointwise ------------------------------------------------------------
@@ -142,17 +164,24 @@ def impact(y_minus, params=None) -> dict:
 
 # --- the step map ----------------------------------------------------------------------------
 
-def step(state, params=None, **options) -> dict:
+def step(state, params=None, *, ground=None, s0=0.0, **options) -> dict:
     """One step from ``state`` (just after a heel strike, or any stance state): the details.
 
-    Never raises on a failed step: ``status`` says what happened ("ok", "fell", "no_strike",
-    ...). Other keys: ``t_strike`` (stance duration [s]), ``y_minus``, ``y_plus``,
+    ``ground`` (a `pdw.Ground`, default flat) is the ground under the walker and ``s0`` the
+    stance foot's rolling coordinate on it [m] (its contact point is s0 - r theta_st); the
+    option ``dh`` [m] adds a floor offset under the swing foot for this step (a step down:
+    dh < 0). Never raises on a failed step: ``status`` says what happened ("ok", "fell",
+    "no_strike", "tripped", "off_ground", ...). Other keys: ``t_strike`` (stance duration
+    [s]), ``y_minus``, ``y_plus``, ``h_st``, ``h_touch`` (ground heights under the stance foot
+    and the new footprint [m]),
     ``step_length`` (footprint spacing [m]), ``T_minus``, ``T_plus``, ``impulse``, ``v_old``,
     ``old_foot_down``, ``E0`` and ``dE_max`` (largest drift of T + V during the stance [J]),
     ``Fn_min`` (smallest normal ground force [N]), ``ratio_max`` (largest |F_t/F_n|), work
     counters. Options: see `DEFAULT_OPTIONS`.
     """
-    res, _, _ = _hybrid.step(_p(params), _state(state), _options(options))
+    g = ground_ref(ground)
+    res, _, _ = _hybrid.step(_p(params), _state(state), _options(options), 0.0,
+                             checks.number("s0", s0), 0, g)
     return res
 
 
@@ -421,12 +450,13 @@ MAX_RECORD_BYTES = 4e9
 
 
 def simulate_hybrid(params=None, state0=None, n_steps=10, *, dt_out=0.002, stance_leg=2,
-                    s0=0.0, **options) -> HybridTrajectory:
+                    s0=0.0, ground=None, **options) -> HybridTrajectory:
     """Walk ``n_steps`` steps of the hybrid model from ``state0`` (reduced, `STATE`).
 
     ``state0`` defaults to the gait of `find_gait`. ``stance_leg`` is the full model's leg
     in stance at the start (2: as at the paper's initial condition, docs/model.md section 5), ``s0``
-    its rolling coordinate. Samples every ``dt_out`` seconds (0: every integrator step),
+    its rolling coordinate. ``ground``: a `pdw.Ground` (default flat; see `ground_ref`).
+    Samples every ``dt_out`` seconds (0: every integrator step),
     plus each step's start and its pre-impact state. Does not raise when the walker falls:
     ``status`` and ``steps`` say what happened. Ctrl-C stops the walk within a second
     (`KeyboardInterrupt`, the partial trajectory as ``.result``, status "interrupted").
@@ -445,7 +475,8 @@ def simulate_hybrid(params=None, state0=None, n_steps=10, *, dt_out=0.002, stanc
     cap = int(n_steps) * min(per_step, 20000)
     if cap > 10 ** 6:       # a large record: walk unrecorded first (cheap) to size it
         cap = 0
-    res, t, y, k = _walk(p, y0, float(s0), int(n_steps), opts, cap, params, stance_leg)
+    g = ground_ref(ground)
+    res, t, y, k = _walk(p, y0, float(s0), int(n_steps), opts, cap, params, stance_leg, g)
     if cap == 0 or any(r["rec_full"] for r in res):
         # size the record from the steps the walk took and walk again (the steps are
         # deterministic: the second walk is the first one, recorded whole)
@@ -456,18 +487,18 @@ def simulate_hybrid(params=None, state0=None, n_steps=10, *, dt_out=0.002, stanc
                 "simulate_hybrid: recording %d steps at dt_out = %g needs %d samples (%.3g GB, "
                 "more than %.3g GB): use a larger dt_out" % (n_steps, dt_out, need,
                                                              need * 48 / 1e9, MAX_RECORD_BYTES / 1e9))
-        res, t, y, k = _walk(p, y0, float(s0), int(n_steps), opts, need, params, stance_leg)
+        res, t, y, k = _walk(p, y0, float(s0), int(n_steps), opts, need, params, stance_leg, g)
         if any(r["rec_full"] for r in res):      # cannot happen; never report it as ok
             raise SimulationError("simulate_hybrid: the record of %d samples was still too small"
                                   % need)
     return _trajectory(params, res, t, y, k, stance_leg, n_steps)
 
 
-def _walk(p, y0, s0, n_steps, opts, cap, params, stance_leg):
+def _walk(p, y0, s0, n_steps, opts, cap, params, stance_leg, ground=None):
     """_hybrid.walk; on Ctrl-C the KeyboardInterrupt carries the partial trajectory
     (``.result``, status "interrupted")."""
     try:
-        return _hybrid.walk(p, y0, s0, n_steps, opts, cap)
+        return _hybrid.walk(p, y0, s0, n_steps, opts, cap, ground)
     except KeyboardInterrupt as e:
         if getattr(e, "partial", None) is not None:
             e.result = _trajectory(params, *e.partial, stance_leg, n_steps)
@@ -478,6 +509,9 @@ def _trajectory(params, res, t, y, k, stance_leg, n_steps):
     legs = np.where(k % 2 == 0, stance_leg, 3 - stance_leg)
     s0s = np.array([r["s0"] for r in res])
     x = full_state(y, params, s0=s0s[k], stance_leg=legs) if len(y) else np.empty((0, 8))
+    h_st = np.array([r.get("h_st", 0.0) for r in res])
+    if len(y) and h_st.any():
+        x[:, 1] += h_st[k]          # the stance foot's level on a shaped ground
     status = "ok" if all(r["status"] == "ok" for r in res) and len(res) == n_steps \
         else res[-1]["status"] if res else "interrupted"
     return HybridTrajectory(t=t, y=y, x=x, stance_leg=legs, step=k, steps=res, status=status)

@@ -59,7 +59,7 @@ def _foot_height(x, leg, p):
 
 def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max=2.5,
          dt=1e-4, rtol=TIGHT["rtol"], atol=TIGHT["atol"], event_tol=TIGHT["event_tol"],
-         record=False, contact=None) -> dict:
+         record=False, contact=None, ground=None) -> dict:
     """One step of the Poincaré map from section point z (``len(section_names(contact))``
     entries: a z of another size raises `InvalidInputError` naming the coordinates); never raises
     on a failed step.
@@ -72,7 +72,8 @@ def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max
     ``swing_period`` (the trailing leg's lift-off to its touch-down), ``step_length``
     (footprint spacing: leg 1's contact point at touch-down, leg 2's being 0), ``travel``
     (the swing foot's own travel), ``n_events``, ``stats``; with ``record=True`` also
-    ``result`` (the `Result`, legs not relabelled, time from the section).
+    ``result`` (the `Result`, legs not relabelled, time from the section). ``ground``: a
+    `pdw.Ground` (default flat), in the section's frame (the new stance foot at s = 0).
     """
     p = _params(params)
     law = Contact.coerce(contact)
@@ -97,7 +98,7 @@ def step(z, params=None, variant="paper", method="rodas4", *, t_hint=None, t_max
         res = simulate(x0, t_end, dt, params=p, variant=variant, flags0=(1, 1),
                        integrator=_integrator(method, rtol, atol, event_tol),
                        record=_RECORD[bool(record)], limits=RETURN, contact=contact,
-                       approach_speeds0=v_in0)
+                       approach_speeds0=v_in0, ground=ground)
         out["stats"] = dict(res.stats)
         lo = next((e for e in res.events if e.leg == 1 and e.kind == "lift_off"), None)
         td = next((e for e in res.events if e.leg == 1 and e.kind == "touch_down"), None)

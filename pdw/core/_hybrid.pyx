@@ -34,6 +34,10 @@ cdef extern from "pdw_hybrid_sim.h":
         double dt_out
         int (*poll)(void *ctx) noexcept nogil
         void *poll_ctx
+        double dh
+        int (*ground)(const void *ctx, double s, double *h, double *slope) noexcept nogil
+        const void *ground_ctx
+        double max_slope
     ctypedef struct pdw_hybrid_result:
         int status
         double t0, s0
@@ -50,6 +54,7 @@ cdef extern from "pdw_hybrid_sim.h":
         double Fn_min, ratio_max
         long n_steps, n_rejected, n_rhs, n_rec
         int rec_full
+        double h_st, h_touch
     void pdw_hybrid_default_opts(pdw_hybrid_opts *o) noexcept nogil
     int pdw_hybrid_impact(const double *p, const double *y_minus, pdw_hybrid_result *r) noexcept nogil
     int pdw_hybrid_step(const double *p, const double *y0, double t0, double s0,
@@ -64,12 +69,78 @@ cdef extern from "pdw_hybrid_sim.h":
     int pdw_hybrid_step_jac(const double *p, const double *y0, const pdw_hybrid_opts *o,
                             pdw_hybrid_result *r, double *DP) noexcept nogil
     void pdw_hybrid_swing_foot_grad(const double *y, const double *p, double *g) noexcept nogil
+    int pdw_hybrid_step_sens(const double *p, const double *y0, const pdw_hybrid_opts *o,
+                             pdw_hybrid_result *r, double *DP, double *dym_dy0, double *dym_ddh,
+                             double *dT_dy0, double *dT_ddh) noexcept nogil
+    long pdw_hybrid_walk_dh(const double *p, const double *y0, long n_steps,
+                            const double *dh_seq, const pdw_hybrid_opts *o, double *y_out,
+                            double *t_out, int *status) noexcept nogil
+
+
+cdef extern from "pdw_ground.h":
+    ctypedef struct pdw_ground:
+        double s_min, s_max
+        long n_cells
+        const double *cells
+        const double *arc
+        long n_lut
+        double lut_inv
+        const long *lut
+        int n_patches, n_fields
+        const int *fields
+        const double *patches
+        double blend
+        int n_zones
+        const double *zones
+    void pdw_ground_eval(const pdw_ground *g, double s, double *out) noexcept nogil
+    int pdw_ground_inside(const pdw_ground *g, double s) noexcept nogil
+
+
+cdef int _ground_h(const void *ctx, double s, double *h, double *slope) noexcept nogil:
+    """The hybrid loop's ground hook over a compiled pdw.Ground (pdw_ground.h)."""
+    cdef double out[3]
+    cdef const pdw_ground *g = <const pdw_ground *> ctx
+    pdw_ground_eval(g, s, out)
+    h[0] = out[0]
+    if slope != NULL:
+        slope[0] = out[1]
+    return 0 if pdw_ground_inside(g, s) else 1
+
+
+cdef class GroundRef:
+    """A `pdw.core.ground_table.GroundTable`'s height cells as the C struct the hybrid loop
+    reads (its arrays kept alive here; patches are not used: the hybrid ground is rigid)."""
+    cdef pdw_ground g
+    cdef object keep
+
+    def __cinit__(self, table):
+        cells = np.ascontiguousarray(table.cells, dtype=np.float64)
+        lut = np.ascontiguousarray(table.lut, dtype=np.int_)
+        if cells.ndim != 2 or cells.shape[0] < 1 or lut.shape[0] < 1:
+            raise ValueError("a ground table needs at least one cell and one lookup bin")
+        self.keep = (cells, lut)
+        cdef double[:, ::1] vc = cells
+        cdef long[::1] vl = lut
+        memset(&self.g, 0, sizeof(self.g))
+        self.g.s_min = table.s_min
+        self.g.s_max = table.s_max
+        self.g.n_cells = cells.shape[0]
+        self.g.cells = &vc[0, 0]
+        self.g.n_lut = lut.shape[0]
+        self.g.lut_inv = table.lut_inv
+        self.g.lut = &vl[0]
+
+    def h(self, double s):
+        """(h, dh/ds, inside) at s, through the hook the loop calls."""
+        cdef double hh = 0.0, sl = 0.0
+        cdef int off = _ground_h(&self.g, s, &hh, &sl)
+        return hh, sl, not off
 
 
 NY = PDW_NHY
 NFOOT = PDW_NHYFOOT
 STATUS = ("ok", "no_strike", "fell", "singular", "nonfinite", "max_steps", "step_tiny",
-          "interrupted")
+          "interrupted", "tripped", "off_ground")
 cdef int _INTERRUPTED = 7
 
 
@@ -83,7 +154,7 @@ cdef int _py(const double[::1] p, const double[::1] y, str yname="y") except -1:
 
 
 OPTION_NAMES = ("rtol", "atol", "h0", "h_max", "t_max", "event_tol", "min_step_angle",
-                "fall_angle", "max_steps", "dt_out")
+                "fall_angle", "max_steps", "dt_out", "dh", "max_slope")
 
 
 def default_options():
@@ -96,7 +167,8 @@ def default_options():
 cdef dict _opts_dict(pdw_hybrid_opts *o):
     return {"rtol": o.rtol, "atol": o.atol, "h0": o.h0, "h_max": o.h_max, "t_max": o.t_max,
             "event_tol": o.event_tol, "min_step_angle": o.min_step_angle,
-            "fall_angle": o.fall_angle, "max_steps": o.max_steps, "dt_out": o.dt_out}
+            "fall_angle": o.fall_angle, "max_steps": o.max_steps, "dt_out": o.dt_out,
+            "dh": o.dh, "max_slope": o.max_slope}
 
 
 include "_poll.pxi"
@@ -110,10 +182,13 @@ cdef object _raised(list pending, partial=None):
         raise exc
 
 
-cdef void _fill_opts(pdw_hybrid_opts *o, dict opts, list pending) except *:
+cdef void _fill_opts(pdw_hybrid_opts *o, dict opts, list pending, GroundRef ground=None) except *:
     pdw_hybrid_default_opts(o)
     o.poll = _poll
     o.poll_ctx = <void *> pending
+    if ground is not None:
+        o.ground = _ground_h
+        o.ground_ctx = <const void *> &ground.g
     for k, v in opts.items():
         if k == "rtol": o.rtol = v
         elif k == "atol": o.atol = v
@@ -125,6 +200,8 @@ cdef void _fill_opts(pdw_hybrid_opts *o, dict opts, list pending) except *:
         elif k == "fall_angle": o.fall_angle = v
         elif k == "max_steps": o.max_steps = v
         elif k == "dt_out": o.dt_out = v
+        elif k == "dh": o.dh = v
+        elif k == "max_slope": o.max_slope = v
         else:
             raise ValueError("unknown hybrid option %r; allowed: %s" % (k, ", ".join(OPTION_NAMES)))
 
@@ -142,7 +219,7 @@ cdef dict _result_dict(pdw_hybrid_result *r):
         "step_length": r.step_length, "s0_next": r.s0_next, "E0": r.E0, "dE_max": r.dE_max,
         "Fn_min": r.Fn_min, "ratio_max": r.ratio_max,
         "n_steps": r.n_steps, "n_rejected": r.n_rejected, "n_rhs": r.n_rhs, "n_rec": r.n_rec,
-        "rec_full": bool(r.rec_full),
+        "rec_full": bool(r.rec_full), "h_st": r.h_st, "h_touch": r.h_touch,
     }
 
 
@@ -250,14 +327,15 @@ def solve(double[:, ::1] A, double[::1] b):
 
 @_named_buffers
 def step(const double[::1] p, const double[::1] y0, dict opts, double t0=0.0, double s0=0.0,
-         long rec_cap=0):
-    """One step of the hybrid map. Returns (result dict, rec_t, rec_y)."""
+         long rec_cap=0, GroundRef ground=None):
+    """One step of the hybrid map (on ``ground`` if given). Returns (result dict, rec_t,
+    rec_y)."""
     cdef pdw_hybrid_opts o
     cdef pdw_hybrid_result r
     _py(p, y0, "y0")
     _count("rec_cap", rec_cap, 0)
     cdef list pending = []
-    _fill_opts(&o, opts, pending)
+    _fill_opts(&o, opts, pending, ground)
     rec_t = _zeros("the record (rec_cap)", max(rec_cap, 1))
     rec_y = _zeros("the record (rec_cap)", (max(rec_cap, 1), PDW_NHY))
     cdef double[::1] vt = rec_t
@@ -295,8 +373,9 @@ def step_batch(const double[::1] p, const double[:, ::1] y0, dict opts, double[:
 
 @_named_buffers
 def walk(const double[::1] p, const double[::1] y0, double s0, long n_steps, dict opts,
-         long rec_cap):
-    """n_steps steps; returns (list of result dicts, rec_t, rec_y, rec_step)."""
+         long rec_cap, GroundRef ground=None):
+    """n_steps steps (on ``ground`` if given); returns (list of result dicts, rec_t, rec_y,
+    rec_step)."""
     cdef pdw_hybrid_opts o
     _py(p, y0, "y0")
     # both counts checked before a size is computed from them: n_steps * sizeof(...) cannot
@@ -304,7 +383,7 @@ def walk(const double[::1] p, const double[::1] y0, double s0, long n_steps, dic
     _count("n_steps", n_steps, 1)
     _count("rec_cap", rec_cap, 0)
     cdef list pending = []
-    _fill_opts(&o, opts, pending)
+    _fill_opts(&o, opts, pending, ground)
     results = _zeros("the step results of %d steps (n_steps)" % n_steps,
                      n_steps * <long>sizeof(pdw_hybrid_result), np.uint8)
     cdef unsigned char[::1] vr = results
@@ -406,3 +485,88 @@ def step_jac(const double[::1] p, const double[::1] y0, dict opts):
         d["status"] = STATUS[st] if 0 <= st < len(STATUS) else str(st)
         DP[:] = np.nan
     return d, DP
+
+
+@_named_buffers
+def step_sens(const double[::1] p, const double[::1] y0, dict opts):
+    """One step, its Jacobian and its sensitivities to the floor offset ``dh``: (result dict,
+    DP (4, 4), dym_dy0 (4, 4), dym_ddh (4,), dT_dy0 (4,), dT_ddh); NaN unless ok."""
+    cdef pdw_hybrid_opts o
+    cdef pdw_hybrid_result r
+    cdef int st
+    cdef double tdh = np.nan
+    _py(p, y0, "y0")
+    cdef list pending = []
+    _fill_opts(&o, opts, pending)
+    DP = np.full((PDW_NHY, PDW_NHY), np.nan)
+    Ym = np.full((PDW_NHY, PDW_NHY), np.nan)
+    ydh = np.full(PDW_NHY, np.nan)
+    Tg = np.full(PDW_NHY, np.nan)
+    cdef double[:, ::1] v = DP, vm = Ym
+    cdef double[::1] vd = ydh, vt = Tg
+    with nogil:
+        st = pdw_hybrid_step_sens(&p[0], &y0[0], &o, &r, &v[0, 0], &vm[0, 0], &vd[0], &vt[0],
+                                  &tdh)
+    _raised(pending)
+    d = _result_dict(&r)
+    if st != 0:
+        d["status"] = STATUS[st] if 0 <= st < len(STATUS) else str(st)
+        for a in (DP, Ym, ydh, Tg):
+            a[...] = np.nan
+        tdh = np.nan
+    return d, DP, Ym, ydh, Tg, tdh
+
+
+@_named_buffers
+def walk_dh_batch(const double[::1] p, const double[:, ::1] y0, const double[:, ::1] dh,
+                  dict opts, long[::1] n_done, int[::1] status, double[:, ::1] y_last,
+                  double[::1] t_sum, list grounds=None):
+    """Walker i walks from y0[i] with the floor offsets dh[i, :] (one per step) until a step
+    fails or the row ends: n_done[i] completed steps, status[i] (0: none failed), y_last[i]
+    the state after its last completed step (y0[i] if none), t_sum[i] their duration [s]."""
+    cdef pdw_hybrid_opts o
+    cdef Py_ssize_t i, j, n = y0.shape[0], K = dh.shape[1]
+    _len("p", p.shape[0], PDW_NP)
+    _rows("y0", n, y0.shape[1], n, PDW_NHY)
+    _rows("dh", dh.shape[0], K, n, K)
+    _rows("y_last", y_last.shape[0], y_last.shape[1], n, PDW_NHY)
+    _len("n_done", n_done.shape[0], n)
+    _len("status", status.shape[0], n)
+    _len("t_sum", t_sum.shape[0], n)
+    if K < 1:
+        raise ValueError("dh must have at least one column")
+    cdef list pending = []
+    _fill_opts(&o, opts, pending)
+    if grounds is not None and len(grounds) != n:
+        raise ValueError("grounds must list %d GroundRef, got %d" % (n, len(grounds)))
+    gbuf = np.zeros(max(n, 1), dtype=np.uintp)
+    cdef size_t[::1] vg = gbuf
+    cdef GroundRef gr
+    cdef int has_g = grounds is not None
+    if has_g:
+        for i in range(n):
+            gr = grounds[i]
+            vg[i] = <size_t> &gr.g
+    yo = np.empty((K, PDW_NHY))
+    to = np.empty(K)
+    cdef double[:, ::1] vy = yo
+    cdef double[::1] vt = to
+    cdef long k, m
+    cdef double ts
+    with nogil:
+        for i in range(n):
+            if has_g:
+                o.ground = _ground_h
+                o.ground_ctx = <const void *> vg[i]
+            m = pdw_hybrid_walk_dh(&p[0], &y0[i, 0], K, &dh[i, 0], &o, &vy[0, 0], &vt[0],
+                                   &status[i])
+            n_done[i] = m
+            ts = 0.0
+            for k in range(m):
+                ts += vt[k]
+            t_sum[i] = ts
+            for j in range(PDW_NHY):
+                y_last[i, j] = vy[m - 1, j] if m > 0 else y0[i, j]
+            if status[i] == _INTERRUPTED:
+                break
+    _raised(pending)

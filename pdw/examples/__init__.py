@@ -1,7 +1,8 @@
 """Example scenes and study files shipped with pdw (package data).
 
 ``pdw run --example NAME`` runs a scene, ``pdw sweep --example NAME`` a study,
-``pdw continue --example NAME`` a continuation (``continuations/*.toml``, docs/continuation.md);
+``pdw continue --example NAME`` a continuation (``continuations/*.toml``, docs/continuation.md),
+``pdw robustness --example NAME`` a robustness measure (``robustness/*.toml``, docs/robustness.md);
 ``--list-examples`` lists them. In Python: `scene_path`, `study_path`, `scenes`, `studies`.
 
 Scenes (``*.toml`` here) are `pdw.Scene` files (docs/scenes.md); studies (``studies/*.toml``)
@@ -45,6 +46,16 @@ def continuations() -> list:
 def continuation_path(name: str) -> pathlib.Path:
     """Path of the example continuation ``name`` (e.g. ``"compass_cascade"``)."""
     return _path(HERE / "continuations", continuations(), "continuation", name)
+
+
+def robustness_specs() -> list:
+    """Names of the example robustness specs (docs/robustness.md)."""
+    return _names(HERE / "robustness")
+
+
+def robustness_path(name: str) -> pathlib.Path:
+    """Path of the example robustness spec ``name`` (e.g. ``"max_step_k_hip"``)."""
+    return _path(HERE / "robustness", robustness_specs(), "robustness spec", name)
 
 
 def scene_path(name: str) -> pathlib.Path:

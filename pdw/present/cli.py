@@ -39,6 +39,7 @@ from ..core.provenance import provenance
 from ..sim.gait import steps
 from ..sim.scene import PRESETS, Scene
 from .cli_continue import add_cli as add_continue_cli
+from .cli_robustness import add_cli as add_robustness_cli
 from .cli_sweep import add_cli as add_sweep_cli
 from .deps import EXTRAS, MissingDependency, missing_extra, require  # noqa: F401 (cli.EXTRAS)
 from .report import walk_report
@@ -218,6 +219,7 @@ def _parser():
     r.add_argument("--out", help="also write steps.csv, run.json and scene.toml to this folder")
     add_sweep_cli(sub)                          # ``pdw sweep STUDY.toml`` (cli_sweep.py)
     add_continue_cli(sub)                       # ``pdw continue SPEC.toml`` (cli_continue.py)
+    add_robustness_cli(sub)                     # ``pdw robustness SPEC.toml`` (cli_robustness.py)
     return ap
 
 

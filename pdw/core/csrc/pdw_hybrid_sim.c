@@ -32,6 +32,10 @@ void pdw_hybrid_default_opts(pdw_hybrid_opts *o)
     o->dt_out = 0.0;
     o->poll = NULL;
     o->poll_ctx = NULL;
+    o->dh = 0.0;
+    o->ground = NULL;
+    o->ground_ctx = NULL;
+    o->max_slope = 1.0;
 }
 
 /* ---- Dormand-Prince 5(4) ---------------------------------------------------------------- */
@@ -210,10 +214,29 @@ static void ground_check(const double *p, const double *y, const double *dy,
     if (ratio > r->ratio_max) r->ratio_max = ratio;
 }
 
-static int armed_now(const double *foot, const double *y, const pdw_hybrid_opts *o, int armed)
+/* the heel-strike event function: the swing foot's height above the ground under it,
+ * y_sw - level (pdw_hybrid_opts); with dh = 0 and no ground exactly y_sw */
+typedef struct floor_ctx {
+    const pdw_hybrid_opts *o;
+    double s0, h_st;
+} floor_ctx;
+
+static double gap(const floor_ctx *F, const double *foot, double *slope)
+{
+    double level = F->o->dh;
+    if (F->o->ground) {
+        double h = 0.0;
+        F->o->ground(F->o->ground_ctx, F->s0 + foot[PDW_HYFOOT_X_SW], &h, slope);
+        level += h - F->h_st;
+    }
+    return foot[PDW_HYFOOT_Y_SW] - level;
+}
+
+static int armed_now(const floor_ctx *F, const double *foot, const double *y,
+                     const pdw_hybrid_opts *o, int armed)
 {
     if (foot[PDW_HYFOOT_X_SW] <= foot[PDW_HYFOOT_X_ST]) return 0;
-    if (foot[PDW_HYFOOT_Y_SW] > 0.0
+    if (gap(F, foot, NULL) > 0.0
         && y[PDW_HY_THETA_SW] - y[PDW_HY_THETA_ST] >= o->min_step_angle) return 1;
     return armed;
 }
@@ -233,6 +256,12 @@ int pdw_hybrid_step(const double *p, const double *y0, double t0, double s0,
     memcpy(r->y0, y0, sizeof r->y0);
     memcpy(y, y0, sizeof y);
     r->status = PDW_HYBRID_OK;
+    floor_ctx F = {o, s0, 0.0};
+    int off = 0;
+    if (o->ground)
+        off = o->ground(o->ground_ctx, s0 - p[PDW_P_R]*y0[PDW_HY_THETA_ST], &F.h_st, NULL);
+    r->h_st = F.h_st;
+    if (off) { r->status = PDW_HYBRID_OFF_GROUND; return r->status; }
     if (o->poll && o->poll(o->poll_ctx)) { r->status = PDW_HYBRID_INTERRUPTED; return r->status; }
     if (!finite4(y)) { r->status = PDW_HYBRID_NONFINITE; return r->status; }
     f(&S, y, k1);
@@ -241,7 +270,7 @@ int pdw_hybrid_step(const double *p, const double *y0, double t0, double s0,
     r->ratio_max = 0.0;
     ground_check(p, y, k1, r);
     pdw_hybrid_swing_foot(y, p, foot);
-    armed = armed_now(foot, y, o, 0);
+    armed = armed_now(&F, foot, y, o, 0);
     rec_push(&R, t0, y);
     for (;;) {
         if (r->n_steps >= o->max_steps) { r->status = PDW_HYBRID_MAX_STEPS; break; }
@@ -269,9 +298,10 @@ int pdw_hybrid_step(const double *p, const double *y0, double t0, double s0,
         r->n_steps++;
         pdw_hybrid_swing_foot(ynew, p, foot_new);
         /* heel strike inside this step? */
-        if (armed && foot[PDW_HYFOOT_Y_SW] > 0.0 && foot_new[PDW_HYFOOT_Y_SW] <= 0.0
+        const double g_old = gap(&F, foot, NULL), g_new = gap(&F, foot_new, NULL);
+        if (armed && g_old > 0.0 && g_new <= 0.0
             && foot_new[PDW_HYFOOT_X_SW] > foot_new[PDW_HYFOOT_X_ST]) {
-            double a = 0.0, b = h, ga = foot[PDW_HYFOOT_Y_SW], gb = foot_new[PDW_HYFOOT_Y_SW];
+            double a = 0.0, b = h, ga = g_old, gb = g_new;
             double yb[NY], kb[NY], ys[NY], ks[NY], fs[PDW_NHYFOOT];
             int side = 0;
             memcpy(yb, ynew, sizeof yb);
@@ -280,7 +310,7 @@ int pdw_hybrid_step(const double *p, const double *y0, double t0, double s0,
                 if (!(tau > a && tau < b)) tau = 0.5*(a + b);
                 dopri(&S, y, k1, tau, ys, ks, NULL);
                 pdw_hybrid_swing_foot(ys, p, fs);
-                const double g = fs[PDW_HYFOOT_Y_SW];
+                const double g = gap(&F, fs, NULL);
                 if (g > 0.0) {
                     a = tau; ga = g;
                     if (side == -1) gb *= 0.5;
@@ -307,6 +337,16 @@ int pdw_hybrid_step(const double *p, const double *y0, double t0, double s0,
             r->x_touch = s0 + foot[PDW_HYFOOT_X_SW];
             r->step_length = r->x_touch - (s0 - p[PDW_P_R]*y0[PDW_HY_THETA_ST]);
             r->s0_next = r->x_touch + p[PDW_P_R]*y[PDW_HY_THETA_SW];
+            r->h_touch = r->h_st + o->dh;
+            if (o->ground) {
+                double slope = 0.0, h = 0.0;
+                if (o->ground(o->ground_ctx, r->x_touch, &h, &slope)) {
+                    r->status = PDW_HYBRID_OFF_GROUND;
+                    break;
+                }
+                r->h_touch = h + o->dh;
+                if (fabs(slope) > o->max_slope) { r->status = PDW_HYBRID_TRIPPED; break; }
+            }
             r->status = pdw_hybrid_impact(p, y, r);
             break;
         }
@@ -315,7 +355,7 @@ int pdw_hybrid_step(const double *p, const double *y0, double t0, double s0,
         memcpy(y, ynew, sizeof y);
         memcpy(k1, k7, sizeof k1);
         memcpy(foot, foot_new, sizeof foot);
-        armed = armed_now(foot, y, o, armed);
+        armed = armed_now(&F, foot, y, o, armed);
         ground_check(p, y, k1, r);
         const double dE = fabs(energy(p, y) - r->E0);
         if (dE > r->dE_max) r->dE_max = dE;
@@ -355,6 +395,27 @@ long pdw_hybrid_walk(const double *p, const double *y0, double s0, long n_steps,
         t += r->t_strike;
         s = r->s0_next;
         memcpy(y, r->y_plus, sizeof y);
+    }
+    return n_steps;
+}
+
+long pdw_hybrid_walk_dh(const double *p, const double *y0, long n_steps, const double *dh_seq,
+                        const pdw_hybrid_opts *o, double *y_out, double *t_out, int *status)
+{
+    pdw_hybrid_opts ok = *o;
+    pdw_hybrid_result r;
+    double y[NY], s = 0.0;
+    memcpy(y, y0, sizeof y);
+    *status = PDW_HYBRID_OK;
+    for (long k = 0; k < n_steps; ++k) {
+        ok.dh = dh_seq[k];
+        pdw_hybrid_step(p, y, 0.0, s, &ok, &r, NULL, NULL, 0);
+        s = r.s0_next;
+        if (r.status == PDW_HYBRID_OK && r.old_foot_down) r.status = PDW_HYBRID_FELL;
+        if (r.status != PDW_HYBRID_OK) { *status = r.status; return k; }
+        memcpy(y, r.y_plus, sizeof y);
+        memcpy(y_out + NY*k, y, sizeof y);
+        t_out[k] = r.t_strike;
     }
     return n_steps;
 }

@@ -34,6 +34,22 @@ typedef struct pdw_hybrid_opts {
                                  right-hand sides within it (NULL: never); nonzero stops the
                                  step with PDW_HYBRID_INTERRUPTED (Ctrl-C) */
     void *poll_ctx;
+    /* The ground (docs/hybrid.md, "On a shaped ground"). Heel strike is when the armed swing
+     * foot's contact point reaches the ground under it: y_sw = level, with
+     *   level = dh + (ground ? h(s0 + x_sw) - h_st : 0),
+     * h_st the ground's height at the stance foot's touch-down point; the stance foot rolls on
+     * the mean slope plane at its own level. dh = 0 and ground = NULL: flat, bitwise the
+     * model without these fields. */
+    double dh;                /* ground under the swing foot relative to the stance foot's
+                                 level for the whole step [m] (a step-down: dh < 0) */
+    int (*ground)(const void *ctx, double s, double *h, double *slope);
+                              /* height h(s) [m] above the mean slope plane at s [m] into *h,
+                                 dh/ds into *slope when slope != NULL; returns nonzero when s
+                                 is outside the ground's defined extent (a strike or a stance
+                                 there stops the step: PDW_HYBRID_OFF_GROUND); NULL: flat */
+    const void *ground_ctx;
+    double max_slope;         /* a strike where |dh/ds| > max_slope is a trip (the foot hit
+                                 a riser): status PDW_HYBRID_TRIPPED */
 } pdw_hybrid_opts;
 
 enum { PDW_HYBRID_POLL_RHS = 4096 };
@@ -46,7 +62,9 @@ enum {
     PDW_HYBRID_NONFINITE = 4,     /* NaN or infinity */
     PDW_HYBRID_MAX_STEPS = 5,     /* max_steps integrator steps without heel strike */
     PDW_HYBRID_STEP_TINY = 6,     /* step size underflow */
-    PDW_HYBRID_INTERRUPTED = 7    /* opts->poll asked to stop (Ctrl-C) */
+    PDW_HYBRID_INTERRUPTED = 7,   /* opts->poll asked to stop (Ctrl-C) */
+    PDW_HYBRID_TRIPPED = 8,       /* the swing foot struck a riser (|dh/ds| > max_slope) */
+    PDW_HYBRID_OFF_GROUND = 9     /* a foot outside the ground's defined extent */
 };
 
 typedef struct pdw_hybrid_result {
@@ -73,10 +91,13 @@ typedef struct pdw_hybrid_result {
     long n_steps, n_rejected, n_rhs;
     long n_rec;                 /* samples written to the record buffers */
     int rec_full;               /* 1 if the record buffer filled up */
+    double h_st;                /* ground height under the stance foot's touch-down point [m] */
+    double h_touch;             /* ground height under the new footprint [m] */
 } pdw_hybrid_result;
 
 /* Default options (rtol 1e-10, atol 1e-12, h0 1e-3 s, h_max 0.01 s, t_max 5 s,
- * event_tol 1e-13 s, min_step_angle 0.1 rad, fall_angle 1.4 rad, max_steps 100000, dt_out 0).
+ * event_tol 1e-13 s, min_step_angle 0.1 rad, fall_angle 1.4 rad, max_steps 100000, dt_out 0,
+ * dh 0, ground NULL, max_slope 1).
  * min_step_angle > 0 excludes the degenerate "gait" in which the swing leg barely passes the
  * stance leg and swings back onto the ground next to the stance foot (zero step length). */
 void pdw_hybrid_default_opts(pdw_hybrid_opts *o);
@@ -114,5 +135,21 @@ int pdw_hybrid_rhs_jac(const double *y, const double *p, double *ydot, double *A
 int pdw_hybrid_impact_jac(const double *p, const double *ym, double *D);
 int pdw_hybrid_step_jac(const double *p, const double *y0, const pdw_hybrid_opts *o,
                         pdw_hybrid_result *r, double *DP);
+
+/* As pdw_hybrid_step_jac, and the sensitivities of the pre-impact state and the strike time
+ * to the initial state and to the floor offset o->dh (the disturbance of the gait
+ * sensitivity norm): dym_dy0 = S Phi(T) (4x4), dym_ddh = f / (grad g . f) (4),
+ * dT_dy0 = -grad g Phi / (grad g . f) (4), *dT_ddh = 1 / (grad g . f). A ground function
+ * (o->ground) is refused (PDW_HYBRID_SINGULAR): its slope would enter the event. */
+int pdw_hybrid_step_sens(const double *p, const double *y0, const pdw_hybrid_opts *o,
+                         pdw_hybrid_result *r, double *DP, double *dym_dy0, double *dym_ddh,
+                         double *dT_dy0, double *dT_ddh);
+
+/* n_steps steps from y0 (s0 = 0, on o->ground if set) with the floor offset dh_seq[k] at
+ * step k (o->dh ignored; a failed step, or one whose old foot does not leave, ends the walk);
+ * y_out (n_steps x 4) the post-impact states, t_out (n_steps) the stance durations. Returns
+ * the completed steps; *status the failing step's status (PDW_HYBRID_OK if none). */
+long pdw_hybrid_walk_dh(const double *p, const double *y0, long n_steps, const double *dh_seq,
+                        const pdw_hybrid_opts *o, double *y_out, double *t_out, int *status);
 
 #endif /* PDW_HYBRID_SIM_H */

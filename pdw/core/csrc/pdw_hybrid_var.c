@@ -154,7 +154,15 @@ static int dopri_aug(const double *p, const double *u, const double *k1, double 
 int pdw_hybrid_step_jac(const double *p, const double *y0, const pdw_hybrid_opts *o,
                         pdw_hybrid_result *r, double *DP)
 {
+    return pdw_hybrid_step_sens(p, y0, o, r, DP, NULL, NULL, NULL, NULL);
+}
+
+int pdw_hybrid_step_sens(const double *p, const double *y0, const pdw_hybrid_opts *o,
+                         pdw_hybrid_result *r, double *DP, double *dym_dy0, double *dym_ddh,
+                         double *dT_dy0, double *dT_ddh)
+{
     double u[NA], k1[NA], un[NA], k7[NA], err[NA];
+    if (o->ground) return PDW_HYBRID_SINGULAR;
     pdw_hybrid_step(p, y0, 0.0, 0.0, o, r, NULL, NULL, 0);
     if (r->status != PDW_HYBRID_OK) return r->status;
     const double T = r->t_strike;
@@ -208,6 +216,17 @@ int pdw_hybrid_step_jac(const double *p, const double *y0, const pdw_hybrid_opts
             double s = 0.0;
             for (int k = 0; k < NY; ++k) s += S[i*4 + k]*Phi[k*4 + j];
             SPhi[i*4 + j] = s;
+        }
+    /* the event g(y) - dh = 0 (o->dh a constant): dT = (d dh - grad g Phi dy0) / (grad g . f),
+     * dy- = Phi dy0 + f dT */
+    if (dym_dy0) memcpy(dym_dy0, SPhi, sizeof SPhi);
+    if (dym_ddh) for (int i = 0; i < NY; ++i) dym_ddh[i] = f[i] / gf;
+    if (dT_ddh) *dT_ddh = 1.0 / gf;
+    if (dT_dy0)
+        for (int j = 0; j < NY; ++j) {
+            double s = 0.0;
+            for (int k = 0; k < NY; ++k) s += g[k]*Phi[k*4 + j];
+            dT_dy0[j] = -s / gf;
         }
     if (pdw_hybrid_impact_jac(p, r->y_minus, D)) return PDW_HYBRID_SINGULAR;
     for (int i = 0; i < NY; ++i)

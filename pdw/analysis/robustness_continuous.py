@@ -1,0 +1,232 @@
+"""The robustness measures for the continuous (compliant) model (docs/robustness.md, "The
+compliant model"): the step or the rough ground is a `pdw.Ground` under `pdw.simulate`.
+
+* The gait: `pdw.find_gait` (the touch-down section; leg 2 has just touched down at s = 0,
+  flags (1, 1)). A walk starts there with ``flags0=(1, 1)``; its steps are `pdw.steps` of the
+  run (``L`` footprint spacing, ``cycle`` touch-down to touch-down).
+* A step of height H: ``Ground.step(edge, -H or +H)`` with the edge halfway between the stance
+  foot (s = 0) and the gait's next footprint (s = L), smoothed over ``edge_width``.
+* The trials of a `max_step` round are the walkers of one `pdw.simulate_batch` (each walker
+  its own step ground; bitwise its `pdw.simulate` run), and so are the walkers of a chunk of
+  `first_passage` (each its own random ground). The batch keeps each walker's last
+  `STEP_RING` steps (`BatchResult.steps`), which is what "returned" looks at.
+* The gait sensitivity norm: central differences of the touch-down map in the section
+  coordinates and in the floor heights, at two steps (h and h/2); a warning when the two norms
+  differ by more than ``rel_check``. The state is augmented by the previous step's floor
+  height: during the double support the trailing foot still stands on it, so on compliant
+  ground a disturbance acts on two steps (tested against the summed response of a walk). (An exact monodromy of the compliant model is not in this
+  tree; these are finite differences, and the docs say so.)
+"""
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..core.errors import InvalidInputError
+from ..core.ground import Ground
+from ..sim.batch import simulate_batch
+from ..sim.gait import steps as _steps
+from ..sim.options import Integrator, Limits
+from ..sim.simulation import simulate
+from . import limit_cycle as _lc
+from . import robustness_core as _rb
+
+#: integrator tolerances of the walks (rodas4)
+WALK = dict(method="rodas4", rtol=1e-8, atol=1e-10)
+#: the options of a walk that are fields of `pdw.Integrator` (the rest go to simulate as given)
+_INTEGRATOR = ("method", "rtol", "atol", "h_max", "event_tol", "max_steps", "check_step")
+
+
+def _run_kw(options):
+    """WALK updated by ``options``, its integrator settings as one `pdw.Integrator`."""
+    kw = {**WALK, **options}
+    it = {k: kw.pop(k) for k in _INTEGRATOR if k in kw}
+    return dict(kw, integrator=Integrator(**it))
+
+
+def continuous_gait(params, gait=None):
+    """The continuous model's period-one gait (`pdw.find_gait`), checked."""
+    if gait is None:
+        return _lc.find_gait(params)
+    if getattr(gait, "model", None) != "continuous":
+        raise InvalidInputError("gait must be a continuous pdw.Gait (pdw.find_gait), got %r"
+                                % (gait,))
+    return gait
+
+
+def batch(params, gait, grounds, n_steps, *, threads=2, executor=None, **options):
+    """`pdw.simulate_batch` of len(grounds) walkers from the gait's touch-down state, walker i
+    on grounds[i], for ``n_steps`` gait periods and a half (as `walk`)."""
+    n = len(grounds)
+    x0 = np.repeat(np.asarray(gait.state, dtype=float)[None, :], n, axis=0)
+    kw = _run_kw(options)
+    return simulate_batch(x0, t_end=(n_steps + 1.5) * gait.period, params=params,
+                          flags0=(1, 1), threads=threads, executor=executor, ground=list(grounds),
+                          **kw)
+
+
+def walk(params, gait, ground, n_steps, **options):
+    """Walk ``n_steps`` steps from the gait's touch-down state on ``ground``: (status, L (k,),
+    T (k,)), the step lengths [m] and touch-down-to-touch-down times [s] of the complete steps
+    (the first is the step from the gait's state)."""
+    t_end = (n_steps + 1.5) * gait.period
+    kw = _run_kw(options)
+    res = simulate(np.asarray(gait.state, dtype=float), t_end=t_end, params=params,
+                   flags0=(1, 1), limits=Limits(on_failure="return"), ground=ground, **kw)
+    st = _steps(res)
+    L = np.asarray(st["L"], dtype=float)
+    T = np.asarray(st["cycle"], dtype=float)
+    # pdw.steps skips the run's first step (its stance foot's touch-down, at t = 0, is not an
+    # event of the run): it is the first touch-down, its footprint measured from the stance
+    # foot's contact point at s = 0 (the section's frame)
+    td = next((e for e in res.events if e.kind == "touch_down"), None)
+    if td is not None and (len(T) == 0 or td.t < st["t_touch_down"][0] - 0.5 * gait.period):
+        L = np.concatenate([[td.x_D], L])
+        T = np.concatenate([[td.t], T])
+    return res.status, L, T
+
+
+def edge_at(gait):
+    """The step edge's position [m]: halfway from the stance foot (s = 0) to the next
+    footprint."""
+    return 0.5 * gait.step_length
+
+
+@dataclass
+class _Trials:
+    gait: Any
+    fn: Any
+
+    def __call__(self, heights):
+        return self.fn(heights)
+
+
+def step_trials_fn(params, *, direction, budget, return_tol, gait=None, executor=None,
+                   ground=None, threads=2, edge_width=0.01, **options):
+    """The trial function of `max_step` for the continuous model: heights -> trial dicts."""
+    if ground is not None:
+        raise InvalidInputError("max_step(model='continuous') builds its own step ground; "
+                                "ground must be None")
+    gait = continuous_gait(params, gait)
+    sign = -1.0 if direction == "down" else 1.0
+    edge = edge_at(gait)
+
+    def run(heights):
+        hs = [float(h) for h in heights]
+        b = batch(params, gait, [Ground.step(edge, sign * h, width=edge_width) for h in hs],
+                  budget + 1, threads=threads, executor=executor, **options)
+        out = []
+        for i, h in enumerate(hs):
+            n = int(b.n_touch_down[i])          # steps taken (each ends in a touch-down)
+            surv = b.status[i] in ("walked", "periodic") and n >= budget
+            ret, k = False, -1
+            if surv:
+                st = b.steps(i)                 # the last STEP_RING complete steps
+                ret, k = _rb.returned(st["L"], st["cycle"], gait.step_length, gait.period,
+                                      return_tol)
+                k = k + n - len(st) if ret else -1
+            out.append(dict(height=h, survived=bool(surv), returned=bool(ret),
+                            steps_to_return=int(k), status=str(b.status[i])))
+        return out
+
+    return _Trials(gait=gait, fn=run)
+
+
+def _section_step(z, params, ground, **options):
+    """One touch-down map step from section point z on ``ground`` (`pdw.analysis.poincare.step`,
+    its tight tolerances): (z', touch-down-to-touch-down time [s], step length [m])."""
+    from .poincare import step
+
+    out = step(z, params, ground=ground, **options)
+    if out["status"] != "ok":
+        raise InvalidInputError("gait_sensitivity (continuous): a finite-difference step "
+                                "failed (%s)" % out["status"])
+    return out["z"], out["period"], out["step_length"]
+
+
+def gait_sensitivity(params, names, *, gait=None, fd_step=1e-6, rel_check=1e-3, **options):
+    """The gait sensitivity norm of the continuous model by central differences (step time and
+    step length indicators), cross-checked at two steps."""
+    for n in names:
+        if n not in ("step_time", "step_length", "speed"):
+            raise InvalidInputError("gait_sensitivity(model='continuous') takes the indicators "
+                                    "step_time, step_length, speed; got %r" % n)
+    gait = continuous_gait(params, gait)
+    z0 = np.asarray(gait.details["z"], dtype=float)
+    edge = edge_at(gait)
+
+    def F(z, e_prev, e):
+        g = None
+        if e_prev != 0.0 or e != 0.0:       # trailing foot's ground, the stance's, the landing's
+            g = Ground.steps([-edge, edge], [e_prev, e], width=0.01, offset=-e_prev)
+        zn, T, L = _section_step(z, params, g, **options)
+        v = {"step_time": T, "step_length": L, "speed": L / T}
+        return np.concatenate([zn, [v[n] for n in names]])
+
+    def system(h):
+        """The augmented linear system in x = (z, e_prev): the disturbance of the previous
+        step stays under the trailing foot during the double support, so it enters the next
+        step too (a compliant-ground effect the hybrid model does not have)."""
+        nz = len(z0)
+        cols = []
+        for j in range(nz + 2):
+            dz = np.zeros(nz)
+            if j < nz:
+                dz[j] = h
+                a, b = F(z0 + dz, 0.0, 0.0), F(z0 - dz, 0.0, 0.0)
+            elif j == nz:
+                a, b = F(z0, h, 0.0), F(z0, -h, 0.0)
+            else:
+                a, b = F(z0, 0.0, h), F(z0, 0.0, -h)
+            cols.append((a - b) / (2 * h))
+        J = np.array(cols).T                 # rows: z' (nz), indicators; cols: z, e_prev, e
+        A = np.zeros((nz + 1, nz + 1))
+        A[:nz, :nz + 1] = J[:nz, :nz + 1]
+        B = np.zeros((nz + 1, 1))
+        B[:nz, 0] = J[:nz, nz + 1]
+        B[nz, 0] = 1.0                       # e becomes the next step's e_prev
+        C = J[nz:, :nz + 1]
+        D = J[nz:, nz + 1:]
+        return A, B, C, D
+
+    A, B, C, D = system(fd_step)
+    norm = _rb.h2_norm(A, B, C, D)
+    A2, B2, C2, D2 = system(0.5 * fd_step)
+    norm2 = _rb.h2_norm(A2, B2, C2, D2)
+    rel = abs(norm - norm2) / max(abs(norm), 1e-300)
+    if rel > rel_check:
+        warnings.warn("gait_sensitivity (continuous): the finite-difference norms at steps %g "
+                      "and %g differ by %.2g (relative): the linearization is not resolved"
+                      % (fd_step, 0.5 * fd_step, rel), stacklevel=3)
+    per = {n: _rb.h2_norm(A, B, C[i:i + 1], D[i:i + 1]) for i, n in enumerate(names)}
+    return _rb.GaitSensitivity(norm=norm, per_indicator=per, indicators=tuple(names), A=A, B=B,
+                               C=C, D=D, method="fd",
+                               check={"fd_norm_half_step": norm2, "rel_diff": rel,
+                                      "fd_step": fd_step}, gait=gait)
+
+
+def walker_ground(ground, seed, i, max_steps, step_length):
+    """Walker i's own random ground: ``ground`` with seed ``seed + i``, defined from -2 m to
+    1.25 (max_steps + 4) step lengths (a walker still walking when it leaves the extent is
+    censored there, never extrapolated)."""
+    spec = dict(ground.spec)
+    ext = (-2.0, 1.25 * (max_steps + 4) * step_length)
+    return Ground.random(spec["sigma"], spec["correlation"], seed=int(seed) + int(i),
+                         modes=spec["modes"], offset=ground.offset, extent=ext)
+
+
+def chunk(params, gait, ground, seed, lo, hi, max_steps, options):
+    """Walkers lo..hi-1 of the continuous model on their own random grounds: (steps, failed,
+    status), as `pdw.analysis.first_passage._hybrid_chunk` (module level: executors take it).
+    One `pdw.simulate_batch` (a ground per walker). A walker's first-passage time counts its
+    steps (touch-downs) plus the failing one; one that walks ``max_steps`` steps, or leaves its
+    ground's extent, is censored at its steps."""
+    grounds = [walker_ground(ground, seed, i, max_steps, gait.step_length) for i in range(lo, hi)]
+    b = batch(params, gait, grounds, max_steps, threads=1, **options)
+    n = np.asarray(b.n_touch_down, dtype=np.int64)      # steps taken
+    fell = ~np.isin(b.status, ("walked", "periodic", "off_ground"))
+    steps = np.where(fell, np.minimum(n + 1, max_steps), np.minimum(n, max_steps))
+    return steps, fell, np.where(fell, b.status, "ok")
