@@ -16,6 +16,7 @@ void pdw_terrain_kinematics(const pdw_kernel *k, const pdw_ground *g, const doub
         gi[PDW_GROUND_H] = e[0];
         gi[PDW_GROUND_DH] = e[1];
         gi[PDW_GROUND_DDH] = e[2];
+        gi[PDW_GROUND_INV_N] = 1.0 / sqrt(1.0 + e[1]*e[1]);
         if (k->variant == 1) {          /* consistent: the rolling coordinate needs sigma, alpha */
             gi[PDW_GROUND_SIGMA] = pdw_ground_arc(g, sA[i]);
             gi[PDW_GROUND_ALPHA] = atan(e[1]);
