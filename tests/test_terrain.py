@@ -86,6 +86,9 @@ def test_a_patch_everywhere_is_the_changed_parameter():
     assert np.array_equal(a.x_final, b.x_final)
     c = pdw.simulate(params=P, ground=Ground.plane(0.0), **kw)
     assert not np.array_equal(a.x_final, c.x_final)
+    far = pdw.simulate(params=P, ground=Ground.plane(0.0).with_patches(
+        [dict(s_a=20.0, s_b=21.0, k_n=2e5)]), **kw)       # a patch the feet never reach
+    assert np.array_equal(far.x_final, c.x_final)
 
 
 def _contact_s(x):

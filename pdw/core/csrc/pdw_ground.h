@@ -103,6 +103,16 @@ static inline void pdw_ground_params(const pdw_ground *g, double s, const double
     }
 }
 
+/* Does any patch reach s (a nonzero window)? */
+static inline int pdw_ground_patched(const pdw_ground *g, double s)
+{
+    for (int i = 0; i < g->n_patches; ++i) {
+        const double *row = g->patches + i*(2 + g->n_fields);
+        if (s > row[0] - 0.5*g->blend && s < row[1] + 0.5*g->blend) return 1;
+    }
+    return 0;
+}
+
 /* The blend zone of s: the number of zone boundaries <= s (a change is an event). */
 static inline int pdw_ground_zone(const pdw_ground *g, double s)
 {
