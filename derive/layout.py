@@ -82,6 +82,7 @@ GROUND = (
     "ddh",      # h''(s) [1/m]
     "sigma",    # arc length of the surface from s_min [m] (the consistent variant's anchor)
     "alpha",    # surface angle atan(h') [rad]
+    "inv_n",    # 1/N = 1/sqrt(1 + h'^2), computed once per foot and evaluation [-]
 )
 
 # Energies (docs/model.md section 3).

@@ -55,7 +55,7 @@ def ground_kinematics(foot: int, variant: str) -> dict:
     th, thd = mdl.Q[2 + foot], mdl.QD[2 + foot]
     g = GND[foot]
     h, dh = g["h"], g["dh"]
-    N = sp.sqrt(1 + dh ** 2)
+    N = 1 / g["inv_n"]              # sqrt(1 + h'^2), its inverse sampled once with the ground
     xa, ya = xo + (l - r) * sp.sin(th), yo - (l - r) * sp.cos(th)
     xad, yad = xdo + (l - r) * sp.cos(th) * thd, ydo + (l - r) * sp.sin(th) * thd
     vn = (-dh * xad + yad) / N
@@ -83,7 +83,7 @@ def ground_forces(foot: int):
     components at D, and the moment r (y - n) x F of moving them from D to C."""
     r = mdl.P["r"]
     dh = GND[foot]["dh"]
-    N = sp.sqrt(1 + dh ** 2)
+    N = 1 / GND[foot]["inv_n"]
     fn, ft = mdl.F_N[foot], mdl.F_T[foot]
     fx = (ft - dh * fn) / N
     fy = (dh * ft + fn) / N
@@ -92,10 +92,10 @@ def ground_forces(foot: int):
 
 def _ground_slopes(g):
     """d/ds of each sampled ground value (the chain rule through s_A): h' , h'', sigma' = N,
-    alpha' = h''/(1 + h'^2); h'' itself does not enter the kinematics."""
-    dh, ddh = g["dh"], g["ddh"]
-    return {"h": dh, "dh": ddh, "sigma": sp.sqrt(1 + dh ** 2), "alpha": ddh / (1 + dh ** 2),
-            "ddh": sp.S.Zero}
+    alpha' = h''/N^2, (1/N)' = -h' h''/N^3; h'' itself does not enter the kinematics."""
+    dh, ddh, inv_n = g["dh"], g["ddh"], g["inv_n"]
+    return {"h": dh, "dh": ddh, "sigma": 1 / inv_n, "alpha": ddh * inv_n ** 2,
+            "ddh": sp.S.Zero, "inv_n": -dh * ddh * inv_n ** 3}
 
 
 def _total_gradient(e, g, slope, dsA):
@@ -128,9 +128,10 @@ def ground_jacobian(variant: str):
         dFn = sym[i, "dFn_ddelta"] * grad[0] + sym[i, "dFn_ddeltad"] * grad[1]
         dFt = sym[i, "dFt_dxi"] * grad[2] + sym[i, "dFt_dv"] * grad[3] + sym[i, "mu"] * dFn
         ddh_dx = sp.Matrix([[slope["dh"] * dsA[j] for j in range(len(x))]])
-        fn, ft, dh = mdl.F_N[i], mdl.F_T[i], g["dh"]
+        dinv_dx = sp.Matrix([[slope["inv_n"] * dsA[j] for j in range(len(x))]])
+        fn, ft, dh, inv_n = mdl.F_N[i], mdl.F_T[i], g["dh"], g["inv_n"]
         fx, fy, mom = (sp.diff(e, fn) * dFn + sp.diff(e, ft) * dFt + sp.diff(e, dh) * ddh_dx
-                       for e in ground_forces(i))
+                       + sp.diff(e, inv_n) * dinv_dx for e in ground_forces(i))
         # the flat forcing's columns for the forces along X (F_T) and Y (F_N) at D
         A += f.diff(mdl.F_T[i]) * fx + f.diff(mdl.F_N[i]) * fy
         A[2 + i, :] += mom

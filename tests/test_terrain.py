@@ -86,6 +86,9 @@ def test_a_patch_everywhere_is_the_changed_parameter():
     assert np.array_equal(a.x_final, b.x_final)
     c = pdw.simulate(params=P, ground=Ground.plane(0.0), **kw)
     assert not np.array_equal(a.x_final, c.x_final)
+    far = pdw.simulate(params=P, ground=Ground.plane(0.0).with_patches(
+        [dict(s_a=20.0, s_b=21.0, k_n=2e5)]), **kw)       # a patch the feet never reach
+    assert np.array_equal(far.x_final, c.x_final)
 
 
 def _contact_s(x):
@@ -158,3 +161,93 @@ def test_derived_jacobian_is_the_derivative_of_the_rhs(variant, ground):
                     - _core.ground_stage(k, cg, x - e, p, 1, 1, anchors)) / (2 * h)
     assert np.abs(f[4:]).max() > 1.0            # forces act
     assert np.abs(J - fd).max() < 1e-8 * np.abs(J).max()
+
+
+def test_scene_ground_table_round_trip_and_run():
+    s = pdw.Scene(preset="paper_steady", stop={"t_end": 0.8}, ground={
+        "kind": "steps", "edges": [0.5], "heights": [-0.004],
+        "patches": [{"s_a": 0.2, "s_b": 0.4, "k_n": 5e4}]})
+    assert isinstance(s.ground, Ground)
+    back = pdw.Scene.from_toml(s.to_toml())
+    assert back == s and back.ground == s.ground
+    r = s.run()
+    direct = pdw.simulate(params=pdw.Params.paper_steady(), t_end=0.8, ground=s.ground)
+    np.testing.assert_array_equal(r.x_final, direct.x_final)
+    assert "[ground]" not in pdw.Scene().to_toml()      # unset: flat, nothing written
+    with pytest.raises(pdw.InvalidInputError, match="scene key 'ground'.*ground.sigma"):
+        pdw.Scene(ground={"kind": "random", "sigma": -1.0})
+
+
+def test_walk_figures_draw_the_ground(tmp_path):
+    matplotlib = pytest.importorskip("matplotlib")
+    matplotlib.use("Agg")
+    from pdw.present import animation, plots
+    g = Ground.steps([0.3], [-0.004], width=0.2).with_patches([dict(s_a=0.1, s_b=0.25, k_n=5e4)])
+    r = pdw.simulate(params=P, t_end=0.6, ground=g, record_every=50)
+    fig = plots.fig_stick(r)
+    ys = [line.get_ydata() for line in fig.axes[0].lines if len(line.get_ydata()) == 1200]
+    assert ys and np.ptp(ys[0]) > 0.004            # the surface drawn is the step's, not a line
+    assert any(line.get_color() == "tab:olive" for line in fig.axes[0].lines)     # the patch
+    animation.animate(r, tmp_path / "walk.gif", duration=0.4, fps=5)
+    assert (tmp_path / "walk.gif").stat().st_size > 0
+
+
+def test_a_study_scene_with_a_ground_runs_its_points_on_it(tmp_path):
+    """Study points on a shaped [scene.ground] run point by point through simulate(ground=)
+    (never batched on flat ground): each row is the scalar run on that ground."""
+    from pdw.studies import points
+    from pdw.studies.study import parse_study
+    text = """
+name = "ground_study"
+[scene]
+preset = "paper_steady"
+stop = { t_end = 1.5 }
+ground = { kind = "steps", edges = [0.5], heights = [-0.004], width = 0.2 }
+[[axes]]
+name = "k_hip"
+values = [0.9, 1.0]
+[run]
+steady = 1
+"""
+    study = parse_study(text, name="ground_study")
+    assert study.scene.ground == Ground.steps([0.5], [-0.004], width=0.2)
+    assert not points.batchable(study)
+    for index, values in study.points()[:1]:
+        row = points.run_point(study.task(index, values))
+        r = pdw.simulate(params=pdw.Params.paper_steady().replace(k_hip=0.9), t_end=1.5,
+                         method=study.scene.integrator.method, rtol=study.scene.integrator.rtol,
+                         atol=study.scene.integrator.atol, ground=study.scene.ground,
+                         record_every=study.scene.record.every, on_failure="return")
+        assert row["t_final"] == r.t_final and row["status"] == r.status
+
+
+def test_compiled_ground_refuses_a_tampered_table():
+    import dataclasses
+
+    from pdw.core import _core
+    t = Ground.sine(0.01, 0.5).table()
+    for bad in (dict(lut_inv=float("nan")), dict(s_max=t.s_min), dict(lut=t.lut + len(t.cells)),
+                dict(cells=t.cells[:, :5]), dict(arc=t.arc[:-1])):
+        with pytest.raises(ValueError, match="ground table"):
+            _core.CGround(dataclasses.replace(t, **bad))
+    c = t.cells.copy()
+    c[3, 4] = np.inf
+    with pytest.raises(ValueError, match="finite"):
+        _core.CGround(dataclasses.replace(t, cells=c))
+    with pytest.raises(TypeError):
+        _core.ground_stage(0, None, np.zeros(8), np.zeros(_core.NP), 1, 1, np.zeros(4))
+
+
+@pytest.mark.parametrize("contact", [{"normal": "flores", "e": 0.5}, {"friction": "lugre"}],
+                         ids=["flores", "lugre"])
+def test_tilted_plane_with_other_contact_laws(contact):
+    """Every contact law runs on the shaped ground unchanged (surface-frame kinematics); LuGre's
+    bristle states ride along (its Jacobian: central differences)."""
+    d = 0.01
+    kw = dict(t_end=2.0, contact=contact, **dict(TIGHT, rtol=1e-10, atol=1e-12))
+    ref = pdw.simulate(pdw.X0_PAPER, params=P.replace(gamma=P.gamma + d), **kw)
+    g = pdw.simulate(_plane_frame(np.array(pdw.X0_PAPER), d), params=P, ground=Ground.plane(d), **kw)
+    assert ref.status == g.status == "walked" and ref.n_gait_steps == g.n_gait_steps >= 2
+    assert np.abs(ref.gait["P"] - g.gait["P"]).max() < 1e-8
+    assert np.abs(_plane_frame(ref.x_final[:8], d) - g.x_final[:8]).max() < 1e-7
+    assert np.abs(ref.x_final[8:] - g.x_final[8:]).max() < 1e-9 if len(ref.x_final) > 8 else True

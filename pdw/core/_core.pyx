@@ -648,7 +648,7 @@ def _real_states(x, bint allow_rows):
 include "_ode.pxi"
 
 
-def ground_stage(int k, CGround ground, const double[::1] x, const double[::1] p, int f1, int f2,
+def ground_stage(int k, CGround ground not None, const double[::1] x, const double[::1] p, int f1, int f2,
                  const double[::1] anchors, bint jacobian=False):
     """f(x) (nx,) or, with jacobian, df/dx (nx, nx) of kernel k on a compiled ground (the
     shaped-ground kernel, pdw_terrain.c), for tests; anchors (NANCHOR,)."""

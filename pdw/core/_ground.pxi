@@ -3,6 +3,11 @@
 import numpy as _np_ground
 
 
+cdef extern from "pdw_model.h":
+    enum:
+        PDW_NGCELL
+
+
 cdef extern from "pdw_ground.h":
     ctypedef struct pdw_ground:
         double s_min, s_max
@@ -32,14 +37,20 @@ cdef class CGround:
         fields = _np_ground.ascontiguousarray(table.patch_fields, dtype=_np_ground.intc)
         patches = _np_ground.ascontiguousarray(table.patches, dtype=_np_ground.float64).reshape(-1)
         zones = _np_ground.ascontiguousarray(table.zones, dtype=_np_ground.float64)
-        if cells.ndim != 2 or cells.shape[1] != 8 or cells.shape[0] < 1:
-            raise ValueError("ground table: cells must have shape (n >= 1, 8)")
+        if cells.ndim != 2 or cells.shape[1] != PDW_NGCELL or cells.shape[0] < 1:
+            raise ValueError("ground table: cells must have shape (n >= 1, %d)" % PDW_NGCELL)
         if arc.shape != (cells.shape[0], 6) or lut.ndim != 1 or lut.shape[0] < 1:
             raise ValueError("ground table: arc (n, 6) and lut (m >= 1,) expected")
         if lut.min() < 0 or lut.max() >= cells.shape[0]:
             raise ValueError("ground table: lut entries out of range")
         if patches.shape[0] != table.patches.shape[0] * (2 + fields.shape[0]):
             raise ValueError("ground table: patches must have shape (p, 2 + fields)")
+        if not (table.s_max > table.s_min and table.lut_inv > 0 and table.lut_inv < 1e300
+                and table.blend > 0 and table.blend < 1e300):
+            raise ValueError("ground table: need s_max > s_min, 0 < lut_inv, blend finite")
+        if not (_np_ground.all(_np_ground.isfinite(cells)) and _np_ground.all(_np_ground.isfinite(arc))
+                and _np_ground.all(_np_ground.isfinite(zones))):
+            raise ValueError("ground table: cells, arc and zones must be finite")
         if fields.shape[0] and (fields.min() < 0 or fields.max() >= PDW_NP):
             raise ValueError("ground table: patch fields out of range")
         self.keep = (cells, arc, lut, fields, patches, zones)

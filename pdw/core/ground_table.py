@@ -67,8 +67,7 @@ class GroundTable:
         w = b - a
         mid = 0.5 * (a + b)
         # one-sided values at each cell's ends (the piece of the cell's midpoint)
-        va = _one_sided(g, a, mid)
-        vb = _one_sided(g, b, mid)
+        va, vb = _knot_values(g, knots, mid)
         coef = _hermite5(w, va, vb)
         cells = np.column_stack([a, 1.0 / w, coef])
         # arc length: exact values at the knots by Gauss-Legendre on the table's own polynomial,
@@ -128,6 +127,24 @@ class GroundTable:
         for j in range(4, -1, -1):
             out = out * u + a[..., j]
         return out
+
+
+def _knot_values(g, knots, mid):
+    """(h, h', h'') of g at each cell's start and end, one-sided (the piece of the cell's
+    midpoint ``mid``); a smooth shape is evaluated once per knot."""
+    if g.kind in ("profile", "steps", "plane"):
+        return _one_sided(g, knots[:-1], mid), _one_sided(g, knots[1:], mid)
+    if g.kind == "sum":
+        va = [np.full(len(mid), g.offset), np.zeros(len(mid)), np.zeros(len(mid))]
+        vb = [np.full(len(mid), g.offset), np.zeros(len(mid)), np.zeros(len(mid))]
+        for p in g.parts:
+            pa, pb = _knot_values(p, knots, mid)
+            for i in range(3):
+                va[i] = va[i] + pa[i]
+                vb[i] = vb[i] + pb[i]
+        return tuple(va), tuple(vb)
+    v = g.evaluate(knots)
+    return tuple(x[:-1] for x in v), tuple(x[1:] for x in v)
 
 
 def _one_sided(g, s, mid):

@@ -14,6 +14,8 @@ from .figure_kit import (
     _new_figure,
     _to_world,
     _touch_downs,
+    draw_ground,
+    ground_height,
 )
 
 # --------------------------------------------------------------------------------------------
@@ -70,10 +72,7 @@ def animate(result, path, fps=25, duration=None, max_playback=12.0):
     ax.set_aspect("equal")
     X_lo = min(x[:, 0].min(), 0.0) - 1.0
     X_hi = x[:, 0].max() + 1.0
-    gx, gy = _to_world(np.array([X_lo, X_hi]), np.zeros(2), gam)
-    bx, by = _to_world(np.array([X_hi, X_lo]), np.full(2, -0.3), gam)
-    ax.fill(np.r_[gx, bx], np.r_[gy, by], facecolor="0.9", edgecolor="none", hatch="//")
-    ax.plot(gx, gy, color="k", lw=1.5)
+    draw_ground(ax, result, X_lo, X_hi, 0.3, gam)      # its shape and patches
     legs = [ax.plot([], [], color=LEG_COLORS[k], lw=2.5, solid_capstyle="round",
                     label="leg %d" % (k + 1))[0] for k in (0, 1)]
     feet = [ax.plot([], [], color=LEG_COLORS[k], lw=2.5)[0] for k in (0, 1)]
@@ -102,12 +101,13 @@ def animate(result, path, fps=25, duration=None, max_playback=12.0):
             done = [e for e in tds if e.leg == k + 1 and e.t <= t[i]]
             if done:
                 prints[k].set_data(*_to_world(np.array([e.x_D for e in done]),
-                                              np.zeros(len(done)), gam))
+                                              np.array([ground_height(result, e.x_D)
+                                                        for e in done]), gam))
             else:
                 prints[k].set_data([], [])
         hx, hy = _to_world(s[0], s[1], gam)
         hip.set_data([hx], [hy])
-        gy0 = _to_world(s[0], 0.0, gam)[1]
+        gy0 = _to_world(s[0], ground_height(result, s[0]), gam)[1]
         ax.set_xlim(hx - half_w, hx + half_w)
         ax.set_ylim(gy0 - 0.12, gy0 + 0.62)
         clock.set_text("t = %5.2f s%s" % (t[i], "  double support" if flags[i].all() else ""))

@@ -217,3 +217,36 @@ def _run_label(result):
     if getattr(result, "failure", None):
         s += " (%s at t = %.3f s)" % (result.failure["reason"], result.failure["t"])
     return s
+
+
+PATCH_COLOR = "tab:olive"
+
+
+def draw_ground(ax, result, X_lo, X_hi, depth, gamma, *, z=0, lw=1.5):
+    """Draw the ground of ``result`` (its `pdw.Ground`, flat when none) in the world frame
+    between X_lo and X_hi along the slope [m]: the surface h(s), hatched below to ``depth``
+    under its lowest point, and each contact patch as a coloured band on the surface (labelled
+    with the properties it sets). Returns (world x, world y) of the surface."""
+    g = getattr(result, "ground", None)
+    n = 2 if g is None or (g.kind == "flat" and not g.patches) else 1200
+    s = np.linspace(X_lo, X_hi, n)
+    h = np.zeros_like(s) if g is None else np.asarray(g.h(s), dtype=float)
+    gx, gy = _to_world(s, h, gamma)
+    bx, by = _to_world(s[::-1], np.full(n, h.min() - depth), gamma)
+    ax.fill(np.r_[gx, bx], np.r_[gy, by], facecolor="0.92", edgecolor="none", hatch="///",
+            zorder=z)
+    ax.plot(gx, gy, color="k", lw=lw, zorder=z + 3)
+    for k, p in enumerate(() if g is None else g.patches):
+        inside = (s >= p.s_a) & (s <= p.s_b)
+        if inside.any():
+            ax.plot(gx[inside], gy[inside], color=PATCH_COLOR, lw=4 * lw, alpha=0.6,
+                    solid_capstyle="butt", zorder=z + 2,
+                    label="patch: " + ", ".join("%s = %.3g" % kv for kv in p.values) if k == 0
+                    else None)
+    return gx, gy
+
+
+def ground_height(result, s):
+    """h(s) [m] of the result's ground (0 when flat or none)."""
+    g = getattr(result, "ground", None)
+    return 0.0 if g is None else float(g.h(s))

@@ -56,6 +56,8 @@ from .figure_kit import (  # noqa: F401 (re-exported by pdw.present.plots)
     _to_world,
     _touch_downs,
     double_support_intervals,
+    draw_ground,
+    ground_height,
 )
 
 __all__ = [
@@ -174,24 +176,20 @@ def fig_stick(result, every=0.05):
     # ground
     X_lo = min(x[:, 0].min(), 0.0) - 0.4
     X_hi = x[:, 0].max() + 0.4
-    gx, gy = _to_world(np.array([X_lo, X_hi]), np.zeros(2), gam)
-    ax.plot(gx, gy, color="k", lw=1.5, zorder=3)
     depth = 0.06
-    bx, by = _to_world(np.array([X_hi, X_lo]), np.full(2, -depth), gam)
-    ax.fill(np.r_[gx, bx], np.r_[gy, by], facecolor="0.92", edgecolor="none", hatch="///",
-            zorder=0)
+    gx, gy = draw_ground(ax, result, X_lo, X_hi, depth, gam)    # its shape and patches
     # footprints
     for n, e in enumerate(_touch_downs(result), start=1):
-        fx, fy = _to_world(e.x_D, 0.0, gam)
+        fx, fy = _to_world(e.x_D, ground_height(result, e.x_D), gam)
         ax.plot(fx, fy, marker="^", color=LEG_COLORS[e.leg - 1], ms=9, mec="k", mew=0.6,
                 zorder=6, ls="none")
         ax.annotate("%d" % n, (fx, fy), xytext=(0, -12), textcoords="offset points",
                     ha="center", va="top", fontsize=8, zorder=6,
                     bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.85))
     ax.set_aspect("equal")
-    ax.set_xlim(gx[0], gx[1])
+    ax.set_xlim(gx[0], gx[-1])
     hip_top = float(np.max(_to_world(x[:, 0], x[:, 1], gam)[1]))
-    ground_low = float(gy[1])
+    ground_low = float(np.min(gy))
     ax.set_ylim(ground_low - depth, hip_top + 0.08)
     ax.set_xlabel("horizontal position x [m] (world frame)")
     ax.set_ylabel("height y [m]")

@@ -46,6 +46,11 @@ TOML layout (every key optional; defaults are `Scene()`'s)::
     friction = "coulomb"
     # k, d, e, v_in_min: the law's parameters (unset: the preset's k_n, d_n)
 
+    [ground]                         # the ground (docs/terrain.md); unset: flat
+    kind = "flat"                    # steps, profile, plane, sine, random, sum
+    # the kind's parameters (edges, heights, width; s, h, order; slope; amplitude,
+    # wavelength, phase; sigma, correlation, seed), offset, extent, patches = [{s_a, s_b, k_n, ...}]
+
     [stop]
     t_end = 3.5                      # [s]
     steps = 0                        # stop after this many complete gait steps (0: no limit)
@@ -74,6 +79,7 @@ from typing import Any
 from ..core import _layout, _toml
 from ..core.contact import Contact
 from ..core.errors import InvalidInputError
+from ..core.ground import Ground
 from ..core.integrators import METHODS
 from ..core.params import X0_PAPER, Params
 from .simulation import Result, simulate
@@ -117,6 +123,7 @@ KINDS = {
     "str": "a string", "float": "a number", "float?": "a number", "int": "an integer",
     "bool": "true or false", "state": "a list of 8 numbers", "flags": "a list of two 0/1 integers",
     "params": "a table of parameter values",
+    "ground": "a [ground] table (docs/terrain.md)",
 }
 
 
@@ -177,6 +184,15 @@ def _coerce(value, kind, key):
                 raise _err("%s.%s" % (key, name), "must be a number, got %r" % (v,))
             out[name] = float(v)
         return out
+    if kind == "ground":
+        if value is None or isinstance(value, Ground):
+            return value
+        if not isinstance(value, dict):
+            raise bad()
+        try:
+            return Ground.from_dict(value)
+        except InvalidInputError as e:
+            raise _err(key, "is invalid: %s" % e) from None
     raise AssertionError(kind)
 
 
@@ -226,6 +242,8 @@ class _Section:
         for f in dataclasses.fields(self):  # type: ignore[arg-type]
             v = getattr(self, f.name)
             if isinstance(v, _Section):
+                out[f.name] = v.to_dict()
+            elif isinstance(v, Ground):
                 out[f.name] = v.to_dict()
             elif isinstance(v, tuple):
                 out[f.name] = list(v)
@@ -405,6 +423,8 @@ class Scene(_Section):
     record: Record = _f(Record(), "record", "what is recorded")
     stop: Stop = _f(Stop(), "stop", "when the run stops")
     contact: ContactLaws = _f(ContactLaws(), "contact", "normal and friction contact laws")
+    ground: Ground | None = _f(None, "ground", "the ground walked on (pdw.Ground, docs/terrain.md); "
+                               "unset: flat")
 
     def _check(self):
         for name, value in self.params.items():
@@ -446,7 +466,7 @@ class Scene(_Section):
             event_tol=it.event_tol, features=self.features, record_events=rec.events,
             record_energies=rec.energies, stop_steps=st.steps,
             periodic_steps=st.periodic_steps if st.periodic else 0,
-            periodic_tol=st.periodic_tol, contact=self.contact.to_contact())
+            periodic_tol=st.periodic_tol, contact=self.contact.to_contact(), ground=self.ground)
 
     def run(self) -> Result:
         """Run the scene (`pdw.simulate` with the scene's settings).

@@ -28,7 +28,7 @@ import time
 import numpy as np
 
 from ..core import _layout
-from ..core.errors import PdwError
+from ..core.errors import InvalidInputError, PdwError
 from ..core.integrators import METHODS
 from ..core.params import Params
 from ..sim import ensemble
@@ -55,6 +55,8 @@ def batchable(study: Study) -> bool:
     if sc.record.every != 0 or sc.stop.on_failure != "return":
         return False
     if not ensemble.plain_model(sc.features, sc.contact.to_contact()):
+        return False
+    if sc.ground is not None and not sc.ground.is_flat:    # point by point: simulate(ground=)
         return False
     return (sc.integrator.method in BITWISE_METHODS
             and ensemble.supports(sc.integrator.method, sc.variant))
@@ -175,6 +177,11 @@ def _newton_point(row, params, scene):
     ``row`` if none is found."""
     from ..analysis.gait_types import GaitNotFoundError
     from ..analysis.limit_cycle import find_gait
+    if scene.ground is not None and not scene.ground.is_flat:
+        if row["status"] != "":         # the fallback after a simulated point: keep that row
+            return
+        raise InvalidInputError("newton mode (find_gait) needs flat ground: a periodic gait "
+                                "of a shaped or patched [scene.ground] is not defined")
     c = scene.contact.to_contact()
     law = {} if c.is_default else dict(contact=c)
     try:

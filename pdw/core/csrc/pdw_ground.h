@@ -51,9 +51,11 @@ static inline void pdw_ground_eval(const pdw_ground *g, double s, double *out)
     const double *c = g->cells + pdw_ground_cell(g, s)*PDW_NGCELL;
     const double iw = c[PDW_GCELL_INV_W], u = (s - c[PDW_GCELL_S]) * iw;
     const double *a = c + PDW_GCELL_A0;
-    out[0] = a[0] + u*(a[1] + u*(a[2] + u*(a[3] + u*(a[4] + u*a[5]))));
-    out[1] = (a[1] + u*(2.0*a[2] + u*(3.0*a[3] + u*(4.0*a[4] + u*5.0*a[5])))) * iw;
-    out[2] = (2.0*a[2] + u*(6.0*a[3] + u*(12.0*a[4] + u*20.0*a[5]))) * iw * iw;
+    /* Estrin's scheme: short dependency chains (the time loops wait on these values) */
+    const double u2 = u*u, u4 = u2*u2;
+    out[0] = (a[0] + a[1]*u) + u2*(a[2] + a[3]*u) + u4*(a[4] + a[5]*u);
+    out[1] = ((a[1] + 2.0*a[2]*u) + u2*(3.0*a[3] + 4.0*a[4]*u) + u4*(5.0*a[5])) * iw;
+    out[2] = ((2.0*a[2] + 6.0*a[3]*u) + u2*(12.0*a[4] + 20.0*a[5]*u)) * (iw * iw);
 }
 
 /* The arc length sigma(s) [m] from s_min. */
@@ -61,8 +63,8 @@ static inline double pdw_ground_arc(const pdw_ground *g, double s)
 {
     const long k = pdw_ground_cell(g, s);
     const double *c = g->cells + k*PDW_NGCELL, *a = g->arc + k*6;
-    const double u = (s - c[PDW_GCELL_S]) * c[PDW_GCELL_INV_W];
-    return a[0] + u*(a[1] + u*(a[2] + u*(a[3] + u*(a[4] + u*a[5]))));
+    const double u = (s - c[PDW_GCELL_S]) * c[PDW_GCELL_INV_W], u2 = u*u, u4 = u2*u2;
+    return (a[0] + a[1]*u) + u2*(a[2] + a[3]*u) + u4*(a[4] + a[5]*u);
 }
 
 /* Is s inside the defined extent? */
@@ -99,6 +101,16 @@ static inline void pdw_ground_params(const pdw_ground *g, double s, const double
         }
         p_out[idx] = v;
     }
+}
+
+/* Does any patch reach s (a nonzero window)? */
+static inline int pdw_ground_patched(const pdw_ground *g, double s)
+{
+    for (int i = 0; i < g->n_patches; ++i) {
+        const double *row = g->patches + i*(2 + g->n_fields);
+        if (s > row[0] - 0.5*g->blend && s < row[1] + 0.5*g->blend) return 1;
+    }
+    return 0;
 }
 
 /* The blend zone of s: the number of zone boundaries <= s (a change is an event). */

@@ -16,6 +16,7 @@ void pdw_terrain_kinematics(const pdw_kernel *k, const pdw_ground *g, const doub
         gi[PDW_GROUND_H] = e[0];
         gi[PDW_GROUND_DH] = e[1];
         gi[PDW_GROUND_DDH] = e[2];
+        gi[PDW_GROUND_INV_N] = 1.0 / sqrt(1.0 + e[1]*e[1]);
         if (k->variant == 1) {          /* consistent: the rolling coordinate needs sigma, alpha */
             gi[PDW_GROUND_SIGMA] = pdw_ground_arc(g, sA[i]);
             gi[PDW_GROUND_ALPHA] = atan(e[1]);
@@ -35,7 +36,11 @@ void pdw_terrain_contact(const pdw_kernel *k, const pdw_ground *g, const double 
 {
     void (*stage)(const double *, const int *, const double *, double *) =
         partials ? k->contact_partials : k->contact;
-    if (g->n_patches == 0) { stage(kin, flags, p, contact); return; }
+    if (g->n_patches == 0 || (!pdw_ground_patched(g, kin[PDW_KIN_X_D])
+                              && !pdw_ground_patched(g, kin[PDW_NKIN + PDW_KIN_X_D]))) {
+        stage(kin, flags, p, contact);      /* neither foot on a patch: the run's parameters */
+        return;
+    }
     double pi[PDW_NP], ci[2*PDW_NCONTACT];
     for (int i = 0; i < 2; ++i) {
         const int fl[2] = {i == 0 ? flags[0] : 0, i == 1 ? flags[1] : 0};
