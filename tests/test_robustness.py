@@ -282,7 +282,7 @@ def test_cli_robustness_writes_csv_json_figure_and_exits_2_on_a_bad_spec(tmp_pat
     rows = list(csv.DictReader(open(tmp_path / "o" / "gsn.csv")))
     assert [float(r["value"]) for r in rows] == [0.75, 0.95]
     G = pdw.gait_sensitivity(P, check=False)
-    assert float(rows[1]["norm"]) == pytest.approx(G.norm, rel=1e-9)
+    assert float(rows[1]["norm"]) == pytest.approx(G.norm, rel=1e-7)
     prov = json.loads((tmp_path / "o" / "gsn.json").read_text())
     assert prov["spec"]["toml"] == spec.read_text() and prov["code"]["input_hash"]
     assert (tmp_path / "o" / "gsn.png").stat().st_size > 1000

@@ -236,8 +236,10 @@ def run_spec(spec: RobustnessSpec, *, executor=None, path_for=None, on_row=None)
     fn = MEASURES[spec.measure]
     rows, results = [], []
     t0, c0 = time.time(), time.process_time()
+    prev = None
     for i, v in enumerate(spec.values):
         kw = dict(spec.options)
+        prev = kw["gait"] = _gait_along(spec, spec.params_at(v), prev)
         if spec.model != "hybrid" or spec.measure != "markov_chain":
             kw["model"] = spec.model
         if spec.ground is not None:
@@ -258,6 +260,26 @@ def run_spec(spec: RobustnessSpec, *, executor=None, path_for=None, on_row=None)
             on_row(row)
     prov = provenance(spec, wall_s=time.time() - t0, cpu_s=time.process_time() - c0)
     return rows, results, prov
+
+
+def _gait_along(spec, params, prev):
+    """The gait at this axis point, followed from the previous point's (one branch of gaits
+    along the axis, as the studies do); the default guesses when that fails or at the first."""
+    from ..analysis import hybrid as _hy
+    from ..analysis import limit_cycle as _lc
+    from ..analysis.gait_types import GaitNotFoundError
+
+    find = _hy.find_gait if spec.model == "hybrid" else _lc.find_gait
+    step = {k: v for k, v in spec.options.items() if k in _STEP_OPTIONS} \
+        if spec.model == "hybrid" else {}
+    if prev is not None:
+        try:
+            if spec.model == "hybrid":
+                return find(params, guess=prev.state, settle_steps=0, **step)
+            return find(params, guess=prev)
+        except (GaitNotFoundError, PdwError):
+            pass
+    return find(params, **step)
 
 
 def provenance(spec, **extra) -> dict:
