@@ -100,10 +100,12 @@ def test_a_preset_warns_above_its_shipped_limit_and_not_below():
     from pdw.sim import stepsize
     dt_max = stepsize.PRESET_DT_MAX["paper", "paper"]["cdm"]
     with pytest.warns(pdw.StepSizeWarning, match="exceeds the estimated"):
-        pdw.simulate(t_end=0.01, dt=dt_max * 1.001, on_failure="return", record_every=0)
+        pdw.simulate(t_end=0.01, dt=dt_max * 1.001, limits=pdw.Limits(on_failure="return"),
+                     record=pdw.Record(every=0))
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        pdw.simulate(t_end=0.01, dt=dt_max / 1.001, on_failure="return", record_every=0)
+        pdw.simulate(t_end=0.01, dt=dt_max / 1.001, limits=pdw.Limits(on_failure="return"),
+                     record=pdw.Record(every=0))
 
 
 def test_the_caches_of_the_python_set_up_hand_out_nothing_shared_that_can_change():
