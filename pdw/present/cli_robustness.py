@@ -18,6 +18,7 @@ import pathlib
 from .. import examples
 from ..core.errors import PdwError
 from ..studies.robustness_spec import load_spec, run_spec
+from . import deps
 
 
 def add_cli(subparsers):
@@ -41,6 +42,8 @@ def cli_main(args):
         raise PdwError("give a spec file or --example NAME (one of them)")
     path = examples.robustness_path(args.example) if args.example else args.spec
     spec = load_spec(path)
+    if not args.no_figures:                 # checked before the work (pdw.present.deps)
+        deps.require("matplotlib", purpose="the figure")
     out = pathlib.Path(args.out or os.path.join("out", "robustness", spec.name))
     out.mkdir(parents=True, exist_ok=True)
 
@@ -65,12 +68,8 @@ def cli_main(args):
             w.writerow({k: r.get(k, "") for k in keys})
     paths["json"].write_text(json.dumps({**prov, "rows": rows}, indent=1, default=_jsonable))
     if not args.no_figures:
-        try:
-            from .robustness_plots import plot_spec
-        except ImportError:
-            print("pdw: no figure: matplotlib is not installed: pip install 'pdw[plot]'")
-        else:
-            paths["png"] = plot_spec(spec, rows, results, out / (spec.name + ".png"))
+        from .robustness_plots import plot_spec
+        paths["png"] = plot_spec(spec, rows, results, out / (spec.name + ".png"))
     for p in paths.values():
         print("wrote %s" % p)
     return 0

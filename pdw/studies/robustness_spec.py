@@ -33,13 +33,13 @@ import os
 import platform
 import sys
 import time
-import tomllib
 
 import numpy as np
 
 from ..analysis import first_passage as _fp
 from ..analysis import markov as _mk
 from ..analysis import robustness as _rb
+from ..core import _toml, paths
 from ..core.errors import InvalidInputError, PdwError
 from ..core.params import Params
 from ..core.provenance import source_revision
@@ -99,17 +99,14 @@ def load_spec(path) -> RobustnessSpec:
 def parse_spec(text, path=None) -> RobustnessSpec:
     """Validate a spec's TOML text whole; raises `InvalidInputError` naming the key."""
     try:
-        d = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
+        d = _toml.loads(text)
+    except _toml.TOMLDecodeError as e:
         raise InvalidInputError("%s: not valid TOML: %s" % (path or "spec", e)) from None
     unknown = sorted(set(d) - set(_TOP))
     if unknown:
         raise InvalidInputError("unknown key(s) %s; allowed: %s" % (", ".join(unknown),
                                                                     ", ".join(_TOP)))
-    name = d.get("name")
-    if not isinstance(name, str) or not name or not all(c.isalnum() or c in "_-." for c in name):
-        raise InvalidInputError("name must be a non-empty string of letters, digits, _ - ., "
-                                "got %r" % (name,))
+    name = paths.file_stem(d.get("name"), "%s: name" % (path or "spec"))   # names the files
     title = d.get("title", name)
     if not isinstance(title, str):
         raise InvalidInputError("title must be a string, got %r" % (title,))
