@@ -31,7 +31,9 @@ LARGE = {"compiled": 40000, "hybrid": 15000, "params": 20000, "simulate": 5000,
          "buffer": 3000,
          # issue 26 (round three): counts into the compiled layer, NaN states at every public
          # entry point, silent coercions, the file formats (BatchResult, the sweep CSV)
-         "counts": 4000, "nan_states": 4000, "coerce": 3000, "batch_file": 2000, "csv": 2000}
+         "counts": 4000, "nan_states": 4000, "coerce": 3000, "batch_file": 2000, "csv": 2000,
+         # the spec formats of round three's terrain and robustness work
+         "ground": 10000, "robustness": 10000}
 _HC = [HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much]
 P = parameter_vector(pdw.Params.paper())
 X0 = np.array(pdw.X0_PAPER)
@@ -744,3 +746,74 @@ def _csv(data):
 
 
 test_fuzz_csv, test_fuzz_csv_study = _twin("csv", _csv)
+
+
+# --- the spec formats round three added: the [ground] table, the robustness spec ---------------
+
+GROUND_KEYS = st.sampled_from(["kind", "edges", "heights", "width", "s", "h", "order", "slope",
+                               "amplitude", "wavelength", "phase", "sigma", "correlation", "seed",
+                               "modes", "offset", "extent", "blend", "bogus"])
+GROUND_KIND = st.sampled_from(['"flat"', '"steps"', '"profile"', '"plane"', '"sine"',
+                               '"random"', '"sum"', '"bogus"', "3"])
+GROUND_VALUE = (TOML_VALUE | st.sampled_from(
+    ["[0.5, 1.0]", "[0.01, -0.01]", "[1.0, 0.5]", "[0.0, 0.5, 1.0]", "[0.0, 0.001, 0.0]",
+     "[-1.0, 40.0]", "[1e300, 1e301]", "1e-300", "0.001", "0.2", "-0.001", "[]", "[[1]]"]))
+PATCH_KEYS = st.sampled_from(["s_a", "s_b", "k_n", "d_n", "mu_s", "mu_d", "k_t", "bogus"])
+
+
+def _ground(case):
+    """A [ground] table of random keys and values: a Ground whose heights are finite inside
+    its range and whose compiled table builds, or InvalidInputError -- never another error."""
+    text = "[ground]\nkind = %s\n%s\n" % (case["kind"], _toml(case["fields"]))
+    for patch in case["patches"]:
+        text += "[[ground.patches]]\n%s\n" % _toml(patch)
+    try:
+        d = pdw.core._toml.loads(text)
+    except pdw.core._toml.TOMLDecodeError:
+        return
+    try:
+        g = pdw.Ground.from_dict(d["ground"])
+        lo, hi = g.s_range
+        s = np.linspace(max(lo, -5.0), min(hi, 5.0), 7) if lo <= hi else np.array([])
+        assert np.isfinite(np.asarray(g.h(s), dtype=float)).all()
+        g.table()
+    except pdw.InvalidInputError:
+        return
+
+
+test_fuzz_ground, test_fuzz_ground_study = _twin("ground", _ground, st.fixed_dictionaries({
+    "kind": GROUND_KIND,
+    "fields": st.lists(st.tuples(GROUND_KEYS, GROUND_VALUE), max_size=5, unique_by=lambda t: t[0]),
+    "patches": st.lists(st.lists(st.tuples(PATCH_KEYS, TOML_VALUE), max_size=4,
+                                 unique_by=lambda t: t[0]), max_size=2),
+}))
+
+ROB_TOP = st.sampled_from(["title", "measure", "model", "preset", "bogus"])
+ROB_MEASURE = st.sampled_from(['"max_step"', '"gait_sensitivity"', '"first_passage"',
+                               '"markov_chain"', '"bogus"', "1"])
+ROB_OPTIONS = st.sampled_from(["direction", "indicators", "sigma", "walkers", "max_steps",
+                               "seed", "tol", "h_max", "bogus"])
+ROB_SWEEP = st.sampled_from(["parameter", "values", "bogus"])
+
+
+def _robustness(case):
+    """A robustness spec of random keys and values: parsed whole, or InvalidInputError."""
+    from pdw.studies.robustness_spec import parse_spec
+    text = ('name = %s\nmeasure = %s\n%s\n[options]\n%s\n[sweep]\n%s\n'
+            % (case["name"], case["measure"], _toml(case["top"]), _toml(case["options"]),
+               _toml(case["sweep"])))
+    try:
+        spec = parse_spec(text)
+    except pdw.InvalidInputError:
+        return
+    assert "/" not in spec.name and not spec.name.startswith(".")
+    assert spec.measure in ("max_step", "gait_sensitivity", "first_passage", "markov_chain")
+    assert len(spec.values) >= 1
+
+
+test_fuzz_robustness, test_fuzz_robustness_study = _twin("robustness", _robustness,
+                                                         st.fixed_dictionaries({
+    "name": st.sampled_from(['"r"', '".."', '"a/b"', '""', '".x"', "3"]),
+    "measure": ROB_MEASURE,
+    "top": _pairs(ROB_TOP), "options": _pairs(ROB_OPTIONS), "sweep": _pairs(ROB_SWEEP),
+}))

@@ -153,7 +153,7 @@ def parse_spec(text, path=None) -> RobustnessSpec:
             raise InvalidInputError("sweep.%s is not a key of [sweep]; allowed: parameter, "
                                     "values, start, stop, num" % extra[0])
         parameter = sweep.get("parameter")
-        if parameter not in fields:
+        if not isinstance(parameter, str) or parameter not in fields:
             raise InvalidInputError("sweep.parameter must be a pdw.Params field, got %r"
                                     % (parameter,))
         if "values" in sweep:
