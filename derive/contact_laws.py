@@ -1,7 +1,7 @@
 """The family of normal contact laws, written once (issue 12, docs/contact_laws.md).
 
 Each law gives the normal force of one penetrating support foot from its depth delta > 0
-[m], its penetration rate delta_dot = -v_y [m/s] (MODEL.md section 4) and, for the laws whose
+[m], its penetration rate delta_dot = -v_y [m/s] (docs/model.md section 4) and, for the laws whose
 damping comes from a coefficient of restitution, the approach speed v_in [m/s] captured at the
 foot's touch-down (a per-foot discrete value, like the consistent variant's anchor s0_i). The
 ground cannot pull: every law with damping is clamped at 0.

@@ -219,7 +219,7 @@ TEXT_SUFFIXES = {".py", ".pyx", ".pxi", ".pyi", ".c", ".h", ".inc", ".md", ".tom
 
 def _product_files():
     yield ROOT / "README.md"
-    for top in ("pdw", "docs", "benchmarks"):
+    for top in ("pdw", "docs", "benchmarks", "derive", "generated"):
         for p in sorted((ROOT / top).rglob("*")):
             if p.is_file() and p.suffix in TEXT_SUFFIXES and "__pycache__" not in p.parts:
                 yield p
