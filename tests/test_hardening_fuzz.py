@@ -476,6 +476,23 @@ def _saved():
     return _SAVED
 
 
+def _tamper(data, a):
+    """Damage a saved file's arrays ``a`` in place, 1 to 3 times: an array dropped, replaced by
+    a random one of its shape, or one numeric entry poked with any float (an integer array
+    becomes float)."""
+    for _ in range(data.draw(st.integers(1, 3))):
+        key = data.draw(st.sampled_from(sorted(a)))
+        action = data.draw(st.sampled_from(["replace", "drop", "poke"]))
+        if action == "drop":
+            a.pop(key, None)
+        elif action == "replace" and key in a:
+            a[key] = data.draw(arrays(a[key].shape))
+        elif key in a and a[key].size and a[key].dtype.kind in "fiu":
+            flat = a[key].astype(float).reshape(-1)
+            flat[data.draw(st.integers(0, flat.size - 1))] = data.draw(ANY_FLOAT)
+            a[key] = flat.reshape(a[key].shape)
+
+
 def _load(data):
     """A saved result with random arrays replaced, dropped or mutated and random metadata
     fields replaced by junk: pdw.load gives an InvalidInputError or a Result whose arrays
@@ -485,17 +502,7 @@ def _load(data):
     s = _saved()
     a = {k: v.copy() for k, v in s["arrays"].items()}
     m = json.loads(json.dumps(s["meta"]))
-    for _ in range(data.draw(st.integers(1, 3))):
-        key = data.draw(st.sampled_from(sorted(a)))
-        action = data.draw(st.sampled_from(["replace", "drop", "poke"]))
-        if action == "drop":
-            a.pop(key, None)
-        elif action == "replace" and key in a:
-            a[key] = data.draw(arrays(a[key].shape))
-        elif key in a and a[key].size:
-            flat = a[key].astype(float).reshape(-1)      # an integer array becomes float
-            flat[data.draw(st.integers(0, flat.size - 1))] = data.draw(ANY_FLOAT)
-            a[key] = flat.reshape(a[key].shape)
+    _tamper(data, a)
     if data.draw(st.booleans()):
         where = m if data.draw(st.booleans()) else m["settings"]
         where[data.draw(st.sampled_from(sorted(where)))] = data.draw(
@@ -658,17 +665,7 @@ def _batch_file(data):
     s = _batch_saved()
     a = {k: v.copy() for k, v in s["arrays"].items()}
     m = json.loads(json.dumps(s["meta"]))
-    for _ in range(data.draw(st.integers(1, 3))):
-        key = data.draw(st.sampled_from(sorted(a)))
-        action = data.draw(st.sampled_from(["replace", "drop", "poke"]))
-        if action == "drop":
-            a.pop(key, None)
-        elif action == "replace" and key in a:
-            a[key] = data.draw(arrays(a[key].shape))
-        elif key in a and a[key].size and a[key].dtype.kind in "fiu":
-            flat = a[key].astype(float).reshape(-1)
-            flat[data.draw(st.integers(0, flat.size - 1))] = data.draw(ANY_FLOAT)
-            a[key] = flat.reshape(a[key].shape)
+    _tamper(data, a)
     if data.draw(st.booleans()):
         m[data.draw(st.sampled_from(sorted(m)))] = data.draw(
             JUNK.filter(lambda v: not isinstance(v, complex)))
