@@ -253,19 +253,12 @@ COMPOSED = RHS.replace("@M@", "@K@").replace("@Z@", "") + """
 void @K@_jacobian(const double *restrict x, const double *restrict p, const int *restrict flags,
     const double *restrict anchors, double *restrict J, double *restrict work)
 {
-    double xdot[PDW_NX], A[PDW_NQ*PDW_NX], col[PDW_NQ], sol[PDW_NQ], fac[PDW_DBLOCK_NFAC];
+    double xdot[PDW_NX], A[PDW_NQ*PDW_NX];
     @K@_rhs(x, p, flags, anchors, xdot, work);
     @K@_contact_partials(work + PDW_WORK_KIN, flags, p, work + PDW_WORK_CONTACT);
     @K@_dynamics_jacobian(x, work + PDW_WORK_TRIG, p, work + PDW_WORK_CONTACT,
                           work + PDW_WORK_QDD, A);
-    pdw_dblock_factor(work + PDW_WORK_M, fac);
-    for (int i = 0; i < PDW_NX*PDW_NX; ++i) J[i] = 0.0;
-    for (int i = 0; i < PDW_NQ; ++i) J[i*PDW_NX + PDW_NQ + i] = 1.0;
-    for (int j = 0; j < PDW_NX; ++j) {
-        for (int i = 0; i < PDW_NQ; ++i) col[i] = A[i*PDW_NX + j];
-        pdw_dblock_solve(work + PDW_WORK_M, fac, col, sol);
-        for (int i = 0; i < PDW_NQ; ++i) J[(PDW_NQ + i)*PDW_NX + j] = sol[i];
-    }
+    pdw_jacobian_from_dynamics(work + PDW_WORK_M, A, J);
 }
 """
 
@@ -437,7 +430,7 @@ typedef struct pdw_kernel {
 
 def source(h):
     parts = [BANNER.format(sympy=sp.__version__, hash=h),
-             "#include <math.h>\n#include \"pdw_model.h\"\n#include \"pdw_linalg.h\"\n"]
+             "#include <math.h>\n#include \"pdw_model.h\"\n#include \"pdw_linalg.h\"\n#include \"pdw_jacobian.h\"\n"]
     sg, cg = mdl.P["sin_gamma"], mdl.P["cos_gamma"]
     body = ["    for (int i = 0; i < PDW_NPARAM; ++i) p[i] = params[i];",
             "    p[PDW_P_%s] = sin(params[PDW_P_GAMMA]);" % sg.name.upper(),

@@ -2,7 +2,7 @@
 #include <math.h>
 #include <string.h>
 #include "pdw_terrain.h"
-#include "pdw_linalg.h"
+#include "pdw_jacobian.h"
 
 void pdw_terrain_kinematics(const pdw_kernel *k, const pdw_ground *g, const double *x,
                             const double *trig, const double *p, const double *anchors,
@@ -95,7 +95,7 @@ void pdw_terrain_jacobian(const pdw_kernel *k, const pdw_ground *g, const double
 {
     const int nx = k->nx;
     if (nx == PDW_NX) {
-        double xdot[PDW_NX], A[PDW_NQ*PDW_NX], col[PDW_NQ], sol[PDW_NQ], fac[PDW_DBLOCK_NFAC];
+        double xdot[PDW_NX], A[PDW_NQ*PDW_NX];
         double cw[2*PDW_NCONTACT], moment[2];
         double *contact = work + PDW_WORK_CONTACT, *gnd = work + PDW_WORK_GROUND;
         pdw_terrain_rhs(k, g, x, p, flags, anchors, xdot, work);
@@ -111,14 +111,7 @@ void pdw_terrain_jacobian(const pdw_kernel *k, const pdw_ground *g, const double
             pdw_consistent_ground_jacobian(x, work + PDW_WORK_TRIG, p, contact, gnd, A);
         else
             pdw_paper_ground_jacobian(x, work + PDW_WORK_TRIG, p, contact, gnd, A);
-        pdw_dblock_factor(work + PDW_WORK_M, fac);
-        for (int i = 0; i < PDW_NX*PDW_NX; ++i) J[i] = 0.0;
-        for (int i = 0; i < PDW_NQ; ++i) J[i*PDW_NX + PDW_NQ + i] = 1.0;
-        for (int j = 0; j < PDW_NX; ++j) {
-            for (int i = 0; i < PDW_NQ; ++i) col[i] = A[i*PDW_NX + j];
-            pdw_dblock_solve(work + PDW_WORK_M, fac, col, sol);
-            for (int i = 0; i < PDW_NQ; ++i) J[(PDW_NQ + i)*PDW_NX + j] = sol[i];
-        }
+        pdw_jacobian_from_dynamics(work + PDW_WORK_M, A, J);
         return;
     }
     double xp[PDW_NX_MAX], fp[PDW_NX_MAX], fm[PDW_NX_MAX];
