@@ -1,5 +1,5 @@
 """The basin of attraction of the `paper_steady` gait on the (phi, thetad2) slice of the
-touch-down section, with the ensemble engine (pdw.analysis.basin), and the scalar path's time
+touch-down section, with the ensemble engine (pdw.analysis.basins.basin), and the scalar path's time
 for the same grid extrapolated from a random sample of grid points run with scalar
 `pdw.simulate` in the same run (same threads), with the verdict agreement on that sample; on
 that sample, scalar and batch runs are also timed against each other in interleaved rounds.
@@ -24,9 +24,9 @@ import numpy as np  # noqa: E402
 from _results import FIGURES, RESULTS, ROOT, publish  # noqa: E402
 
 import pdw  # noqa: E402
-from pdw.analysis import basin as B  # noqa: E402
-from pdw.analysis import cell_mapping as cmap  # noqa: E402
-from pdw.analysis import limit_cycle as lc  # noqa: E402
+from pdw.analysis.basins import basin as B  # noqa: E402
+from pdw.analysis.basins import cell_mapping as cmap  # noqa: E402
+from pdw.analysis.stepmap import limit_cycle as lc  # noqa: E402
 
 N = int(sys.argv[1]) if len(sys.argv) > 1 else 400
 SAMPLE = int(sys.argv[2]) if len(sys.argv) > 2 else 200
@@ -37,7 +37,7 @@ THREADS = os.cpu_count() or 1
 
 
 def scalar_outcome(r, b):
-    """The basin's class of one scalar run (the rules of pdw.analysis.basin)."""
+    """The basin's class of one scalar run (the rules of pdw.analysis.basins.basin)."""
     if r.status == "periodic":
         same = (abs(r.gait["L"][-1] - b.gait_L) <= 0.02 * abs(b.gait_L)
                 and abs(r.gait["P"][-1] - b.gait_P) <= 0.02 * b.gait_P)

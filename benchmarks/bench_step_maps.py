@@ -2,7 +2,7 @@
 engine is used").
 
 Interleaved in one process, round by round, each case once through the engine
-(`pdw.analysis.step_maps`: the finite differences and the cell map's images as walkers of one
+(`pdw.analysis.stepmap.step_maps`: the finite differences and the cell map's images as walkers of one
 `simulate_batch(stop_touch_down=1)`, rodas4 in structure-of-arrays lanes) and once with the
 engine switched off (`step_maps.batchable` forced False: the thread pool of scalar `step`s, as
 before): the Jacobian of the touch-down map at the `paper_steady` gait (find_gait's tolerances,
@@ -25,7 +25,7 @@ from _results import publish
 import pdw
 from pdw import cell_mapping as CM
 from pdw import limit_cycle as LC
-from pdw.analysis import step_maps
+from pdw.analysis.stepmap import step_maps
 
 ROUNDS = int(sys.argv[1]) if len(sys.argv) > 1 else 5
 P = pdw.Params.paper_steady()

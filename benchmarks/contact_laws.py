@@ -38,8 +38,8 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 from _results import publish  # noqa: E402
 
 import pdw  # noqa: E402
-from pdw.analysis import stability_maps as S  # noqa: E402
-from pdw.analysis.calibration import calibrate, calibrate_lugre  # noqa: E402
+from pdw.analysis.numerics import stability_maps as S  # noqa: E402
+from pdw.analysis.numerics.calibration import calibrate, calibrate_lugre  # noqa: E402
 
 P = pdw.Params.paper_steady()
 FIG = ROOT / "docs" / "figures" / "contact_laws_stance.png"

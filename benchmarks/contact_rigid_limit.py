@@ -32,7 +32,7 @@ from _results import publish  # noqa: E402
 
 import pdw  # noqa: E402
 from pdw import hybrid as H  # noqa: E402
-from pdw.analysis.calibration import _bisect, drop_test, typical_landing  # noqa: E402
+from pdw.analysis.numerics.calibration import _bisect, drop_test, typical_landing  # noqa: E402
 from pdw.core.contact import Contact  # noqa: E402
 
 P0 = pdw.Params.paper_steady()

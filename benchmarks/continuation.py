@@ -29,7 +29,7 @@ sys.path.insert(0, str(ROOT))
 
 import pdw  # noqa: E402
 from pdw import hybrid as H  # noqa: E402
-from pdw.analysis.continuation import continue_gait, follow_cascade  # noqa: E402
+from pdw.analysis.bifurcation.continuation import continue_gait, follow_cascade  # noqa: E402
 from pdw.present.cli_continue import preset  # noqa: E402
 from pdw.present.plots_continuation import plot_branches, plot_curves  # noqa: E402
 
@@ -258,7 +258,7 @@ def part_simplest_limit():
 
 
 def part_kelvin_voigt():
-    from pdw.analysis.calibration import calibrate
+    from pdw.analysis.numerics.calibration import calibrate
     P0 = pdw.Params.paper_steady()
     kv = calibrate(P0).contacts["kelvin_voigt"]
     say("== Kelvin-Voigt (k = %.6g, d = %.6g): continued in d_n down to 10 ==" % (kv.k, kv.d))
@@ -281,7 +281,7 @@ def part_kelvin_voigt():
 
 
 def part_codim2(rounds=3):
-    from pdw.analysis.codim2 import continue_bifurcation
+    from pdw.analysis.bifurcation.codim2 import continue_bifurcation
     say("== compass gait: the period-doubling curve in (gamma, c), c 0.5 -> 0.7 (hybrid) ==")
     say("load average before: %s" % (os.getloadavg(),))
     b = continue_gait(H.compass_gait_params(), "gamma", 5.0 * DEG, model="hybrid")
@@ -319,7 +319,7 @@ def part_codim2(rounds=3):
 
 
 def part_chaos():
-    from pdw.analysis import chaos
+    from pdw.analysis.rigid import chaos
     C = H.compass_gait_params()
     say("== compass gait: orbit diagram 4 -> 5.3 deg, 1000 slopes x 200 steps (keep 100) ==")
     say("load average before: %s" % (os.getloadavg(),))
@@ -364,8 +364,8 @@ def part_chaos():
 
 
 def part_monodromy(rounds=3):
-    from pdw.analysis import limit_cycle as LC
-    from pdw.analysis import variational as V
+    from pdw.analysis.stepmap import limit_cycle as LC
+    from pdw.analysis.stepmap import variational as V
     P = pdw.Params.paper_steady()
     g = pdw.find_gait(P)
     z = g.details["z"]

@@ -10,7 +10,7 @@ import math
 import os
 
 import pdw
-from pdw.analysis.calibration import calibrate_lugre
+from pdw.analysis.numerics.calibration import calibrate_lugre
 
 P = pdw.Params.paper_steady()
 cal = calibrate_lugre(P).contact

@@ -17,7 +17,7 @@ import numpy as np
 from _results import FIGURES, publish
 
 import pdw
-from pdw.analysis import robustness_continuous as RC
+from pdw.analysis.robust import robustness_continuous as RC
 
 QUICK = "--quick" in sys.argv
 BASE = pdw.Params.paper_steady()
@@ -111,7 +111,7 @@ def mat_transition(lines):
             # the step index past the mat: footprints are cumulative step lengths from 0
             x = np.cumsum(L)
             past = int(np.searchsorted(x, 2.5)) + 1
-            ret, kk = pdw.analysis.robustness.returned(L[past:], T[past:], g.step_length,
+            ret, kk = pdw.analysis.robust.robustness.returned(L[past:], T[past:], g.step_length,
                                                        g.period, 1e-3)
             grid[i, j] = kk if ret else 99
             row.append("%d" % kk if ret else ">%d" % (len(L) - past))

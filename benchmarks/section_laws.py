@@ -1,4 +1,4 @@
-"""Limit cycles with every contact law (pdw.analysis.section, docs/contact_laws.md "Limit cycles
+"""Limit cycles with every contact law (pdw.analysis.stepmap.section, docs/contact_laws.md "Limit cycles
 with every law"): find_gait on `Params.paper_steady()` with the default law, calibrated LuGre
 friction, Flores (e = 0.18), Lankarani-Nikravesh (e = 0.9) and the calibrated Kelvin-Voigt law, at
 the Newton tolerances (rtol 1e-10): the section's coordinates, the fixed point, L, P, the
@@ -20,9 +20,9 @@ from _results import publish  # noqa: E402
 
 import pdw  # noqa: E402
 from pdw import limit_cycle as LC  # noqa: E402
-from pdw.analysis import section as S  # noqa: E402
-from pdw.analysis.calibration import calibrate, calibrate_lugre  # noqa: E402
 from pdw.analysis.gait_types import GaitNotFoundError  # noqa: E402
+from pdw.analysis.numerics.calibration import calibrate, calibrate_lugre  # noqa: E402
+from pdw.analysis.stepmap import section as S  # noqa: E402
 
 P = pdw.Params.paper_steady()
 LAWS = [("hunt_crossley (default)", pdw.Contact()),

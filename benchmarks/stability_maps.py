@@ -25,7 +25,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 from _results import FIGURES, RESULTS, publish  # noqa: E402
 
 import pdw  # noqa: E402
-from pdw.analysis import stability_maps as S  # noqa: E402
+from pdw.analysis.numerics import stability_maps as S  # noqa: E402
 from pdw.sim import stepsize as SL  # noqa: E402
 
 FIXED = SL.FIXED_STEP

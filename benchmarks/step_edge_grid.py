@@ -1,10 +1,10 @@
 """The walking edge of cdm on a uniform dt grid: is it a clean edge or a ragged one?
 
-`pdw.analysis.stability_maps.largest_step` bisects in log dt and reports the largest step *below which every
+`pdw.analysis.numerics.stability_maps.largest_step` bisects in log dt and reports the largest step *below which every
 tried step passed*. Near the edge the verdict need not be monotone in dt; this script runs every
 dt of a uniform grid (default 1.00 to 3.00 ms in 0.05 ms steps, plus 2.3e-3 exactly) on the
 typical gait (3.5 s, `pdw.sim.stepsize.typical_start`, judged against the rodas4 reference by
-`pdw.analysis.stability_maps.judge`) and reports which pass, the last dt below which all pass, and the passes
+`pdw.analysis.numerics.stability_maps.judge`) and reports which pass, the last dt below which all pass, and the passes
 above the first failure. Writes step_edge_grid.txt (benchmarks/_results.py says where).
 
 Usage: .venv/bin/python benchmarks/step_edge_grid.py [--lo 1e-3] [--hi 3e-3] [--step 5e-5]
@@ -21,7 +21,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 from _results import publish  # noqa: E402
 
 import pdw  # noqa: E402
-from pdw.analysis import stability_maps as S  # noqa: E402
+from pdw.analysis.numerics import stability_maps as S  # noqa: E402
 from pdw.sim.stepsize import typical_start  # noqa: E402
 
 
@@ -50,7 +50,7 @@ def main(argv=None):
     n = int(round((args.hi - args.lo) / args.step)) + 1
     grid = sorted(set(np.round(np.linspace(args.lo, args.hi, n), 12).tolist()) | {2.3e-3})
     lines = ["cdm walking edge on a uniform grid: dt %.2f to %.2f ms in %.3f ms steps (+ 2.3e-3); "
-             "typical gait, 3.5 s, judged against rodas4 (pdw.analysis.stability_maps.judge); load average %s"
+             "typical gait, 3.5 s, judged against rodas4 (pdw.analysis.numerics.stability_maps.judge); load average %s"
              % (args.lo * 1e3, args.hi * 1e3, args.step * 1e3, "%.2f %.2f %.2f" % os.getloadavg()),
              ""]
     for label, params in (("Params.paper()", pdw.Params.paper()),

@@ -40,8 +40,8 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 from _results import publish  # noqa: E402
 from contact_laws import P, sim  # noqa: E402
 
-from pdw.analysis import stability_maps as S  # noqa: E402
-from pdw.analysis.calibration import calibrate, calibrate_lugre  # noqa: E402
+from pdw.analysis.numerics import stability_maps as S  # noqa: E402
+from pdw.analysis.numerics.calibration import calibrate, calibrate_lugre  # noqa: E402
 from pdw.sim import stepsize  # noqa: E402
 
 METHODS = ("cdm", "verlet", "rk4")

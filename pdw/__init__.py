@@ -29,12 +29,12 @@ find_gait               period-one gait of the continuous model: Newton shooting
                         Poincare map, Floquet multipliers (pdw.limit_cycle; cell mapping:
                         pdw.cell_mapping)
 continue_gait, Branch   continuation of gaits in one parameter: branches, Floquet multipliers,
-                        folds, period doublings, Neimark-Sacker, ends (pdw.analysis.continuation;
+                        folds, period doublings, Neimark-Sacker, ends (pdw.analysis.bifurcation.continuation;
                         ``pdw continue``); Branch.save / pdw.load
 plot_branches, plot_curves   bifurcation diagrams (units on both axes, AUTO labels) and
                         two-parameter curves (pdw.present.plots_continuation)
 continue_bifurcation    folds and period doublings followed in a second parameter (minimally
-                        augmented; pdw.analysis.codim2): a BifurcationCurve
+                        augmented; pdw.analysis.bifurcation.codim2): a BifurcationCurve
 sweep                   parameter studies from TOML files: run_study, load_study (``pdw sweep``)
 examples                the scenes and studies shipped with pdw (``pdw run --list-examples``)
 Progress                the progress bar of long jobs (``progress=`` of sweeps, cell maps, basins,
@@ -46,15 +46,17 @@ STATE, VARIANTS         the state layout and the contact variants (docs/model.md
 import sys as _sys
 
 from . import examples  # package data: the shipped scenes and studies
-from .analysis import cell_mapping, hybrid, limit_cycle
-from .analysis.branch import Bifurcation, Branch
-from .analysis.codim2 import BifurcationCurve, continue_bifurcation
-from .analysis.continuation import continue_gait
-from .analysis.first_passage import FirstPassage, first_passage
+from .analysis.basins import cell_mapping
+from .analysis.bifurcation.branch import Bifurcation, Branch
+from .analysis.bifurcation.codim2 import BifurcationCurve, continue_bifurcation
+from .analysis.bifurcation.continuation import continue_gait
 from .analysis.gait_types import Gait, GaitNotFoundError
-from .analysis.limit_cycle import find_gait
-from .analysis.markov import MarkovChain, markov_chain
-from .analysis.robustness import GaitSensitivity, MaxStep, gait_sensitivity, max_step
+from .analysis.rigid import hybrid
+from .analysis.robust.first_passage import FirstPassage, first_passage
+from .analysis.robust.markov import MarkovChain, markov_chain
+from .analysis.robust.robustness import GaitSensitivity, MaxStep, gait_sensitivity, max_step
+from .analysis.stepmap import limit_cycle
+from .analysis.stepmap.limit_cycle import find_gait
 from .core import __version__  # noqa: F401 (pdw.__version__)
 from .core._layout import INPUT_HASH
 from .core.contact import Contact

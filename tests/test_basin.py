@@ -1,10 +1,10 @@
-"""The classification of basin cells (`pdw.analysis.basin`, docs/ensemble.md): a walker that
+"""The classification of basin cells (`pdw.analysis.basins.basin`, docs/ensemble.md): a walker that
 became periodic is the reference gait only when its last step length AND period are each within
 ``match_tol`` (relative) of the reference's; a periodic walker that misses either is another
 gait; one still walking is undecided; a fall is a fall."""
 import numpy as np
 
-from pdw.analysis import basin
+from pdw.analysis.basins import basin
 from pdw.core import _layout
 
 L0, P0, TOL = 0.37, 0.56, 0.02

@@ -141,9 +141,9 @@ def test_empty_batch():
 
 def test_basin_points_are_scalar_walks():
     """A 3 x 2 basin slice: each point's class follows from its scalar simulate run."""
-    from pdw.analysis import basin as B
-    from pdw.analysis import cell_mapping as cmap
-    from pdw.analysis import limit_cycle as lc
+    from pdw.analysis.basins import basin as B
+    from pdw.analysis.basins import cell_mapping as cmap
+    from pdw.analysis.stepmap import limit_cycle as lc
     b = B.basin(phi=(0.6, 0.9, 3), thetad2=(-3.5, -1.0, 2), t_end=6.0, threads=1)
     p = pdw.Params.paper_steady()
     rest = cmap.rest_of(b.reference, p)

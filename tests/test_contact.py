@@ -60,7 +60,7 @@ def test_kelvin_voigt_default_damping_matches_the_drop_test_restitution():
     """The drop test at the typical landing (0.710 m/s, 0.455 kg, docs/contact_laws.md) gives
     Hunt-Crossley's restitution with the default Kelvin-Voigt numbers; the inherited ones
     (Params.k_n, d_n read as N/m, N s/m) give another ground (e = 0.227)."""
-    from pdw.analysis.calibration import drop_test
+    from pdw.analysis.numerics.calibration import drop_test
     e_hc = drop_test(pdw.Contact(), v_in=0.710, mass=0.455).e
     e_kv = drop_test(pdw.Contact("kelvin_voigt"), v_in=0.710, mass=0.455).e
     assert e_kv == pytest.approx(e_hc, abs=0.01)
@@ -70,7 +70,7 @@ def test_kelvin_voigt_default_damping_matches_the_drop_test_restitution():
 
 @pytest.mark.slow
 def test_kelvin_voigt_defaults_are_what_calibrate_computes():
-    from pdw.analysis.calibration import calibrate
+    from pdw.analysis.numerics.calibration import calibrate
     kv = calibrate(pdw.Params.paper_steady()).contacts["kelvin_voigt"]
     assert kv.k == pytest.approx(KELVIN_VOIGT_DEFAULTS["k"], rel=1e-4)
     assert kv.d == pytest.approx(KELVIN_VOIGT_DEFAULTS["d"], rel=1e-3)

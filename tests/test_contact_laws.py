@@ -14,7 +14,7 @@ import pytest
 import sympy as sp
 
 import pdw
-from pdw.analysis.calibration import drop_test
+from pdw.analysis.numerics.calibration import drop_test
 from pdw.core import _core, _layout
 from pdw.core.contact import Contact
 from pdw.core.model import kernel_index, parameter_vector
@@ -169,7 +169,7 @@ def test_calibration_matches_sink_and_restitution():
     sink; Kelvin-Voigt and Flores drop with the Hunt-Crossley restitution; Lankarani-Nikravesh
     cannot dissipate that much (flagged). Flores has Hunt-Crossley's form, so matched at the
     landing speed its damping k chi / v_in is Hunt-Crossley's d_n."""
-    from pdw.analysis.calibration import Landing, calibrate
+    from pdw.analysis.numerics.calibration import Landing, calibrate
     P = pdw.Params.paper_steady()
     cal = calibrate(P, landing=Landing(speed=0.7, mass=0.45, n=1))
     kv = cal.contacts["kelvin_voigt"]
@@ -215,7 +215,7 @@ def test_flores_fixed_point_reproduces_itself_under_simulate():
     orbit. From the fixed point's state (on a period-1 orbit the trailing foot's approach speed
     is the landing one), a continuous run returns to the same section point at every
     touch-down; with both feet re-initialised it does not."""
-    from pdw.analysis import limit_cycle as LC
+    from pdw.analysis.stepmap import limit_cycle as LC
     from pdw.core.model import contact_forces
     c = Contact("flores", e=0.18)
     P = pdw.Params.paper_steady()

@@ -1,11 +1,11 @@
-"""Continuation of gaits, exact monodromy, bifurcations (pdw.analysis.continuation, docs/continuation.md)."""
+"""Continuation of gaits, exact monodromy, bifurcations (pdw.analysis.bifurcation.continuation, docs/continuation.md)."""
 import numpy as np
 import pytest
 
 import pdw
 from pdw import hybrid as H
 from pdw import limit_cycle as LC
-from pdw.analysis.continuation import continue_gait, follow_cascade
+from pdw.analysis.bifurcation.continuation import continue_gait, follow_cascade
 from pdw.core import _hybrid
 from pdw.core.errors import InvalidInputError
 from pdw.core.model import parameter_vector
@@ -219,7 +219,7 @@ def test_continuous_d_hip_branch_ends_in_a_fold():
 # --- the engine on maps with known bifurcations -----------------------------------------------
 
 class _Map:
-    """A duck-typed problem (pdw.analysis.gait_maps) for a smooth map with known bifurcations."""
+    """A duck-typed problem (pdw.analysis.stepmap.gait_maps) for a smooth map with known bifurcations."""
 
     model, parameter, period, ADMISSIBLE = "map", "a", 1, {}
 
@@ -233,7 +233,7 @@ class _Map:
         return float(v)
 
     def evaluate(self, z, mu, jac=True):
-        from pdw.analysis.gait_maps import Evaluation
+        from pdw.analysis.stepmap.gait_maps import Evaluation
         self.n_maps += 1
         h = 1e-7
         P_lam = (self.f(z, mu + h) - self.f(z, mu - h)) / (2 * h)
@@ -249,7 +249,7 @@ class _Map:
 def test_engine_locates_the_fold_and_period_doubling_of_a_quadratic_map():
     """z' = z + a - z^2: fixed points z = +-sqrt(a), a fold at a = 0, and on z = +sqrt(a) the
     multiplier 1 - 2 sqrt(a) passes -1 at a = 1."""
-    from pdw.analysis.continuation import run_continuation
+    from pdw.analysis.bifurcation.continuation import run_continuation
     m = _Map(lambda z, a: z + a - z ** 2, lambda z, a: np.array([[1 - 2 * z[0]]]), 1)
     b = run_continuation(m, [np.sqrt(2.0)], 2.0, -0.5, tol=1e-12, max_points=200)
     kinds = [(f.kind, f.value) for f in b.bifurcations]
@@ -261,7 +261,7 @@ def test_engine_locates_the_fold_and_period_doubling_of_a_quadratic_map():
 def test_engine_locates_the_neimark_sacker_of_the_delayed_logistic_map():
     """x' = y, y' = a y (1 - x): the fixed point's multipliers have |mu|^2 = a - 1, a complex
     pair crossing the unit circle at a = 2."""
-    from pdw.analysis.continuation import run_continuation
+    from pdw.analysis.bifurcation.continuation import run_continuation
     m = _Map(lambda z, a: np.array([z[1], a * z[1] * (1 - z[0])]),
              lambda z, a: np.array([[0.0, 1.0], [-a * z[1], a * (1 - z[0])]]), 2)
     a0 = 1.5
@@ -298,7 +298,7 @@ def test_cli_continue_with_a_contact_section(tmp_path):
     approach speed), not of the default law's; a bad law or a rigid model is refused."""
     import json
 
-    from pdw.analysis import limit_cycle as LC
+    from pdw.analysis.stepmap import limit_cycle as LC
     from pdw.present.cli_continue import load_spec, run_spec
     spec_file = tmp_path / "flores.toml"
     spec_file.write_text('name = "flores_k_hip"\nmodel = "continuous"\npreset = "paper_steady"\n'

@@ -4,7 +4,7 @@ import pytest
 
 import pdw
 from pdw import hybrid as H
-from pdw.analysis import chaos
+from pdw.analysis.rigid import chaos
 
 COMPASS = H.compass_gait_params()
 DEG = np.pi / 180

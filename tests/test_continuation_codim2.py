@@ -1,11 +1,11 @@
-"""Two-parameter continuation of period doublings and folds (issue #24 a; pdw.analysis.codim2)."""
+"""Two-parameter continuation of period doublings and folds (issue #24 a; pdw.analysis.bifurcation.codim2)."""
 import numpy as np
 import pytest
 
 import pdw
 from pdw import hybrid as H
-from pdw.analysis.codim2 import continue_bifurcation
-from pdw.analysis.continuation import continue_gait
+from pdw.analysis.bifurcation.codim2 import continue_bifurcation
+from pdw.analysis.bifurcation.continuation import continue_gait
 
 COMPASS = H.compass_gait_params()
 DEG = np.pi / 180
@@ -86,7 +86,7 @@ class _Flip:
         return float(v)
 
     def evaluate(self, z, mu, jac=True):
-        from pdw.analysis.gait_maps import Evaluation
+        from pdw.analysis.stepmap.gait_maps import Evaluation
         x, d, dl = float(z[0]), 1.0, 0.0
         for _ in range(self.period):
             self.n_maps += 1
@@ -104,7 +104,7 @@ class _Flip:
 
 @pytest.mark.parametrize("c, expected", [(1.0, "supercritical"), (-1.0, "subcritical")])
 def test_criticality_of_a_flip_from_the_period_two_branch(c, expected):
-    from pdw.analysis.continuation import run_continuation
+    from pdw.analysis.bifurcation.continuation import run_continuation
     b = run_continuation(_Flip(c), [0.0], -0.5, 0.5, tol=1e-12)
     (pd,) = b.of_kind("period_doubling")
     assert abs(pd.value) < 1e-6
@@ -137,7 +137,7 @@ class _Pitchfork(_Flip):
     """z' = z + a z - z^3: the branch z = 0 for every a, crossed at a = 0 by z^2 = a."""
 
     def evaluate(self, z, mu, jac=True):
-        from pdw.analysis.gait_maps import Evaluation
+        from pdw.analysis.stepmap.gait_maps import Evaluation
         x = float(z[0])
         self.n_maps += 1
         info = {"period": 1.0, "step_length": 1.0, "double_support": 0.0,
@@ -147,7 +147,7 @@ class _Pitchfork(_Flip):
 
 
 def test_branch_point_located_and_switched_onto_the_crossing_branch():
-    from pdw.analysis.continuation import run_continuation
+    from pdw.analysis.bifurcation.continuation import run_continuation
     b = run_continuation(_Pitchfork(0.0), [0.0], -0.5, 0.5, tol=1e-12,
                          detect=("fold", "branch_point"))
     (bp,) = b.of_kind("branch_point")

@@ -1,12 +1,17 @@
 """Extension points of the continuation engine (issue #24: problem protocol, predictor and step
-control as objects, test functions as objects; pdw.analysis.extension, testfunctions)."""
+control as objects, test functions as objects; pdw.analysis.bifurcation.extension, testfunctions)."""
 import numpy as np
 import pytest
 
 import pdw
-from pdw.analysis.continuation import run_continuation
-from pdw.analysis.extension import NaturalPredictor, ResidualProblem, StepControl, TangentPredictor
-from pdw.analysis.testfunctions import Event, TestFunction
+from pdw.analysis.bifurcation.continuation import run_continuation
+from pdw.analysis.bifurcation.extension import (
+    NaturalPredictor,
+    ResidualProblem,
+    StepControl,
+    TangentPredictor,
+)
+from pdw.analysis.bifurcation.testfunctions import Event, TestFunction
 
 
 def _cubic(z, lam):

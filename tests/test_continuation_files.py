@@ -4,8 +4,8 @@ import pytest
 
 import pdw
 from pdw import hybrid as H
-from pdw.analysis.continuation import continue_gait
-from pdw.analysis.testfunctions import BUILTIN, KINDS, LABELS, Event
+from pdw.analysis.bifurcation.continuation import continue_gait
+from pdw.analysis.bifurcation.testfunctions import BUILTIN, KINDS, LABELS, Event
 
 COMPASS = H.compass_gait_params()
 DEG = np.pi / 180

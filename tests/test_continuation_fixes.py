@@ -4,8 +4,8 @@ import pytest
 
 import pdw
 from pdw import hybrid as H
-from pdw.analysis.continuation import continue_gait, run_continuation
-from pdw.analysis.gait_maps import Evaluation
+from pdw.analysis.bifurcation.continuation import continue_gait, run_continuation
+from pdw.analysis.stepmap.gait_maps import Evaluation
 
 COMPASS = H.compass_gait_params()
 
@@ -181,7 +181,7 @@ def test_kelvin_voigt_period_doubling_located_at_109_745_and_stall_stop():
     of 0.1 it is located at 109.745 (the multiplier -1 to 1e-3; long walks: period 1 at 109.70,
     period 2 at 109.75), the finite-difference cross-check flags the kink next to it, and the
     branch beyond stops as stalled instead of crawling to max_points."""
-    from pdw.analysis.calibration import calibrate
+    from pdw.analysis.numerics.calibration import calibrate
     P0 = pdw.Params.paper_steady()
     kv = calibrate(P0).contacts["kelvin_voigt"]
     with pytest.warns(UserWarning, match="depend on the step"):

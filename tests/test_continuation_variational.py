@@ -1,11 +1,11 @@
 """The continuous model's exact monodromy: variational equations with saltation matrices
-(issue #24 item 2; pdw.analysis.variational), against finite differences away from kinks."""
+(issue #24 item 2; pdw.analysis.stepmap.variational), against finite differences away from kinks."""
 import numpy as np
 import pytest
 
 import pdw
-from pdw.analysis import limit_cycle as LC
-from pdw.analysis import variational as V
+from pdw.analysis.stepmap import limit_cycle as LC
+from pdw.analysis.stepmap import variational as V
 
 pytest.importorskip("scipy")
 
@@ -56,7 +56,7 @@ def test_bifurcation_cross_check_uses_the_exact_monodromy(steady):
     finite-difference multipliers with the exact ones where the variational version exists:
     at paper_steady's gait they agree to 2e-4 (the differences resolve multipliers to ~1e-4);
     with other multipliers it reports the gap."""
-    from pdw.analysis.gait_maps import ContinuousProblem
+    from pdw.analysis.stepmap.gait_maps import ContinuousProblem
     P, g = steady
     prob = ContinuousProblem(P, "k_hip")
     diff, note = prob.crosscheck(g.details["z"], P.k_hip, g.multipliers)

@@ -151,7 +151,7 @@ def test_end_of_run_checks_as_simulate():
 
 
 def test_basin_chunks_checkpoint_and_resume(tmp_path, monkeypatch):
-    from pdw.analysis import basin as B
+    from pdw.analysis.basins import basin as B
     kw = dict(phi=(0.6, 0.9, 4), thetad2=(-3.5, -1.0, 3), t_end=6.0, threads=1)
     ref = B.basin(**kw, chunk_size=100)
     ck = tmp_path / "b.npz"

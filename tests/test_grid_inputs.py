@@ -7,7 +7,7 @@ integer n in [1, MAX_GRID]) and ``chunk_size`` an integer, or `InvalidInputError
 import pytest
 
 import pdw
-from pdw.analysis import basin, cell_mapping
+from pdw.analysis.basins import basin, cell_mapping
 
 P = pdw.Params.paper_steady()
 OK = (-2.0, -1.8, 2)

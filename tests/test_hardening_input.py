@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import pdw
-from pdw.analysis import hybrid
+from pdw.analysis.rigid import hybrid
 from pdw.studies.study import parse_study
 
 X0 = np.array(pdw.X0_PAPER)

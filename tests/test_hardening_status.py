@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 import pdw
-from pdw.analysis import hybrid
+from pdw.analysis.rigid import hybrid
 
 # --- finding 2 -------------------------------------------------------------------------------
 

@@ -8,7 +8,7 @@ import pytest
 import sympy as sp
 
 import pdw
-from pdw.analysis.calibration import calibrate_lugre
+from pdw.analysis.numerics.calibration import calibrate_lugre
 from pdw.core import _core, _layout
 from pdw.core.contact import Contact, lugre_stribeck
 from pdw.core.model import kernel_index, parameter_vector
@@ -232,7 +232,7 @@ def test_a_frictionless_preset_needs_lugre_coefficients():
 def test_the_section_carries_the_trailing_bristle():
     """find_gait's section under LuGre has a 7th coordinate, the trailing foot's bristle [um]
     (tests/test_section_laws.py finds the gait); a 6-coordinate point is refused, naming it."""
-    from pdw.analysis import limit_cycle
+    from pdw.analysis.stepmap import limit_cycle
     c = Contact(friction="lugre")
     assert limit_cycle.section_names(c) == limit_cycle.SECTION + ("z1_um",)
     with pytest.raises(pdw.InvalidInputError, match=r"7 components .*z1_um"):

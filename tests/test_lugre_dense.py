@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import pdw
-from pdw.analysis.calibration import calibrate_lugre
+from pdw.analysis.numerics.calibration import calibrate_lugre
 from pdw.core import _core, _layout
 from pdw.sim import dense
 

@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 
 import pdw
-from pdw.analysis import hybrid, poincare, step_maps
+from pdw.analysis.rigid import hybrid
+from pdw.analysis.stepmap import poincare, step_maps
 
 X0 = np.array(pdw.X0_PAPER, dtype=float)
 Y0 = np.array([0.2, -0.2, -1.0, -0.3])          # a hybrid (reduced) state

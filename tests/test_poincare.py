@@ -1,4 +1,4 @@
-"""The touch-down Poincare map (`pdw.analysis.poincare.step`, docs/studies.md "Limit cycles")
+"""The touch-down Poincare map (`pdw.analysis.stepmap.poincare.step`, docs/studies.md "Limit cycles")
 with a fixed-step method, and `pdw.limit_cycle.floquet` against an independent Jacobian.
 
 A fixed-step run samples the touch-down only on the step grid; `step` interpolates linearly
@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 
 import pdw
-from pdw.analysis import cell_mapping, limit_cycle, poincare
+from pdw.analysis.basins import cell_mapping
+from pdw.analysis.stepmap import limit_cycle, poincare
 
 P = pdw.Params.paper_steady()
 

@@ -84,7 +84,7 @@ def test_cell_map_and_point_mapping_count_every_cell(workers):
 
 
 def test_continuation_counts_its_points():
-    from pdw.analysis.continuation import continue_gait
+    from pdw.analysis.bifurcation.continuation import continue_gait
     tty, quiet = _bars()
     params = pdw.hybrid.compass_gait_params()
     b = continue_gait(params, "gamma", params.gamma * 1.05, model="hybrid", max_points=4,
@@ -97,7 +97,7 @@ def test_continuation_counts_its_points():
 
 
 def test_basin_counts_its_grid_points():
-    from pdw.analysis import basin
+    from pdw.analysis.basins import basin
     tty, quiet = _bars()
     b = basin.basin(pdw.Params.paper_steady(), phi=(0.74, 0.76, 2), thetad2=(-2.0, -1.8, 2),
                     t_end=6.0, chunk_size=3, progress=tty)

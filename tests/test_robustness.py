@@ -8,8 +8,8 @@ import pytest
 
 import pdw
 from pdw import hybrid as H
-from pdw.analysis import first_passage as FP
-from pdw.analysis import robustness as R
+from pdw.analysis.robust import first_passage as FP
+from pdw.analysis.robust import robustness as R
 from pdw.core import _hybrid
 from pdw.core.model import parameter_vector
 
@@ -299,7 +299,7 @@ def cgait():
 
 
 def test_max_step_continuous_bracket_is_checked_by_direct_walks(cgait):
-    from pdw.analysis import robustness_continuous as RC
+    from pdw.analysis.robust import robustness_continuous as RC
 
     m = pdw.max_step(P, model="continuous", gait=cgait, budget=30, h_tol=2e-4,
                      trials_per_round=4)
@@ -312,7 +312,7 @@ def test_max_step_continuous_bracket_is_checked_by_direct_walks(cgait):
 
 
 def test_gait_sensitivity_continuous_matches_a_direct_step_down_response(cgait):
-    from pdw.analysis import robustness_continuous as RC
+    from pdw.analysis.robust import robustness_continuous as RC
 
     G = pdw.gait_sensitivity(P, model="continuous", gait=cgait,
                              indicators=("step_time", "step_length"))
@@ -325,7 +325,7 @@ def test_gait_sensitivity_continuous_matches_a_direct_step_down_response(cgait):
 
 
 def test_first_passage_continuous_each_walker_its_own_ground_and_resume(cgait, tmp_path):
-    from pdw.analysis import robustness_continuous as RC
+    from pdw.analysis.robust import robustness_continuous as RC
 
     g = pdw.Ground.random(0.0025, 0.1)
     kw = dict(model="continuous", ground=g, walkers=6, max_steps=25, gait=cgait, seed=5)

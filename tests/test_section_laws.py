@@ -1,4 +1,4 @@
-"""The touch-down Poincaré section for every contact law (pdw.analysis.section): LuGre's section
+"""The touch-down Poincaré section for every contact law (pdw.analysis.stepmap.section): LuGre's section
 carries the trailing foot's bristle, Lankarani-Nikravesh's and Flores' its approach speed, so
 find_gait, Floquet multipliers and continuation work with them and the map is the continuous
 run's; the default laws keep their 6-coordinate section bit for bit."""
@@ -8,9 +8,9 @@ import pytest
 import pdw
 from pdw import cell_mapping as CM
 from pdw import limit_cycle as LC
-from pdw.analysis import section as S
-from pdw.analysis.calibration import calibrate_lugre
-from pdw.analysis.continuation import continue_gait
+from pdw.analysis.bifurcation.continuation import continue_gait
+from pdw.analysis.numerics.calibration import calibrate_lugre
+from pdw.analysis.stepmap import section as S
 from pdw.core.contact import Contact
 
 P = pdw.Params.paper_steady()
@@ -203,7 +203,7 @@ def test_kelvin_voigt_period_one_gait_is_unstable_by_a_flip():
     """Calibrated like the others (same sink, same landing restitution), Kelvin-Voigt's
     period-1 gait on paper_steady exists but is unstable with a real multiplier near -1.45 (a
     flip), which is why its walk stays irregular (docs/contact_laws.md)."""
-    from pdw.analysis.calibration import calibrate
+    from pdw.analysis.numerics.calibration import calibrate
     kv = calibrate(P).contacts["kelvin_voigt"]
     g = LC.find_gait(P, contact=kv, workers=2)
     m = g.multipliers[0]

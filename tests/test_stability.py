@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import pdw
-from pdw.analysis import stability_maps as S
+from pdw.analysis.numerics import stability_maps as S
 from pdw.core.errors import (
     DivergedError,
     FellError,
@@ -376,7 +376,7 @@ def test_maps_nominal_cell_and_claims():
 def test_edge_on_grid_brackets_the_edge():
     """The benchmarks' edge finder: scan, then log-bisect; the bracket holds the true edge and
     is sqrt(10)^(1/2^refine) wide; all-pass and first-fail grids say so."""
-    from pdw.analysis.stability_maps import edge_on_grid
+    from pdw.analysis.numerics.stability_maps import edge_on_grid
     grid = [1e-5 * 10 ** (k / 2) for k in range(9)]
     seen = []
 

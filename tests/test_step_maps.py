@@ -1,4 +1,4 @@
-"""Many touch-down step maps through the ensemble engine (pdw.analysis.step_maps): the same
+"""Many touch-down step maps through the ensemble engine (pdw.analysis.stepmap.step_maps): the same
 numbers as the scalar `step`, walker by walker, so find_gait, Floquet, continuation and cell
 mapping do not move when they use it; and the stop condition it rests on (stop_touch_down)."""
 import numpy as np
@@ -7,8 +7,8 @@ import pytest
 import pdw
 from pdw import cell_mapping as CM
 from pdw import limit_cycle as LC
-from pdw.analysis import step_maps
-from pdw.analysis.gait_maps import ContinuousProblem
+from pdw.analysis.stepmap import step_maps
+from pdw.analysis.stepmap.gait_maps import ContinuousProblem
 from pdw.core import _batch
 
 P = pdw.Params.paper_steady()

@@ -12,7 +12,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 import pdw  # noqa: E402
-from pdw.analysis import basin  # noqa: E402
+from pdw.analysis.basins import basin  # noqa: E402
 from pdw.present import study_plots  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent

@@ -2,7 +2,7 @@
 A basin of attraction
 =====================
 
-Where the walker ends up from a grid of touch-down states (`pdw.analysis.basin`): every grid
+Where the walker ends up from a grid of touch-down states (`pdw.analysis.basins.basin`): every grid
 point is one walker of the ensemble engine (`pdw.simulate_batch`, docs/ensemble.md), started
 at a touch-down with step angle phi and swing rate thetad2, run until its last four steps
 agree (a periodic gait) or it falls. The window is wide enough to hold the basin's edge on
@@ -13,7 +13,7 @@ few seconds); the grid's default is 100 x 100 (docs/ensemble.md).
 import matplotlib.pyplot as plt
 
 import pdw
-from pdw.analysis import basin
+from pdw.analysis.basins import basin
 
 b = basin.basin(pdw.Params.paper_steady(), phi=(0.6, 0.9, 32), thetad2=(-6.0, 1.0, 32),
                 t_end=12.0)

@@ -23,7 +23,7 @@ foot's approach speed captured at its touch-down. The laws whose k has `Params.k
 hunt_crossley d to `Params.d_n`. kelvin_voigt's k and d have other units (N/m, N s/m): they
 never take `Params`' numbers, but default to the law's own calibration to the paper's ground
 (`KELVIN_VOIGT_DEFAULTS`: k = 7318 N/m, d = 112.2 N s/m, the static sink and the drop-test
-restitution of `Params.paper_steady()`'s Hunt-Crossley ground, `pdw.analysis.calibration`;
+restitution of `Params.paper_steady()`'s Hunt-Crossley ground, `pdw.analysis.numerics.calibration`;
 docs/contact_laws.md), filled in when the Contact is made, so its repr shows them.
 
 =====================  ====================================================================
@@ -69,7 +69,7 @@ UNITS = {
 #: kelvin_voigt's defaults: its own calibration to the paper's ground (not `Params.k_n`,
 #: `Params.d_n`, whose units differ): k = W / delta_s (the Hunt-Crossley static sink under the
 #: walker's weight W) and d such that the drop test at the typical landing gives Hunt-Crossley's
-#: restitution 0.1405 (`pdw.analysis.calibration.calibrate` of `Params.paper_steady()`: k =
+#: restitution 0.1405 (`pdw.analysis.numerics.calibration.calibrate` of `Params.paper_steady()`: k =
 #: 7318.12 N/m, d = 112.211 N s/m; here to 4 figures; a test recomputes them).
 KELVIN_VOIGT_DEFAULTS = {"k": 7318.0, "d": 112.2}
 #: LuGre's parameters: (lower bound, lower bound open, unit, meaning)

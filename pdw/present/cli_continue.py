@@ -53,8 +53,8 @@ import time
 import numpy as np
 
 from .. import examples
-from ..analysis.branch import _jsonable
-from ..analysis.continuation import continue_gait, follow_cascade
+from ..analysis.bifurcation.branch import _jsonable
+from ..analysis.bifurcation.continuation import continue_gait, follow_cascade
 from ..core import _toml
 from ..core.contact import Contact
 from ..core.errors import InvalidInputError

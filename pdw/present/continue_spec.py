@@ -34,7 +34,7 @@ COUNTS = {"max_points": (2, 10 ** 6), "max_newton": (1, 1000), "cascade": (0, 16
 POSITIVE = {"step": None, "step_min": 1.0, "step_max": 1.0, "tol": None, "locate_tol": None,
             "fd_step": 1.0}
 KINDS = ("fold", "period_doubling", "neimark_sacker", "end")
-#: The continuous model's step-map options (`pdw.analysis.poincare.step`) and their ranges
+#: The continuous model's step-map options (`pdw.analysis.stepmap.poincare.step`) and their ranges
 #: (lo, hi, open at lo); the hybrid model's are `pdw.hybrid.DEFAULT_OPTIONS`.
 CONTINUOUS_OPTIONS = {"rtol": (0.0, 1.0), "atol": (0.0, None), "event_tol": (0.0, None),
                       "t_max": (0.0, None), "dt": (0.0, 1.0)}
@@ -64,7 +64,7 @@ def _text(where, key, v):
 
 def preset(name, **overrides) -> Params:
     """The walker of a spec's ``preset``."""
-    from ..analysis import hybrid as H
+    from ..analysis.rigid import hybrid as H
     if name == "compass":
         return H.compass_gait_params(**overrides)
     if name == "simplest":
@@ -207,7 +207,7 @@ def _options(where, options, model) -> dict:
     if not isinstance(options, dict):
         raise InvalidInputError("%s must be a table, got %r" % (where, options))
     if model == "hybrid":
-        from ..analysis import hybrid as H
+        from ..analysis.rigid import hybrid as H
         try:
             return H._options(options)
         except InvalidInputError as e:

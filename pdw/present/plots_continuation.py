@@ -1,4 +1,4 @@
-"""Bifurcation diagrams of continued branches (`pdw.analysis.branch.Branch`, docs/continuation.md).
+"""Bifurcation diagrams of continued branches (`pdw.analysis.bifurcation.branch.Branch`, docs/continuation.md).
 
 Stable parts solid, unstable dashed, one colour per branch; bifurcations marked and labelled
 (AUTO-style, e.g. PD1): period doubling (circle), fold (square), Neimark-Sacker (diamond),

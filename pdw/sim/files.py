@@ -107,7 +107,7 @@ def register(tag: str, cls: type, to_file, from_file, *, to_xarray=None) -> Kind
 
 #: readers of whole files by their ``meta["format"]`` tag, for kinds whose reader opens the file
 #: itself (registered by the layers above: ``"pdw-branch-1"``,
-#: `pdw.analysis.continuation.load_branch`)
+#: `pdw.analysis.bifurcation.continuation.load_branch`)
 LOADERS: dict[str, Callable[[pathlib.Path], Any]] = {}
 
 

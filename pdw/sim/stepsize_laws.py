@@ -69,7 +69,7 @@ def law_of(contact) -> str:
     return contact.normal
 
 
-#: Effective mass of a landing foot along the normal [kg] (`pdw.analysis.calibration.
+#: Effective mass of a landing foot along the normal [kg] (`pdw.analysis.numerics.calibration.
 #: typical_landing` on the default walker, docs/contact_laws.md): the mass of the contact
 #: oscillator of `oscillator_limit`.
 LANDING_MASS = 0.455

@@ -172,7 +172,7 @@ def _newton_point(row, params, scene):
     """Fill ``row`` from `pdw.find_gait` (default guesses, the scene's contact laws); keeps
     ``row`` if none is found."""
     from ..analysis.gait_types import GaitNotFoundError
-    from ..analysis.limit_cycle import find_gait
+    from ..analysis.stepmap.limit_cycle import find_gait
     if scene.ground is not None and not scene.ground.is_flat:
         if row["status"] != "":         # the fallback after a simulated point: keep that row
             return

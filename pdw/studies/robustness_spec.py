@@ -1,5 +1,5 @@
 """The robustness spec (``pdw robustness SPEC.toml``, docs/robustness.md): one measure of
-`pdw.analysis.robustness` (max_step, gait_sensitivity, first_passage, markov_chain), at one
+`pdw.analysis.robust.robustness` (max_step, gait_sensitivity, first_passage, markov_chain), at one
 parameter set or along one parameter axis, validated whole before anything runs::
 
     name = "max_step_k_hip"          # output names
@@ -36,9 +36,9 @@ import time
 
 import numpy as np
 
-from ..analysis import first_passage as _fp
-from ..analysis import markov as _mk
-from ..analysis import robustness as _rb
+from ..analysis.robust import first_passage as _fp
+from ..analysis.robust import markov as _mk
+from ..analysis.robust import robustness as _rb
 from ..core import _toml, paths
 from ..core.errors import InvalidInputError, PdwError
 from ..core.params import Params
@@ -262,9 +262,9 @@ def run_spec(spec: RobustnessSpec, *, executor=None, path_for=None, on_row=None)
 def _gait_along(spec, params, prev):
     """The gait at this axis point, followed from the previous point's (one branch of gaits
     along the axis, as the studies do); the default guesses when that fails or at the first."""
-    from ..analysis import hybrid as _hy
-    from ..analysis import limit_cycle as _lc
     from ..analysis.gait_types import GaitNotFoundError
+    from ..analysis.rigid import hybrid as _hy
+    from ..analysis.stepmap import limit_cycle as _lc
 
     find = _hy.find_gait if spec.model == "hybrid" else _lc.find_gait
     step = {k: v for k, v in spec.options.items() if k in _STEP_OPTIONS} \

@@ -4,7 +4,7 @@ simulation of every grid point with the ensemble engine (`pdw.simulate_batch`; d
 The section, its coordinates and the slice are those of `pdw.cell_mapping` (touch-down of the
 swing foot, legs relabelled; grid over phi = theta2 - theta1 [rad] and thetad2 [rad/s], the
 other four coordinates taken from a reference section point, `cell_mapping.reference_point`).
-Unlike cell mapping, no cell-to-cell approximation: each grid point's state (`lc.embed`, flags
+Unlike cell mapping, no cell-to-cell approximation: each grid point's state (`_section.embed`, flags
 (1, 1)) is walked with the paper's central difference method until the last
 ``periodic_steps`` gait steps agree (the compiled loop's periodicity stop) or until ``t_end``,
 and is classed by its outcome:
@@ -26,14 +26,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core import _layout, checks, paths
-from ..core.errors import InvalidInputError
-from ..core.params import Params
-from ..core.progress import progress_bar
-from ..sim.batch import simulate_batch
-from ..sim.options import Stop
+from ...core import _layout, checks, paths
+from ...core.errors import InvalidInputError
+from ...core.params import Params
+from ...core.progress import progress_bar
+from ...sim.batch import simulate_batch
+from ...sim.options import Stop
+from ..stepmap import poincare as _poincare
+from ..stepmap import section as _section
 from . import cell_mapping as cmap
-from . import limit_cycle as lc
 
 FELL, GAIT, OTHER, UNDECIDED = 0, 1, 2, 3
 OUTCOMES = ("fell", "gait", "other", "undecided")
@@ -168,7 +169,7 @@ def basin(params=None, phi=(0.69, 0.81, 100), thetad2=(-3.2, -0.4, 100), *, t_en
         raise InvalidInputError("params must be a pdw.Params, got %s" % type(p).__name__)
     (a0, a1, na), (b0, b1, nb) = cmap.grid_axis("phi", phi), cmap.grid_axis("thetad2", thetad2)
     chunk_size = checks.count("chunk_size", chunk_size, lo=1)
-    z_ref = cmap.reference_point(p) if reference is None else lc._z(reference, "reference")
+    z_ref = cmap.reference_point(p) if reference is None else _poincare._z(reference, "reference")
     if z_ref is None:
         raise InvalidInputError("the paper's initial condition does not reach a touch-down "
                                 "with these params: give a reference section point")
@@ -177,12 +178,12 @@ def basin(params=None, phi=(0.69, 0.81, 100), thetad2=(-3.2, -0.4, 100), *, t_en
     opts = dict(t_end=t_end, dt=dt, params=p, flags0=(1, 1), lanes=lanes, vector=vector,
                 stop=Stop(periodic=periodic_steps > 0, periodic_steps=periodic_steps or 4,
                           periodic_tol=periodic_tol))
-    ref = simulate_batch(lc.embed(z_ref, p)[None, :], threads=1, **opts)
+    ref = simulate_batch(_section.embed(z_ref, p)[None, :], threads=1, **opts)
     if ref.status[0] != "periodic":
         raise InvalidInputError("the reference point does not settle into a periodic gait "
                                 "within t_end = %g s (status %s)" % (t_end, ref.status[0]))
     L0, P0 = float(_last(ref, "L")[0]), float(_last(ref, "P")[0])
-    x0 = np.array([lc.embed(cmap.cell_state(a, b, rest, p), p) for b in B for a in A])
+    x0 = np.array([_section.embed(cmap.cell_state(a, b, rest, p), p) for b in B for a in A])
     n = len(x0)
     key = _key(p, A, B, {**{k: v for k, v in opts.items() if k != "params"},
                          "match_tol": match_tol, "reference": z_ref.tolist()})

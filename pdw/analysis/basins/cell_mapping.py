@@ -39,11 +39,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core import checks, interrupt
-from ..core.errors import InvalidInputError
-from ..core.params import X0_PAPER, Params
-from ..core.progress import progress_bar
-from . import limit_cycle as lc
+from ...core import checks, interrupt
+from ...core.errors import InvalidInputError
+from ...core.params import X0_PAPER, Params
+from ...core.progress import progress_bar
+from ..stepmap import poincare as _poincare
+from ..stepmap import section as _section
+from ..stepmap import step_maps as _maps
 
 SINK = -1
 GRID = ("phi", "thetad2")
@@ -53,7 +55,7 @@ def reference_point(params=None, variant="paper", method="rodas4", contact=None)
     """The section point (`pdw.limit_cycle.section_names` (contact)) of the first touch-down of
     the paper's initial condition (X0_PAPER, flags (0, 1)) under ``contact``; None if the
     walker does not get there."""
-    return lc.settle(X0_PAPER, params, variant, method, flags0=(0, 1), t_end=0.6,
+    return _section.settle(X0_PAPER, params, variant, method, flags0=(0, 1), t_end=0.6,
                      contact=contact)
 
 
@@ -260,13 +262,13 @@ def cell_map(params=None, variant="paper", phi=(0.69, 0.81, 80), thetad2=(-3.2, 
     CellMap
     """
     p = Params.paper_steady() if params is None else params
-    opts = {**lc.LOOSE, **options}
+    opts = {**_section.LOOSE, **options}
     (a0, a1, na), (b0, b1, nb) = grid_axis("phi", phi), grid_axis("thetad2", thetad2)
     a_edges = np.linspace(a0, a1, int(na) + 1)
     b_edges = np.linspace(b0, b1, int(nb) + 1)
     contact = options.get("contact")
     z_ref = (reference_point(p, variant, method, contact) if reference is None
-             else lc._z(reference, "reference", contact))
+             else _poincare._z(reference, "reference", contact))
     if z_ref is None:
         raise InvalidInputError("no reference point: the paper's initial condition does not "
                                 "reach a touch-down with these parameters; pass reference=")
@@ -275,8 +277,8 @@ def cell_map(params=None, variant="paper", phi=(0.69, 0.81, 80), thetad2=(-3.2, 
     A = np.repeat(0.5 * (a_edges[1:] + a_edges[:-1]), int(nb))
     B = np.tile(0.5 * (b_edges[1:] + b_edges[:-1]), int(na))
     Z = np.array([cell_state(A[c], B[c], rest[c], p) for c in range(N)])
-    # through the ensemble engine where it takes the maps (the same numbers as `lc.step`)
-    image_point, status = lc.map_images(Z, p, variant, method, workers=workers, t_hint=0.6,
+    # through the ensemble engine where it takes the maps (the same numbers as `_poincare.step`)
+    image_point, status = _maps.map_images(Z, p, variant, method, workers=workers, t_hint=0.6,
                                         progress=progress, **opts)
     g = grid_of(image_point)
     image = _cell_index(a_edges, b_edges, g[:, 0], g[:, 1])
@@ -335,12 +337,12 @@ def point_mapping_basin(cm: CellMap, z_star, *, n_steps=12, tol=1e-4, workers=No
     a step failed). ``progress``: False, True or a `pdw.Progress` (one unit per cell).
     """
     p = cm.params
-    opts = {**cm.info.get("options", lc.LOOSE), **options}
+    opts = {**cm.info.get("options", _section.LOOSE), **options}
     A, B = cm.centers()
     Z = np.array([cell_state(A[c], B[c], cm.rest[c], p) for c in range(len(A))])
     z_star = np.asarray(z_star, dtype=float)
     fn = lambda z: _converge(z, z_star, n_steps, tol, p, cm.variant, cm.info.get("method", "rodas4"), opts)  # noqa: E731
-    nw = min(lc._workers(workers), len(Z))
+    nw = min(_maps._workers(workers), len(Z))
     bar = progress_bar(progress, len(Z), "point mapping")
     outs = interrupt.thread_map(fn, Z, nw, bar)        # Ctrl-C stops every thread
     return np.array([o[0] for o in outs]), np.array([o[1] for o in outs])
@@ -349,7 +351,7 @@ def point_mapping_basin(cm: CellMap, z_star, *, n_steps=12, tol=1e-4, workers=No
 def _converge(z, z_star, n_steps, tol, p, variant, method, opts):
     t_hint = 0.6
     for k in range(1, n_steps + 1):
-        s = lc.step(z, p, variant, method, t_hint=t_hint, **opts)
+        s = _poincare.step(z, p, variant, method, t_hint=t_hint, **opts)
         if s["status"] != "ok":
             return False, -1
         z, t_hint = s["z"], s["period"]

@@ -1,4 +1,4 @@
-"""Branches of gaits and their bifurcations: the data a continuation returns (`pdw.analysis.continuation`).
+"""Branches of gaits and their bifurcations: the data a continuation returns (`pdw.analysis.bifurcation.continuation`).
 
 A `Branch` holds one family of period-n gaits followed in one parameter: per-point arrays
 (``values``, ``period``, ``step_length``, ``double_support``, ``multipliers``, ``stable``,
@@ -6,7 +6,7 @@ A `Branch` holds one family of period-n gaits followed in one parameter: per-poi
 located `Bifurcation` s. It writes itself as CSV (`Branch.to_csv`) and JSON (`Branch.to_json`),
 plots itself (`Branch.plot`, a bifurcation diagram: stable solid, unstable dashed) and switches
 onto the period-2 branch at a period doubling (`Branch.switch`, i.e.
-`pdw.analysis.continuation.switch_branch`).
+`pdw.analysis.bifurcation.continuation.switch_branch`).
 """
 from __future__ import annotations
 
@@ -19,8 +19,8 @@ from typing import Any
 
 import numpy as np
 
-from ..core.errors import InvalidInputError
-from .gait_types import Gait
+from ...core.errors import InvalidInputError
+from ..gait_types import Gait
 from .testfunctions import KINDS, LABELS
 
 __all__ = ["Bifurcation", "Branch", "KINDS", "LABELS"]
@@ -53,7 +53,7 @@ class Bifurcation:
         the critical eigenvector (real part, for a period doubling), multipliers.
     located : bool
         True when the final bracket is within ``locate_tol`` and the test function vanishes
-        continuously there (`pdw.analysis.continuation_engine.locate`). False: it was only
+        continuously there (`pdw.analysis.bifurcation.continuation_engine.locate`). False: it was only
         *detected* between ``bracket[0]`` and ``bracket[1]``, ``value`` is just the best point
         found, and ``location_note`` says why the location failed.
     bracket : tuple of float
@@ -123,7 +123,7 @@ class Branch:
     sorted by decreasing modulus, ``stable`` (all moduli < 1), ``state`` (N, 4 hybrid /
     8 continuous, 10 with LuGre: the `Gait.state` of each point), ``z`` (N, dim) section
     coordinates (dim: 3 hybrid; continuous 6, or more with a contact law that has memory,
-    `pdw.analysis.section.section_names`),
+    `pdw.analysis.stepmap.section.section_names`),
     ``orbit`` (N, n, dim) the n section points of each period-n gait (``orbit[:, 0] == z``),
     ``tangents`` (N, dim + 1), ``step_size`` (N: the arclength step that reached the point;
     0 for the first), ``newton_iterations`` (N).
@@ -178,7 +178,7 @@ class Branch:
             Offset from the bifurcation's fixed point in the section coordinates (halved up to
             ``max_tries`` times when Newton fails or lands back on the period-n branch).
         **kw
-            Passed to `pdw.analysis.continuation.switch_branch` (``max_tries``).
+            Passed to `pdw.analysis.bifurcation.continuation.switch_branch` (``max_tries``).
 
         Returns
         -------
@@ -193,16 +193,16 @@ class Branch:
         back by `pdw.load`): the new branch starts at the last point, in the direction the
         branch was going. ``**kw``: `pdw.continue_gait`'s options (the saved model, variant,
         contact, period and parameter coordinate are reused; a branch continued with
-        ``params_of`` needs it again). See `pdw.analysis.continuation.extend_branch`."""
+        ``params_of`` needs it again). See `pdw.analysis.bifurcation.continuation.extend_branch`."""
         if self.extender is None:
             raise InvalidInputError("this branch cannot be extended (no problem attached)")
         return self.extender(self, stop, **kw)
 
     def criticality(self, bifurcation: Bifurcation, **kw: Any) -> dict:
         """Super- or subcritical, for a period doubling of this branch, from the direction of
-        the period-2n branch: `pdw.analysis.continuation.criticality`."""
+        the period-2n branch: `pdw.analysis.bifurcation.continuation.criticality`."""
         import importlib
-        return importlib.import_module("pdw.analysis.continuation").criticality(
+        return importlib.import_module("pdw.analysis.bifurcation.continuation").criticality(
             self, bifurcation, **kw)
 
     # --- files ------------------------------------------------------------------------------------
@@ -218,7 +218,7 @@ class Branch:
         doublings (`switch`)."""
         if not str(path).endswith(".npz"):
             raise InvalidInputError("Branch.save: path must end in .npz, got %r" % str(path))
-        from ..core.provenance import provenance
+        from ...core.provenance import provenance
         arrays: dict[str, Any] = {k: np.asarray(getattr(self, k)) for k in self.ARRAYS}
         prob = self.problem
         problem = None

@@ -33,10 +33,10 @@ from typing import Any
 
 import numpy as np
 
-from ..core.errors import InvalidInputError
-from ..core.params import Params
+from ...core.errors import InvalidInputError
+from ...core.params import Params
+from ..stepmap.gait_maps import Evaluation
 from .branch import Bifurcation
-from .gait_maps import Evaluation
 
 #: the bifurcation kinds a curve can follow, and the sign s of A = M + s I
 SIGNS = {"period_doubling": 1.0, "fold": -1.0}
@@ -49,7 +49,7 @@ def _null_vectors(A):
 
 class AugmentedProblem:
     """The minimally augmented system of a fold / period doubling of ``prob`` (a one-parameter
-    problem of `pdw.analysis.gait_maps`, whose parameter is the bifurcation's) in the second
+    problem of `pdw.analysis.stepmap.gait_maps`, whose parameter is the bifurcation's) in the second
     parameter ``parameter2``, as a problem of the continuation engine (module docstring)."""
 
     ADMISSIBLE: dict = {}

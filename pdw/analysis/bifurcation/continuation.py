@@ -1,10 +1,10 @@
 """Continuation of gaits in one parameter: branches, stability, bifurcations (docs/continuation.md).
 
 The problem: fixed points of the period-n step map, G(z, u) = P^n(z; lambda(u)) - z = 0, with z
-the section coordinates (`pdw.analysis.gait_maps`) and u the parameter coordinate, scaled so
+the section coordinates (`pdw.analysis.stepmap.gait_maps`) and u the parameter coordinate, scaled so
 that the requested range is one unit: u = (mu - mu_0) / (mu_stop - mu_0), mu = lambda (or
 log lambda with ``log=True``). A branch is a curve x(s) = (z, u)(s) of solutions. The engine
-itself is `pdw.analysis.continuation_engine`.
+itself is `pdw.analysis.bifurcation.continuation_engine`.
 
 Pseudo-arclength (default): from a point x_i with unit tangent t_i (the null vector of
 DG = [M - I, dP/du], oriented by t_{i-1}), predict x_i + ds t_i and correct by Newton's method on
@@ -19,7 +19,7 @@ bifurcation there: fold: the tangent's u component (natural: det(M - I)); period
 det(M + I); Neimark-Sacker: prod_{j<k} (mu_j mu_k - 1) (a complex pair with |mu| = 1 makes a
 factor vanish; a real pair with mu_j mu_k = 1, a neutral saddle, is rejected after location);
 the end of the family: an admissibility function of the model through 0
-(`pdw.analysis.gait_maps.HybridProblem.ADMISSIBLE`, ...), or the step map failing (the walker
+(`pdw.analysis.stepmap.gait_maps.HybridProblem.ADMISSIBLE`, ...), or the step map failing (the walker
 falls, no heel strike, ...) where the corrector cannot go on. Each crossing is located by the Illinois
 (regula falsi) method on the arclength s along the predictor from x_i, every trial point
 corrected onto the branch, until the bracket in the parameter is narrower than ``locate_tol``.
@@ -48,13 +48,15 @@ from typing import Callable, Literal, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..core.errors import InvalidInputError
-from ..core.params import Params
-from ..core.progress import Progress, progress_bar
-from ..sim import files as _files
+from ...core.errors import InvalidInputError
+from ...core.params import Params
+from ...core.progress import Progress, progress_bar
+from ...sim import files as _files
+from ..gait_types import Gait, GaitNotFoundError
+from ..rigid import hybrid as H
+from ..stepmap import limit_cycle as LC
+from ..stepmap.gait_maps import ContinuousProblem, HybridProblem
 from . import extension as X
-from . import hybrid as H
-from . import limit_cycle as LC
 from . import testfunctions as TF
 from .branch import BRANCH_FORMAT, Bifurcation, Branch
 from .continuation_engine import (
@@ -67,8 +69,6 @@ from .continuation_engine import (
     label_points,
     tests,
 )
-from .gait_maps import ContinuousProblem, HybridProblem
-from .gait_types import Gait, GaitNotFoundError
 
 MODELS = ("continuous", "hybrid")
 
@@ -163,7 +163,7 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
     log : bool
         Continue in log(parameter) (for parameters spanning decades, e.g. k_n).
     detect : tuple of str
-        Which built-in test functions to watch (`pdw.analysis.testfunctions.BUILTIN`: "fold",
+        Which built-in test functions to watch (`pdw.analysis.bifurcation.testfunctions.BUILTIN`: "fold",
         "period_doubling", "neimark_sacker", "end", "branch_point").
     max_newton : int
         Newton iterations of the corrector per point (>= 1).
@@ -175,7 +175,7 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
         Step-map options (hybrid: `pdw.hybrid.DEFAULT_OPTIONS`; continuous: rtol, atol,
         event_tol, t_max, dt, contact: with a contact law that has memory (LuGre friction,
         lankarani_nikravesh, flores) the section and z have its extra coordinates,
-        `pdw.analysis.section.section_names`).
+        `pdw.analysis.stepmap.section.section_names`).
     at : sequence of float
         Parameter values at which the branch gets a point of its own (a natural correction
         there, when the branch passes the value), e.g. to compare with a table.
@@ -183,12 +183,12 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
         A bar over the branch's points (up to ``max_points``) on stderr when it is a terminal
         (`pdw.core.progress`).
     events : sequence of TestFunction
-        User test functions, e.g. ``pdw.analysis.testfunctions.Event("step_length", 0.4)``
+        User test functions, e.g. ``pdw.analysis.bifurcation.testfunctions.Event("step_length", 0.4)``
         (step length = 0.4 m): located like bifurcations and reported with them (kind
         ``"event"``, label UZ).
     monodromy : {"differences", "exact"}
         The continuous model's M: central differences (default), or exact from the variational
-        equations with saltation matrices (`pdw.analysis.variational`; default laws, paper
+        equations with saltation matrices (`pdw.analysis.stepmap.variational`; default laws, paper
         variant, period 1; 25-40x the CPU time per point).
     stall_points, stall_length : int, float
         The continuation stops as *stalled* when the last ``stall_points`` steps together
@@ -218,7 +218,7 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
                 or prob.period != 1):
             raise InvalidInputError("monodromy='exact' of the continuous model needs the "
                                     "default laws, variant 'paper' and period 1 "
-                                    "(pdw.analysis.variational)")
+                                    "(pdw.analysis.stepmap.variational)")
         prob.monodromy = "exact"
     if value is None:
         if isinstance(start, Gait) and start.details and "value" in start.details:
@@ -250,13 +250,13 @@ def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_po
                      direction=None, origin=None, settings=None, t0=None, at=(),
                      progress=False, events=(), stall_points=8, stall_length=1e-3,
                      step_control=None) -> Branch:
-    """The continuation proper, on any problem object (`pdw.analysis.gait_maps`: ``dim``, ``evaluate``,
+    """The continuation proper, on any problem object (`pdw.analysis.stepmap.gait_maps`: ``dim``, ``evaluate``,
     ``coord``/``value``, ``gait``, ``ADMISSIBLE``, ...), from the fixed point z0 at ``value``
     towards ``stop``; the arguments as in `continue_gait` (``direction``: (dz, dmu) to orient
     the first tangent; ``origin``: where a switched branch was born, for plots; ``at``:
     parameter values where a point is also computed, by a natural correction, whenever the
     branch passes them; ``method``: "pseudo_arclength", "natural" or a predictor object,
-    ``step_control``: a `pdw.analysis.extension.StepControl`, both extension points)."""
+    ``step_control``: a `pdw.analysis.bifurcation.extension.StepControl`, both extension points)."""
     t0 = time.perf_counter() if t0 is None else t0
     o = _check_options(dict(method=method, step=step, step_min=step_min, step_max=step_max,
                             tol=tol, locate_tol=locate_tol, max_points=max_points,
@@ -437,7 +437,7 @@ def load_branch(path: str | os.PathLike) -> Branch:
     if pr is not None and not pr.get("params_of"):
         opts = dict(pr["options"])
         if isinstance(opts.get("contact"), dict):
-            from ..core.contact import Contact
+            from ...core.contact import Contact
             opts["contact"] = Contact(**opts["contact"])
         opts.pop("t_hint", None)
         prob = _problem(Params(**pr["params"]), pr["parameter"], pr["model"], pr["variant"],

@@ -1,10 +1,10 @@
-"""The predictor-corrector engine and the test functions of `pdw.analysis.continuation`.
+"""The predictor-corrector engine and the test functions of `pdw.analysis.bifurcation.continuation`.
 
-`Engine` works in the scaled coordinates x = (z, u) of one problem (`pdw.analysis.gait_maps`):
+`Engine` works in the scaled coordinates x = (z, u) of one problem (`pdw.analysis.stepmap.gait_maps`):
 Newton correction on the step map bordered by the arclength (or natural) condition, unit
 tangents, and one continuation step. `tests` evaluates the test functions at a point,
 `check_crossings` finds their sign changes between two points and locates each by the
-Illinois method (`locate`); the method is described in `pdw.analysis.continuation`.
+Illinois method (`locate`); the method is described in `pdw.analysis.bifurcation.continuation`.
 """
 from __future__ import annotations
 
@@ -12,12 +12,12 @@ import warnings
 
 import numpy as np
 
-from ..core import checks
-from ..core.errors import InvalidInputError
+from ...core import checks
+from ...core.errors import InvalidInputError
+from ..stepmap.gait_maps import Evaluation
 from . import extension as X
 from . import testfunctions as TF
 from .branch import Bifurcation
-from .gait_maps import Evaluation
 
 
 class Point:
@@ -98,7 +98,7 @@ class Engine:
 
     def step_from(self, pt, ds):
         """The next point at step ds from pt, predicted by ``self.predictor``
-        (`pdw.analysis.extension`)."""
+        (`pdw.analysis.bifurcation.extension`)."""
         x_pred, c = self.predictor.predict(self, pt, ds)
         x, ev, its = self.correct(x_pred, c)
         if x is None:
@@ -110,7 +110,7 @@ class Engine:
 # --- test functions ---------------------------------------------------------------------------
 
 def tests(engine, pt, functions=None):
-    """The values of every test function (`pdw.analysis.testfunctions`) at ``pt``: {name: f}."""
+    """The values of every test function (`pdw.analysis.bifurcation.testfunctions`) at ``pt``: {name: f}."""
     out = {}
     for tf in (engine.functions if functions is None else functions):
         for name, v in tf.values(engine, pt).items():

@@ -4,7 +4,7 @@
   engine solves G(z, lambda) = P(z) - z = 0 from ``evaluate`` (P, M = dP/dz, dP/dlambda). A
   problem given as a residual (G, dG/dz, dG/dlambda) is adapted by `ResidualProblem`
   (P = z + G, M = I + dG/dz, dP/dlambda = dG/dlambda); the gait maps of
-  `pdw.analysis.gait_maps` and the augmented problem of `pdw.analysis.codim2` are problems.
+  `pdw.analysis.stepmap.gait_maps` and the augmented problem of `pdw.analysis.bifurcation.codim2` are problems.
 * **Predictors** (`TangentPredictor`: pseudo-arclength, the default; `NaturalPredictor`: a step
   in the parameter alone): ``predict(engine, point, ds) -> (x_pred, border)``, the corrector
   solving [G(x); border . (x - x_pred)] = 0.
@@ -17,13 +17,13 @@ from typing import Any, Callable, Protocol
 
 import numpy as np
 
-from ..core.errors import InvalidInputError
-from .gait_maps import Evaluation
-from .gait_types import Gait
+from ...core.errors import InvalidInputError
+from ..gait_types import Gait
+from ..stepmap.gait_maps import Evaluation
 
 
 class ContinuationProblem(Protocol):
-    """What the engine needs of a problem (duck-typed; `pdw.analysis.gait_maps`)."""
+    """What the engine needs of a problem (duck-typed; `pdw.analysis.stepmap.gait_maps`)."""
 
     dim: int
     model: str

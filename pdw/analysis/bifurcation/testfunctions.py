@@ -1,7 +1,7 @@
 """Test functions of a continuation as objects: what is watched along a branch (docs/continuation.md).
 
 A test function maps a branch point to one or more named scalars; a sign change between two
-points marks a point to locate there (`pdw.analysis.continuation_engine.check_crossings`). The
+points marks a point to locate there (`pdw.analysis.bifurcation.continuation_engine.check_crossings`). The
 built-in ones are the bifurcations of a fixed point of a map, the admissible ends of a gait
 family, and user events:
 
@@ -26,7 +26,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..core.errors import InvalidInputError
+from ...core.errors import InvalidInputError
 
 
 class TestFunction:
@@ -218,7 +218,7 @@ def select(detect: Any, events: Any = ()) -> list[TestFunction]:
     out: list[TestFunction] = [t for t in BUILTIN if t.kind in detect]
     for e in events or ():
         if not isinstance(e, TestFunction):
-            raise InvalidInputError("events: each must be a pdw.analysis.testfunctions.Event "
+            raise InvalidInputError("events: each must be a pdw.analysis.bifurcation.testfunctions.Event "
                                     "or TestFunction, got %r" % (e,))
         out.append(e)
     return out

@@ -18,11 +18,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core import _core, _layout
-from ..core.contact import Contact
-from ..core.errors import InvalidInputError
-from ..core.model import kernel_index, parameter_vector
-from ..core.params import Params
+from ...core import _core, _layout
+from ...core.contact import Contact
+from ...core.errors import InvalidInputError
+from ...core.model import kernel_index, parameter_vector
+from ...core.params import Params
 
 _KIN = {n: i for i, n in enumerate(_layout.KIN)}
 _CON = {n: i for i, n in enumerate(_layout.CONTACT)}
@@ -149,8 +149,8 @@ def typical_landing(params: Params | None = None, variant: str = "paper", t_end:
     """Measure the touch-downs of the default (Hunt-Crossley) walker from the paper's start:
     a cdm run at dt = 1e-4 s, the state one step before each touch-down after the first
     ``skip`` (the start-up transient)."""
-    from ..core.model import contact_forces, mass_matrix
-    from ..sim.simulation import simulate
+    from ...core.model import contact_forces, mass_matrix
+    from ...sim.simulation import simulate
     params = Params.paper_steady() if params is None else params
     r = simulate(params=params, variant=variant, t_end=t_end, dt=1e-4, method="cdm")
     speeds, masses = [], []
@@ -271,8 +271,8 @@ def calibrate_lugre(params: Params | None = None, sigma0: float = 1e5,
 
     ``normal`` and ``normal_parameters`` (k, d, e, ...) give the normal law, as `Contact`.
     """
-    from ..core.contact import lugre_stribeck
-    from ..core.model import mass_matrix
+    from ...core.contact import lugre_stribeck
+    from ...core.model import mass_matrix
     params = Params.paper_steady() if params is None else params
     W = params.weight
     q = np.zeros(_layout.NQ)

@@ -15,12 +15,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.errors import InvalidInputError
-from ..core.model import contact_forces, energies, rhs
-from ..core.params import Params
-from ..sim.options import Integrator, Limits, Record
-from ..sim.simulation import simulate
-from ..sim.stepsize import FIXED_STEP, _set_hip_height, step_limit, typical_start  # noqa: F401
+from ...core.errors import InvalidInputError
+from ...core.model import contact_forces, energies, rhs
+from ...core.params import Params
+from ...sim.options import Integrator, Limits, Record
+from ...sim.simulation import simulate
+from ...sim.stepsize import FIXED_STEP, _set_hip_height, step_limit, typical_start  # noqa: F401
 
 # --------------------------------------------------------------------------------------------
 # the criteria of the stability maps

@@ -15,13 +15,13 @@ from typing import Sequence
 
 import numpy as np
 
-from ..core import _hybrid, checks  # type: ignore[attr-defined]  # compiled, no stub
-from ..core.errors import InvalidInputError
-from ..core.interrupt import thread_map
-from ..core.model import parameter_vector
-from ..core.params import Params
+from ...core import _hybrid, checks  # type: ignore[attr-defined]  # compiled, no stub
+from ...core.errors import InvalidInputError
+from ...core.interrupt import thread_map
+from ...core.model import parameter_vector
+from ...core.params import Params
+from ..gait_types import GaitNotFoundError
 from . import hybrid as H
-from .gait_types import GaitNotFoundError
 
 _E = np.array([[1.0, 0, 0], [-1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0]])
 

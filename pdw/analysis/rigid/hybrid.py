@@ -27,16 +27,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core import _hybrid, _layout, checks  # type: ignore[attr-defined]  # compiled, no stub
-from ..core.errors import (
+from ...core import _hybrid, _layout, checks  # type: ignore[attr-defined]  # compiled, no stub
+from ...core.errors import (
     FellError,
     InvalidInputError,
     SimulationError,
     SingularSystemError,
 )
-from ..core.model import parameter_vector
-from ..core.params import Params
-from .gait_types import Gait, GaitNotFoundError
+from ...core.model import parameter_vector
+from ...core.params import Params
+from ..gait_types import Gait, GaitNotFoundError
 
 STATE = ("theta_st", "theta_sw", "thetad_st", "thetad_sw")
 #: Options of the compiled step map and their defaults (see pdw/core/csrc/pdw_hybrid_sim.h).
@@ -94,7 +94,7 @@ def ground_ref(ground):
     A tilted plane is refused (it is the walker on another slope: change ``gamma``)."""
     if ground is None:
         return None
-    from ..core.ground import Ground
+    from ...core.ground import Ground
 
     g = Ground.coerce(ground)
     if g.kind == "flat":

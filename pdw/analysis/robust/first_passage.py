@@ -24,8 +24,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core import _hybrid, checks, interrupt
-from ..core.errors import InvalidInputError
+from ...core import _hybrid, checks, interrupt
+from ...core.errors import InvalidInputError
 from . import robustness as _rb
 
 _COLUMNS = ("walker", "steps", "failed", "status")
@@ -177,7 +177,7 @@ def first_passage(params=None, *, sigma=None, ground=None, walkers=400, max_step
         (`dh_sequence`).
     ground : pdw.Ground, optional
         Continuous model: a ``Ground.random(sigma=..., ...)``; walker i walks its own ground,
-        the same but of seed ``seed + i`` (`pdw.analysis.robustness_continuous.chunk`).
+        the same but of seed ``seed + i`` (`pdw.analysis.robust.robustness_continuous.chunk`).
     walkers, max_steps : int
         Walkers, and the steps after which a walker still walking is censored.
     model : {"hybrid", "continuous"}
@@ -211,7 +211,7 @@ def first_passage(params=None, *, sigma=None, ground=None, walkers=400, max_step
     seed = checks.count("seed", seed, lo=0, hi=2 ** 63 - 1)
     threads = checks.count("threads", threads, lo=1, hi=1024)
     if model == "continuous":
-        from ..core.ground import Ground
+        from ...core.ground import Ground
         from . import robustness_continuous as _rc
 
         if sigma is not None:

@@ -27,8 +27,8 @@ from typing import Any
 
 import numpy as np
 
-from ..core import checks
-from ..core.errors import InvalidInputError
+from ...core import checks
+from ...core.errors import InvalidInputError
 from . import robustness as _rb
 
 
@@ -81,7 +81,7 @@ class MarkovChain:
 
     def sample(self, walkers, max_steps, seed=0):
         """Monte Carlo on the discretized chain itself: (steps (walkers,), failed (walkers,)),
-        each walker from the gait's cell; for `pdw.analysis.first_passage.mfpt_estimate`."""
+        each walker from the gait's cell; for `pdw.analysis.robust.first_passage.mfpt_estimate`."""
         rng = np.random.default_rng(seed)
         Q = self.Q.tocsr()
         n = Q.shape[0]

@@ -4,8 +4,8 @@
   ground stays at the new level) that the period-one gait survives and returns from;
 * `gait_sensitivity`: the gait sensitivity norm of Hobbelen & Wisse (IEEE T-RO 23(6), 2007):
   the H2 norm of the linearized step map from a floor-height disturbance to gait indicators;
-* `pdw.analysis.first_passage`: the mean first-passage time on rough ground (Monte Carlo) and
-  `pdw.analysis.markov`: its Markov-chain estimate (Byl & Tedrake, IJRR 28(8), 2009).
+* `pdw.analysis.robust.first_passage`: the mean first-passage time on rough ground (Monte Carlo) and
+  `pdw.analysis.robust.markov`: its Markov-chain estimate (Byl & Tedrake, IJRR 28(8), 2009).
 
 The hybrid model (`pdw.hybrid`, docs/hybrid.md) meets a floor-height disturbance through the
 step map's floor offset ``dh`` (the ground under the swing foot relative to the stance foot's
@@ -23,12 +23,12 @@ import math
 
 import numpy as np
 
-from ..core import _hybrid, checks, interrupt
-from ..core.errors import InvalidInputError
-from ..core.model import parameter_vector
-from ..core.params import Params
-from . import hybrid as _hy
-from .gait_types import Gait
+from ...core import _hybrid, checks, interrupt
+from ...core.errors import InvalidInputError
+from ...core.model import parameter_vector
+from ...core.params import Params
+from ..gait_types import Gait
+from ..rigid import hybrid as _hy
 from .robustness_core import GaitSensitivity, MaxStep, h2_norm, returned
 
 __all__ = ["max_step", "gait_sensitivity", "disturbance_response", "step_lengths", "MaxStep",

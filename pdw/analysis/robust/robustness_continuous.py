@@ -25,13 +25,13 @@ from typing import Any
 
 import numpy as np
 
-from ..core.errors import InvalidInputError
-from ..core.ground import Ground
-from ..sim.batch import simulate_batch
-from ..sim.gait import steps as _steps
-from ..sim.options import Integrator, Limits
-from ..sim.simulation import simulate
-from . import limit_cycle as _lc
+from ...core.errors import InvalidInputError
+from ...core.ground import Ground
+from ...sim.batch import simulate_batch
+from ...sim.gait import steps as _steps
+from ...sim.options import Integrator, Limits
+from ...sim.simulation import simulate
+from ..stepmap import limit_cycle as _lc
 from . import robustness_core as _rb
 
 #: integrator tolerances of the walks (rodas4)
@@ -136,9 +136,9 @@ def step_trials_fn(params, *, direction, budget, return_tol, gait=None, executor
 
 
 def _section_step(z, params, ground, **options):
-    """One touch-down map step from section point z on ``ground`` (`pdw.analysis.poincare.step`,
+    """One touch-down map step from section point z on ``ground`` (`pdw.analysis.stepmap.poincare.step`,
     its tight tolerances): (z', touch-down-to-touch-down time [s], step length [m])."""
-    from .poincare import step
+    from ..stepmap.poincare import step
 
     out = step(z, params, ground=ground, **options)
     if out["status"] != "ok":
@@ -220,7 +220,7 @@ def walker_ground(ground, seed, i, max_steps, step_length):
 
 def chunk(params, gait, ground, seed, lo, hi, max_steps, options):
     """Walkers lo..hi-1 of the continuous model on their own random grounds: (steps, failed,
-    status), as `pdw.analysis.first_passage._hybrid_chunk` (module level: executors take it).
+    status), as `pdw.analysis.robust.first_passage._hybrid_chunk` (module level: executors take it).
     One `pdw.simulate_batch` (a ground per walker). A walker's first-passage time counts its
     steps (touch-downs) plus the failing one; one that walks ``max_steps`` steps, or leaves its
     ground's extent, is censored at its steps."""

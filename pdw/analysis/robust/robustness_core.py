@@ -1,5 +1,5 @@
 """Result types and the pieces of the robustness measures shared by the hybrid and the compliant
-model (`pdw.analysis.robustness`, `pdw.analysis.robustness_continuous`; docs/robustness.md)."""
+model (`pdw.analysis.robust.robustness`, `pdw.analysis.robust.robustness_continuous`; docs/robustness.md)."""
 from __future__ import annotations
 
 import math
@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.errors import InvalidInputError
+from ...core.errors import InvalidInputError
 
 
 @dataclass

@@ -1,4 +1,4 @@
-"""Step maps of one parameter, with their Jacobians, for continuation (`pdw.analysis.continuation`).
+"""Step maps of one parameter, with their Jacobians, for continuation (`pdw.analysis.bifurcation.continuation`).
 
 A *problem* is the period-n step map z -> P^n(z; lambda) on a model's Poincaré section with
 the Jacobians the continuation needs: ``M = d P^n / d z`` (the monodromy matrix; its
@@ -12,7 +12,7 @@ eigenvalues are the Floquet multipliers) and ``d P^n / d lambda``. Two models:
   differences to ~1e-9 at rtol = atol = 1e-12 (tests/test_continuation.py).
 * `ContinuousProblem` (`pdw.limit_cycle`, compliant ground): z at the swing foot's
   touch-down (6 coordinates, or more with a contact law that has memory: ``options["contact"]``,
-  `pdw.analysis.section.section_names`). M by central differences of the rodas4 map (rtol 1e-10, atol 1e-12, event_tol
+  `pdw.analysis.stepmap.section.section_names`). M by central differences of the rodas4 map (rtol 1e-10, atol 1e-12, event_tol
   1e-12, step ``fd_step`` = 1e-5): the map is reproducible to ~1e-10, so M is good to ~1e-5
   (multipliers below ~1e-4 in modulus are not resolved). The 12 + 2 evaluations run on an
   executor (threads by default; the compiled loop releases the GIL); 2 dim + 2 with dim = len(z).
@@ -30,13 +30,15 @@ import os
 
 import numpy as np
 
-from ..core import _hybrid  # type: ignore[attr-defined]  # compiled, no stub
-from ..core.errors import InvalidInputError
-from ..core.model import parameter_vector
-from ..core.params import Params
-from . import hybrid as H
-from . import limit_cycle as LC
-from .gait_types import Gait
+from ...core import _hybrid  # type: ignore[attr-defined]  # compiled, no stub
+from ...core.errors import InvalidInputError
+from ...core.model import parameter_vector
+from ...core.params import Params
+from ..gait_types import Gait
+from ..rigid import hybrid as H
+from . import poincare as _poincare
+from . import section as _section
+from . import step_maps as _maps
 
 
 class Evaluation:
@@ -199,7 +201,7 @@ class HybridProblem(_Problem):
 
 class ContinuousProblem(_Problem):
     """Period-n map of the continuous walker (`pdw.limit_cycle`) on its section: ``dim`` = 6,
-    or more with a contact law that has memory (``options["contact"]``, `LC.section_names`)."""
+    or more with a contact law that has memory (``options["contact"]``, `_section.section_names`)."""
 
     dim = 6
     model = "continuous"
@@ -215,21 +217,21 @@ class ContinuousProblem(_Problem):
                  method="rodas4", options=None, fd_step=1e-5, executor=None, workers=None, **kw):
         super().__init__(params, parameter, params_of, period, log, **kw)
         self.variant, self.method = variant, method
-        self.opts = {**LC.TIGHT, **(options or {})}
+        self.opts = {**_poincare.TIGHT, **(options or {})}
         self.contact = self.opts.get("contact")
-        self.dim = len(LC.section_names(self.contact))
+        self.dim = len(_section.section_names(self.contact))
         self.fd_step = float(fd_step)
         self.executor = executor
         self.workers = max(1, int(workers or os.cpu_count() or 1))
         self.t_hint = None
         self.ref_events = None       # support events per cycle at the branch's first point
-        self.monodromy = "differences"   # or "exact" (pdw.analysis.variational)
+        self.monodromy = "differences"   # or "exact" (pdw.analysis.stepmap.variational)
 
     def section(self, state):
         s = np.asarray(state, dtype=float).reshape(-1)
         if self.contact is None:
-            return LC.section_coordinates(s, 2) if s.size == 8 else s.copy()
-        return LC._guess_z(s, self.base, self.contact, self.variant)
+            return _section.section_coordinates(s, 2) if s.size == 8 else s.copy()
+        return _section._guess_z(s, self.base, self.contact, self.variant)
 
     def __getstate__(self):
         # the tasks travel to process pools / Dask workers without the executor itself
@@ -241,7 +243,7 @@ class ContinuousProblem(_Problem):
             return list(self.executor.map(fn, tasks))
         # the finite differences through the ensemble engine where it takes them (the same
         # numbers), the rest on threads; Ctrl-C stops every thread
-        return LC.compose_points([t[0] for t in tasks], self.period,
+        return _maps.compose_points([t[0] for t in tasks], self.period,
                                  [self.params_at(mu) for _, mu in tasks], self.variant,
                                  self.method, {**self.opts, "t_hint": self.t_hint}, self.workers)
 
@@ -290,7 +292,7 @@ class ContinuousProblem(_Problem):
         info = {"period": float(sum(s["period"] for s in steps)),
                 "step_length": float(np.mean([s["step_length"] for s in steps])),
                 "double_support": float(np.mean([s["double_support"] for s in steps])),
-                "state": LC.embed(z, self.params_at(mu), self.contact),
+                "state": _section.embed(z, self.params_at(mu), self.contact),
                 "n_events": int(sum(s["n_events"] for s in steps)),
                 "orbit": np.array([z] + [s["z"] for s in steps[:-1]])}
         if self.ref_events is None:
@@ -306,7 +308,7 @@ class ContinuousProblem(_Problem):
     CHECK_TOL = 1e-3
 
     def crosscheck(self, z, mu, multipliers):
-        """The multipliers again, exactly (`pdw.analysis.variational`: default laws, paper
+        """The multipliers again, exactly (`pdw.analysis.stepmap.variational`: default laws, paper
         variant, period 1) or else from central differences with ``CHECK_FACTOR`` x
         ``fd_step``: (largest difference to ``multipliers``, note or ""). A difference above
         ``CHECK_TOL`` means the step map has a kink within a few difference steps of z (the
@@ -315,7 +317,7 @@ class ContinuousProblem(_Problem):
         z = np.asarray(z, dtype=float)
         if (self.contact is None and self.variant == "paper" and self.period == 1
                 and self.monodromy != "exact"):
-            # the exact monodromy (pdw.analysis.variational) where it exists
+            # the exact monodromy (pdw.analysis.stepmap.variational) where it exists
             from . import variational
             try:
                 Mx = variational.step_jacobian(z, self.params_at(mu), **{
@@ -366,7 +368,7 @@ class ContinuousProblem(_Problem):
                                                "central differences, fd_step %g"
                                                % self.fd_step),
                              "variant": self.variant, "options": dict(self.opts),
-                             "section_names": LC.section_names(self.contact)})
+                             "section_names": _section.section_names(self.contact)})
 
 
 class _ContinuousTask:
@@ -380,5 +382,5 @@ class _ContinuousTask:
         z, mu = task
         pr = self.prob
         opts = {**pr.opts, "t_hint": pr.t_hint}
-        return LC._compose(np.asarray(z), pr.period, pr.params_at(mu), pr.variant, pr.method,
+        return _maps._compose(np.asarray(z), pr.period, pr.params_at(mu), pr.variant, pr.method,
                            opts)

@@ -24,7 +24,7 @@ so the mechanical section is 6-dimensional, with coordinates (`SECTION`)
          trailing leg's rate, leading (swing) leg's rate)        [rad, rad, m/s, m/s, rad/s, rad/s]
 
 A contact law with memory adds the trailing foot's share of it (`section_names(contact)`,
-`pdw.analysis.section`): with LuGre friction its bristle deflection ``z1_um`` [um] (the leading
+`pdw.analysis.stepmap.section`): with LuGre friction its bristle deflection ``z1_um`` [um] (the leading
 foot's is 0: reset at its touch-down), with the lankarani_nikravesh and flores normal laws its
 approach speed ``v_in1`` [m/s] captured at its own touch-down (the leading foot's is -v_y of the
 section state). The map then is the continuous run's, on and off a fixed point, for period-n
@@ -46,8 +46,8 @@ run's, its approach speed the one it got at the start (or at a later touch-down 
 Nothing in the compiled code is changed: the loop records every accepted step (a few thousand
 samples) and Python picks the one at the event. The simulation runs to
 ``1.3 * t_hint + 0.05`` s (``t_hint``: the previous period, default 0.75 s) and, if the touch-down
-has not happened by then, again to ``t_max``. (`pdw.analysis.poincare` holds `step`; many maps
-at once, through the ensemble engine with ``stop_touch_down=1``: `pdw.analysis.step_maps`.)
+has not happened by then, again to ``t_max``. (`pdw.analysis.stepmap.poincare` holds `step`; many maps
+at once, through the ensemble engine with ``stop_touch_down=1``: `pdw.analysis.stepmap.step_maps`.)
 
 *Restarting the discrete state.* At the section both legs are support, so nobody is armed
 (docs/model.md section 5) and the restart's discrete state equals the running one, except for the
@@ -68,7 +68,7 @@ Newton shooting and Floquet multipliers
 an absolute step ``fd_step`` (default 1e-5 in every coordinate: rad, m/s, rad/s, um), each column
 from two step-map evaluations (2 len(z) per Jacobian; for period 1 with an adaptive method and
 the default laws as walkers of one `pdw.simulate_batch` call, rodas4 in the ensemble engine's
-vectorized lanes, bitwise the scalar maps: `pdw.analysis.step_maps`; otherwise in parallel
+vectorized lanes, bitwise the scalar maps: `pdw.analysis.stepmap.step_maps`; otherwise in parallel
 threads: the compiled loop releases the GIL). With the default tolerances (rtol 1e-10, atol 1e-12, event_tol 1e-12) one map
 evaluation is reproducible to ~1e-10, so the Jacobian is good to ~1e-5 and Newton converges to a
 residual max|P(z) - z| < ``tol`` = 1e-9 (the floor is ~3e-10). The Floquet multipliers are the
@@ -94,9 +94,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..core.errors import InvalidInputError
-from ..core.params import X0_PAPER, Params
-from .gait_types import Gait, GaitNotFoundError
+from ...core.errors import InvalidInputError
+from ...core.params import X0_PAPER, Params
+from ..gait_types import Gait, GaitNotFoundError
 from .poincare import (  # noqa: F401  (the one-step map, re-exported)
     LOOSE_LUGRE,
     STEP_STATUS,
@@ -231,7 +231,7 @@ def find_gait(params: Params | None = None, variant: str = "paper",
     options
         Step-map options: rtol, atol, event_tol (default `TIGHT`), t_max, dt, and
         ``contact`` (`pdw.Contact`: the normal and friction laws). The section follows the law
-        (`section_names`, `pdw.analysis.section`): with LuGre friction it carries the trailing
+        (`section_names`, `pdw.analysis.stepmap.section`): with LuGre friction it carries the trailing
         foot's bristle ``z1_um`` [um], with lankarani_nikravesh or flores the trailing foot's
         approach speed ``v_in1`` [m/s], so the map is the continuous run's for every law.
 

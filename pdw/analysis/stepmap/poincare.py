@@ -1,6 +1,6 @@
 """The touch-down Poincaré map of the continuous walker, one step at a time (`step`); the
 section, the map's definition and its use are described in `pdw.limit_cycle` (docs/studies.md,
-"Limit cycles"). Many steps at once: `pdw.analysis.step_maps`.
+"Limit cycles"). Many steps at once: `pdw.analysis.stepmap.step_maps`.
 """
 from __future__ import annotations
 
@@ -9,11 +9,11 @@ import math
 
 import numpy as np
 
-from ..core.contact import Contact
-from ..core.errors import FellError, InvalidInputError, SimulationError
-from ..core.integrators import INTEGRATORS, METHODS
-from ..sim.options import Integrator, Record
-from ..sim.simulation import simulate
+from ...core.contact import Contact
+from ...core.errors import FellError, InvalidInputError, SimulationError
+from ...core.integrators import INTEGRATORS, METHODS
+from ...sim.options import Integrator, Record
+from ...sim.simulation import simulate
 from . import section as _section
 from .section import RETURN, section_coordinates, section_names
 

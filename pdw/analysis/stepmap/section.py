@@ -1,5 +1,5 @@
 """The touch-down Poincaré section of the continuous walker, for every contact law
-(`pdw.analysis.limit_cycle`; docs/studies.md, "Limit cycles"; docs/contact_laws.md).
+(`pdw.analysis.stepmap.limit_cycle`; docs/studies.md, "Limit cycles"; docs/contact_laws.md).
 
 The section is the touch-down of the swing foot with the legs relabelled: leg 2 has just
 touched down (the *leading* leg, its contact point put at the origin), leg 1 trails. Its
@@ -38,14 +38,14 @@ import math
 
 import numpy as np
 
-from ..core import _layout
-from ..core.contact import LAW_PARAMETERS, Contact
-from ..core.errors import InvalidInputError
-from ..core.model import contact_forces
-from ..core.params import X0_DISTURBED, X0_PAPER, Params
-from ..sim.options import Integrator, Limits, Record
-from ..sim.simulation import simulate
-from .gait_types import Gait
+from ...core import _layout
+from ...core.contact import LAW_PARAMETERS, Contact
+from ...core.errors import InvalidInputError
+from ...core.model import contact_forces
+from ...core.params import X0_DISTURBED, X0_PAPER, Params
+from ...sim.options import Integrator, Limits, Record
+from ...sim.simulation import simulate
+from ..gait_types import Gait
 
 #: The step maps' runs return a divergence as a status (they judge it themselves).
 RETURN = Limits(on_failure="return")
@@ -250,7 +250,7 @@ def settle(x0, params=None, variant="paper", method="rodas4", *, flags0=(0, 1), 
 def hybrid_guess(params=None):
     """A section point from the hybrid (rigid-ground) model's gait: its pre-impact state with
     the hip velocity of the rolling stance foot, legs relabelled (None if it has no gait)."""
-    from . import hybrid
+    from ..rigid import hybrid
     p = _params(params)
     try:
         g = hybrid.find_gait(p)
@@ -295,7 +295,7 @@ def _guess_z(guess, params, contact=None, variant="paper"):
             z = np.asarray(guess.details["z"], dtype=float)
             names = guess.details.get("section_names", SECTION)
         else:
-            from . import hybrid
+            from ..rigid import hybrid
             x = hybrid.full_state(guess.details["y_minus"], params)
             z = section_coordinates(x, 2)
         if contact is None and names == SECTION:

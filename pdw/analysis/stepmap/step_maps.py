@@ -1,6 +1,6 @@
 """Many touch-down step maps at once (docs/ensemble.md, "Where the engine is used"): the finite
 differences of `pdw.limit_cycle.jacobian` (so `find_gait` and `floquet`) and of continuation
-(`pdw.analysis.gait_maps`) through `compose_points`, `pdw.cell_mapping.cell_map`'s images
+(`pdw.analysis.stepmap.gait_maps`) through `compose_points`, `pdw.cell_mapping.cell_map`'s images
 through `map_images`: through the ensemble engine (`images`) where it takes them, else on a
 thread pool of scalar steps (`map_batch`, `_compose`).
 
@@ -25,14 +25,14 @@ import os
 
 import numpy as np
 
-from ..core import interrupt
-from ..core.contact import Contact
-from ..core.errors import InvalidInputError
-from ..core.integrators import INTEGRATORS, METHODS
-from ..core.progress import progress_bar
-from ..sim.batch import simulate_batch
-from ..sim.ensemble import plain_model, supports
-from ..sim.options import Integrator, Stop
+from ...core import interrupt
+from ...core.contact import Contact
+from ...core.errors import InvalidInputError
+from ...core.integrators import INTEGRATORS, METHODS
+from ...core.progress import progress_bar
+from ...sim.batch import simulate_batch
+from ...sim.ensemble import plain_model, supports
+from ...sim.options import Integrator, Stop
 from . import section as _section
 from .poincare import expected_end, step
 
@@ -123,7 +123,7 @@ def map_images(Z, params=None, variant="paper", method="rodas4", *, workers=None
     """(Z', status) of every row of Z (N, len(z)): P(z) (NaN where the step failed) and
     `step`'s status, the same as `map_batch`'s ``z`` and ``status``. Through the ensemble
     engine in chunks of ``chunk_size`` rows where it takes the maps
-    (`pdw.analysis.step_maps.batchable`; ``workers`` threads), `step` for the rest; otherwise
+    (`pdw.analysis.stepmap.step_maps.batchable`; ``workers`` threads), `step` for the rest; otherwise
     `map_batch`. ``progress``: one unit per row."""
     Z = np.atleast_2d(np.asarray(Z, dtype=float))
     n = len(Z)
@@ -184,7 +184,7 @@ def _step_defaults():
 def compose_points(points, period, params, variant, method, options, workers=None):
     """``[(P^n(z) or None, steps)]`` for every point, as `_compose` gives them: the first
     point's with its step dicts, the others' through the ensemble engine where it takes them
-    (`pdw.analysis.step_maps.batchable`: z' bitwise `step`'s; their steps are then
+    (`pdw.analysis.stepmap.step_maps.batchable`: z' bitwise `step`'s; their steps are then
     ``[{"status": "ok", "z": z'}]``), else, and for every point the engine leaves, `_compose`.
     ``params``: one `Params` or one per point. The first point runs in its own thread beside
     the engine's batch (``workers - 1`` threads); Ctrl-C stops both (`pdw.core.interrupt`)."""

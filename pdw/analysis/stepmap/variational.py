@@ -1,7 +1,7 @@
 """The exact monodromy of the continuous walker's step map: variational equations with saltation
 matrices (issue #24 item 2; a Python/SciPy version over the compiled rhs and Jacobian).
 
-One step of the touch-down map (`pdw.analysis.poincare.step`) from section point z:
+One step of the touch-down map (`pdw.analysis.stepmap.poincare.step`) from section point z:
 
     x0 = E(z)          (`section.embed`: leg 2's contact point at the origin, flags (1, 1))
     x' = f(x; flags)   between support-flag switches (lift-off: a support foot's height
@@ -34,9 +34,9 @@ import math
 
 import numpy as np
 
-from ..core.errors import InvalidInputError
-from ..core.ode import ode_function
-from ..core.params import Params
+from ...core.errors import InvalidInputError
+from ...core.ode import ode_function
+from ...core.params import Params
 from . import section as _section
 
 N = 8
@@ -78,7 +78,7 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
     Parameters
     ----------
     z : array_like (6,)
-        Section point (`pdw.analysis.section.SECTION`).
+        Section point (`pdw.analysis.stepmap.section.SECTION`).
     params : Params
         Default `Params.paper_steady()`.
     variant : {"paper"}
