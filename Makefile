@@ -113,13 +113,15 @@ study: $(STAMP)
 ## checkout, so the test of pdw's own source revision is left out there
 SAN_DIR   := build/sanitize
 SAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined -g
-SAN_TESTS ?= tests/test_hardening_boundary.py tests/test_hardening_status.py \
-             tests/test_hardening_input.py tests/test_hardening_fuzz.py tests/test_simulation.py \
-             tests/test_hybrid.py tests/test_integrators.py tests/test_features.py \
-             tests/test_hardening_entry.py tests/test_hardening_interrupt.py tests/test_batch.py \
-             tests/test_step_maps.py \
-             tests/test_contact_laws.py tests/test_ode_function.py tests/test_export.py \
-             tests/test_dense_output.py
+SAN_TESTS ?= tests/core/test_core_sizes.py tests/sim/test_statuses.py \
+             tests/core/test_model_inputs.py tests/sim/test_fuzz.py tests/sim/test_simulation.py \
+             tests/analysis/rigid/test_hybrid.py tests/analysis/rigid/test_hybrid_options.py \
+             tests/core/test_integrators.py tests/core/test_features.py \
+             tests/sim/test_batch_inputs.py tests/sim/test_io.py tests/core/test_contact.py \
+             tests/core/test_interrupt.py tests/sim/test_batch.py \
+             tests/analysis/stepmap/test_step_maps.py \
+             tests/core/test_contact_laws.py tests/core/test_ode_function.py tests/sim/test_export.py \
+             tests/sim/test_dense_output.py
 sanitize: $(STAMP)
 	rm -rf $(SAN_DIR) && mkdir -p $(SAN_DIR)
 	PDW_DEBUG=1 PDW_CFLAGS="$(SAN_FLAGS)" LDFLAGS="-fsanitize=address,undefined" \
@@ -133,7 +135,7 @@ sanitize: $(STAMP)
 	  ASAN_OPTIONS=detect_leaks=0:abort_on_error=1:allocator_may_return_null=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  LD_PRELOAD="$$(gcc -print-file-name=libasan.so) $$(gcc -print-file-name=libubsan.so)" \
 	  $(abspath $(PY)) -m pytest -q -p no:cacheprovider $(SAN_TESTS) \
-	  --deselect tests/test_export.py::test_source_revision_is_pdws_own_not_the_cwds
+	  --deselect tests/sim/test_export.py::test_source_revision_is_pdws_own_not_the_cwds
 
 ## mutation: the mutation campaign (docs/testing.md): each mutant of benchmarks/mutation.py
 ## applied, rebuilt (object cache in build/mutation-cc), its focused tests run, the source

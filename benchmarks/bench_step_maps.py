@@ -7,7 +7,7 @@ Interleaved in one process, round by round, each case once through the engine
 engine switched off (`step_maps.batchable` forced False: the thread pool of scalar `step`s, as
 before): the Jacobian of the touch-down map at the `paper_steady` gait (find_gait's tolerances,
 13 maps), `find_gait` from its default guesses, and a 20 x 20 cell map (LOOSE tolerances, 400
-maps). Both give the same numbers (asserted here; tests/test_step_maps.py). Wall and process CPU
+maps). Both give the same numbers (asserted here; tests/analysis/stepmap/test_step_maps.py). Wall and process CPU
 time, medians of ROUNDS rounds, with 1 and 2 workers; the load average is printed before and
 after (a shared machine: read the ratios, taken in the same rounds).
 

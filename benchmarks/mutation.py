@@ -49,20 +49,19 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 OUT = ROOT / "benchmarks" / "results" / "mutation.json"
 
 # ---- focused test subsets (new component tests first: they are the fast, precise ones) ------
-SWITCH = ["tests/test_switching.py", "tests/test_simulation.py", "tests/test_batch.py"]
-GAIT = ["tests/test_online_gait.py", "tests/test_gait.py", "tests/test_scenes.py"]
-CDM = ["tests/test_cdm.py", "tests/test_simulation.py", "tests/test_model_physics.py"]
-BATCH = ["tests/test_batch_paths.py", "tests/test_batch.py"]
-ODE = ["tests/test_error_control.py", "tests/test_switching.py", "tests/test_integrators.py",
-       "tests/test_simulation.py", "tests/test_dense_output.py"]
-STATUS = ["tests/test_statuses.py", "tests/test_switching.py", "tests/test_simulation.py",
-          "tests/test_hardening_status.py",
-          "tests/test_stability.py::test_singular_system_error_carries_time_state_reason"]
-LUGRE = ["tests/test_lugre.py"]
-SECTION = ["tests/test_poincare.py", "tests/test_limit_cycle.py", "tests/test_step_maps.py"]
-BASIN = ["tests/test_basin.py", "tests/test_ensemble.py"]
-HYBRID = ["tests/test_hybrid_options.py", "tests/test_hybrid.py"]
-STUDY = ["tests/test_study_axes.py", "tests/test_sweep.py"]
+SWITCH = ["tests/core/test_switching.py", "tests/sim/test_simulation.py", "tests/sim/test_batch.py"]
+GAIT = ["tests/sim/test_online_gait.py", "tests/sim/test_gait.py", "tests/sim/test_scenes.py"]
+CDM = ["tests/core/test_cdm.py", "tests/sim/test_simulation.py", "tests/core/test_model_physics.py"]
+BATCH = ["tests/sim/test_batch_paths.py", "tests/sim/test_batch.py"]
+ODE = ["tests/core/test_error_control.py", "tests/core/test_switching.py", "tests/core/test_integrators.py",
+       "tests/sim/test_simulation.py", "tests/sim/test_dense_output.py"]
+STATUS = ["tests/sim/test_statuses.py", "tests/core/test_switching.py", "tests/sim/test_simulation.py",
+          "tests/analysis/numerics/test_stability.py::test_singular_system_error_carries_time_state_reason"]
+LUGRE = ["tests/core/test_lugre.py"]
+SECTION = ["tests/analysis/stepmap/test_poincare.py", "tests/analysis/stepmap/test_limit_cycle.py", "tests/analysis/stepmap/test_step_maps.py"]
+BASIN = ["tests/analysis/basins/test_basin.py", "tests/sim/test_ensemble.py"]
+HYBRID = ["tests/analysis/rigid/test_hybrid_options.py", "tests/analysis/rigid/test_hybrid.py"]
+STUDY = ["tests/studies/test_study_axes.py", "tests/studies/test_sweep.py"]
 
 D = "pdw/core/csrc/pdw_discrete.c"
 CD = "pdw/core/csrc/pdw_cdm.c"
@@ -104,13 +103,13 @@ MUTANTS = [
     M("d_arm_below", "physics", D, "else if (y > 0.0) d->armed[i] = 1;",
       "else if (y < 0.0) d->armed[i] = 1;", SWITCH, "armed below the ground instead of above"),
     M("d_td_other_anchor", "physics", D, "d->anchors[i] = ki[PDW_KIN_S];",
-      "d->anchors[i] = kj[PDW_KIN_S];", SWITCH + ["tests/test_features.py"],
+      "d->anchors[i] = kj[PDW_KIN_S];", SWITCH + ["tests/core/test_features.py"],
       "touch-down anchors the other foot's rolling coordinate"),
     M("d_td_vin_sign", "physics", D, "d->anchors[PDW_ANCHOR_V_IN1 + i] = -vy;",
-      "d->anchors[PDW_ANCHOR_V_IN1 + i] = vy;", SWITCH + ["tests/test_contact_laws.py"],
+      "d->anchors[PDW_ANCHOR_V_IN1 + i] = vy;", SWITCH + ["tests/core/test_contact_laws.py"],
       "approach speed captured with the wrong sign"),
     M("d_init_anchor_swap", "physics", D, "d->anchors[i] = d->flags[i] ? ki[PDW_KIN_S] : 0.0;",
-      "d->anchors[i] = d->flags[i] ? 0.0 : ki[PDW_KIN_S];", SWITCH + ["tests/test_features.py"],
+      "d->anchors[i] = d->flags[i] ? 0.0 : ki[PDW_KIN_S];", SWITCH + ["tests/core/test_features.py"],
       "initial anchor of a support foot left at 0"),
     MM("td_no_vy_everywhere", "physics",
        [(D, "if (d->armed[i] && y < 0.0 && vy < 0.0) {", "if (d->armed[i] && y < 0.0) {"),
@@ -182,7 +181,7 @@ MUTANTS = [
       "s->status = stop == PDW_STOP_STEPS ? PDW_STATUS_PERIODIC : PDW_STATUS_DONE;", STATUS + GAIT,
       "a steps stop reported as periodic"),
     M("s_rec_fn2", "status", D, "o[PDW_REC_F_N2] = c[PDW_NCONTACT + PDW_CONTACT_F_N];",
-      "o[PDW_REC_F_N2] = c[PDW_CONTACT_F_N];", CDM + ["tests/test_gait.py"],
+      "o[PDW_REC_F_N2] = c[PDW_CONTACT_F_N];", CDM + ["tests/sim/test_gait.py"],
       "recorded F_n2 is leg 1's"),
     # ---- the central difference method (pdw_cdm.c, Eqs. 13-17) -------------------------------
     M("c_start_sign", "integrator", CD,

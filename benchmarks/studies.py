@@ -1,7 +1,7 @@
 """Run every study of pdw/examples/studies/*.toml (the paper's Table 5 and Figs. 11-14), copy the
 figures to docs/figures/study_<name>.png and print the trends (first -> last point of each
 line) next to the paper's (benchmarks/results/studies.txt). `make study` runs it through
-tests/test_sweep.py::test_all_studies (slow).
+tests/studies/test_sweep.py::test_all_studies (slow).
 
 Usage: .venv/bin/python benchmarks/studies.py [NAME ...] [--workers N]
 """

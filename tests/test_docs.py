@@ -32,6 +32,8 @@ import sys
 
 import pytest
 
+import pdw
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 PAGES = [ROOT / "README.md"] + sorted((ROOT / "docs").glob("*.md"))
 RUN = {"python": "python", "py": "python", "sh": "sh", "bash": "sh", "shell": "sh",
@@ -140,7 +142,6 @@ def run_sh(code: str, cwd: pathlib.Path, where: str):
 
 
 def run_toml(code: str, where: str):
-    import pdw
     from pdw.core import _toml
     from pdw.studies.study import parse_study
     data = _toml.loads(code)
@@ -241,3 +242,10 @@ def test_the_stale_reference_pattern_catches_what_it_should():
     for good in ("docs/model.md section 6", "pdw.core._layout.FEATURES", "pdw.core._core",
                  "a shared library", "shared memory"):
         assert not STALE.search(good), good
+
+
+def test_work_precision_doc_does_not_send_users_to_private_batches():
+    """docs/work_precision.md told users to call _core.rhs_batch; the public face is pdw.rhs."""
+    import pathlib
+    text = (pathlib.Path(__file__).resolve().parent.parent / "docs" / "work_precision.md").read_text()
+    assert "_core.rhs_batch" not in text and "pdw.rhs" in text

@@ -19,8 +19,8 @@ touch-down before recording that step, so the recorded sample starts the next in
 interval before it ends at the swing value of z (`_left_limits`).
 
 The interpolant passes through the recorded states exactly, is C^1 inside each smooth stretch,
-and its error between steps converges with the method's order (tests/test_dense_output.py,
-tests/test_lugre_dense.py).
+and its error between steps converges with the method's order (tests/sim/test_dense_output.py,
+tests/sim/test_lugre_dense.py).
 The anchors (docs/model.md section 6, `pdw.core._layout.ANCHORS`) are not recorded; they are
 rebuilt from the touch-downs as the loops set them: the rolling coordinate s_i and the approach
 speed max(-v_y, 0) of foot i at the step where flag i became 1 (or at the start, for a foot
@@ -128,7 +128,7 @@ class DenseOutput:
         so the interpolant stays sixth order. The kernels without a symbolic Jacobian (LuGre's)
         have a central difference with a fixed step, cbrt(eps) max(1, |x_j|): that step is
         larger than a creeping foot's slip velocity, whose |v| has a kink at 0, and a Jacobian
-        error that does not fall with h makes the quintic second order (tests/test_lugre_dense.py
+        error that does not fall with h makes the quintic second order (tests/sim/test_lugre_dense.py
         measures both). Four right-hand sides per state instead of that Jacobian's 21."""
         h = np.diff(self.t)
         e = np.where(h > 0, h, 1.0)[:, None] / EPS_PER_STEP

@@ -8,7 +8,7 @@ from ..core.params import Params
 
 #: `pdw.sim.stepsize._dt_max` of the presets (`Params.paper`, `Params.paper_steady`), as
 #: computed by `pdw.sim.stepsize._dt_max_computed` (about 7 ms each, which the first fixed-step
-#: `simulate` of a process would pay: 2-3x the paper run it checks). tests/test_speed.py checks
+#: `simulate` of a process would pay: 2-3x the paper run it checks). tests/sim/test_speed.py checks
 #: that every entry is still what the computation gives, bit for bit;
 #: `pdw.sim.stepsize._preset_table()` computes the table anew.
 PRESET_DT_MAX = {

@@ -35,10 +35,10 @@ from ..sim import ensemble
 from ..sim.scene import Scene
 from .study import COLUMNS, Study
 
-#: Methods whose batch runs are bitwise `pdw.simulate`'s (tests/test_batch.py: cdm with
+#: Methods whose batch runs are bitwise `pdw.simulate`'s (tests/sim/test_batch.py: cdm with
 #: ``vector=False`` and every adaptive or fixed-step method of the engine, one lane per walker
 #: through the scalar integrator's own steps): only these batch a sweep, so that its rows do not
-#: change (tests/test_ensemble.py compares the rows with `run_point`'s for cdm and rodas4).
+#: change (tests/sim/test_ensemble.py compares the rows with `run_point`'s for cdm and rodas4).
 BITWISE_METHODS = METHODS
 #: Points per batched task at most (a task's rows reach the CSV together).
 MAX_GROUP = 64

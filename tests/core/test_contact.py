@@ -111,3 +111,11 @@ def test_the_calibrated_kelvin_voigt_limit_is_unchanged():
     base = step_limit(P.replace(k_n=7318.0, d_n=112.2), "cdm")
     assert kv.law_factor == LAW_CALIBRATION["paper"]["kelvin_voigt"]["cdm"]
     assert kv.dt_max == pytest.approx(base.dt_max * kv.law_factor, rel=1e-12)
+
+
+@pytest.mark.parametrize("kw", [dict(k="1e5"), dict(k=True), dict(d=1j),
+                                dict(normal="flores", e="0.5")])
+def test_contact_parameters_must_be_real_numbers(kw):
+    """Contact(k="1e5") was float("1e5"), Contact(k=True) a stiffness of 1."""
+    with pytest.raises(pdw.InvalidInputError, match="contact." + [k for k in kw if k != "normal"][0]):
+        pdw.Contact(**kw)

@@ -231,7 +231,7 @@ def test_a_frictionless_preset_needs_lugre_coefficients():
 
 def test_the_section_carries_the_trailing_bristle():
     """find_gait's section under LuGre has a 7th coordinate, the trailing foot's bristle [um]
-    (tests/test_section_laws.py finds the gait); a 6-coordinate point is refused, naming it."""
+    (tests/analysis/stepmap/test_section_laws.py finds the gait); a 6-coordinate point is refused, naming it."""
     from pdw.analysis.stepmap import limit_cycle
     c = Contact(friction="lugre")
     assert limit_cycle.section_names(c) == limit_cycle.SECTION + ("z1_um",)

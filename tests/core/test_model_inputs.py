@@ -10,6 +10,7 @@ solvers, which checks nothing per call; the continuous model's step, whose statu
 "bad_state") returns NaN in every entry; `poincare.step_map` raises its SimulationError
 ("bad_state").
 """
+
 import numpy as np
 import pytest
 
@@ -117,3 +118,38 @@ def test_finite_states_are_untouched_by_the_check():
     assert np.isnan(out[2]).all()
     rows = [0, 1, 3, 4]
     assert np.array_equal(out[rows], pdw.rhs(X[rows]))
+
+
+@pytest.mark.parametrize("flags", ["01", "11", (1,), (0.9, 1.9), (0, 1, 1), [[0, 1, 1]], None,
+                                   (0, 2), (True, 2.0)])
+def test_model_functions_refuse_malformed_flags(flags):
+    """rhs(x, flags='01') computed flags (1, 1); flags=(1,) broadcast; (0.9, 1.9) became (0, 1)."""
+    with pytest.raises(pdw.InvalidInputError, match="flags"):
+        pdw.rhs(X0, flags=flags)
+    with pytest.raises(pdw.InvalidInputError, match="flags"):
+        pdw.jacobian(X0, flags=flags)
+
+
+def test_flags_accepted_forms_agree():
+    """The accepted spellings of the same flags give the same numbers."""
+    want = pdw.rhs(X0, flags=(0, 1))
+    for f in ([0, 1], np.array([0, 1]), np.array([0, 1], dtype=np.intc), (np.int64(0), 1)):
+        assert np.array_equal(pdw.rhs(X0, flags=f), want)
+
+
+def test_model_functions_refuse_complex_and_misshapen_states():
+    with pytest.raises(pdw.InvalidInputError, match="real"):
+        pdw.rhs(X0 + 1j)
+    with pytest.raises(pdw.InvalidInputError, match="shape"):
+        pdw.rhs(X0.reshape(2, 4))
+    with pytest.raises(pdw.InvalidInputError, match="anchors"):
+        pdw.rhs(X0, anchors=(0.0,))
+
+
+def test_model_function_errors_are_invalid_input():
+    with pytest.raises(pdw.InvalidInputError, match="variant"):
+        pdw.rhs(X0, variant="papr")
+    with pytest.raises(pdw.InvalidInputError, match="params"):
+        pdw.rhs(X0, params={"k_n": 1e5})
+    with pytest.raises(pdw.InvalidInputError, match="feature"):
+        pdw.rhs(X0, features=("hip_sprung",))

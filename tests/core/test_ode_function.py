@@ -1,4 +1,5 @@
 """pdw.ode_function: the compiled model object for external solvers."""
+
 import numpy as np
 import pytest
 
@@ -126,3 +127,32 @@ def test_solve_ivp_reproduces_simulate_rodas4_between_flag_changes():
     # and along the way, at pdw's own samples
     mid = sol.sol(ours.t).T
     assert np.max(np.abs(mid - ours.x)) < 1e-6
+
+
+@pytest.mark.parametrize("x", [np.array(pdw.X0_PAPER, complex), ["1"] * 8, np.ones((2, 4)),
+                               np.ones((1, 1, 8)), np.ones(8, bool)],
+                         ids=["complex", "strings", "2x4", "1x1x8", "bool"])
+def test_ode_function_refuses_states_it_used_to_coerce(x):
+    """f(t, x) used to take the real part, parse strings and ravel any 8-element array."""
+    f = pdw.ode_function()
+    with pytest.raises(pdw.InvalidInputError, match="x must"):
+        f(0.0, x)
+    with pytest.raises(pdw.InvalidInputError, match="x must"):
+        f.jac(0.0, x)
+
+
+def test_ode_function_fast_and_converting_paths_agree():
+    f = pdw.ode_function()
+    x = np.array(pdw.X0_PAPER)
+    assert np.array_equal(f(0.0, x), f(0.0, list(x)))
+    assert np.array_equal(f(0.0, np.vstack([x, x]))[1], f(0.0, x))
+    assert np.array_equal(f.jac(0.0, list(x)), f.jac(0.0, x))
+
+
+@pytest.mark.parametrize("kw,field", [(dict(flags=np.array([0.0, 1.0])), "flags"),
+                                      (dict(flags=(0.9, 1)), "flags"),
+                                      (dict(anchors=("0", "1")), "anchors"),
+                                      (dict(anchors=(0.0, float("inf"))), "anchors")])
+def test_ode_function_discrete_state_is_strict(kw, field):
+    with pytest.raises(pdw.InvalidInputError, match=field):
+        pdw.ode_function(**kw)

@@ -159,3 +159,10 @@ def test_error_message_states_the_allowed_range_values():
         Params.paper(gamma=2.0)
     msg = str(exc.value)
     assert "0.785" in msg or "pi" in msg, msg              # |gamma| <= pi/4
+
+
+@pytest.mark.parametrize("field,value", [("k_n", -1.0), ("l", math.nan), ("m_h", "2"),
+                                         ("g", None), ("mu_s", 1j), ("v_s", True)])
+def test_params_errors_are_invalid_input_naming_the_field(field, value):
+    with pytest.raises(pdw.InvalidInputError, match=r"Params\.%s" % field):
+        pdw.Params(**{field: value})

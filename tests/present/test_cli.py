@@ -201,7 +201,7 @@ def test_a_run_that_raises_a_divergence_exits_3(tmp_path, capsys):
 
 def test_the_readme_exit_code_table_is_the_commands(capsys):
     """The README's exit codes are `cli.EXIT_CODES`, and it says they hold for every command."""
-    readme = (pathlib.Path(__file__).resolve().parent.parent / "README.md").read_text()
+    readme = (pathlib.Path(__file__).resolve().parents[2] / "README.md").read_text()
     text = " ".join(readme.split("Exit codes")[1].split("\n\n")[0].split())
     assert text.startswith(", the same for every command:"), text
     codes = [int(c) for c in re.findall(r"(?<![\w.])(\d{1,3}) (?=[a-z])", text)]

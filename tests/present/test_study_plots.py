@@ -15,7 +15,7 @@ import pdw  # noqa: E402
 from pdw.analysis.basins import basin  # noqa: E402
 from pdw.present import study_plots  # noqa: E402
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 STUDY = """
 name = "falls"

@@ -4,10 +4,12 @@
 a bad index was found only after the whole batch had run. Each entry must now be an integer
 in [0, N) (`pdw.core.checks.count`), checked before the run, naming the entry.
 """
+
 import numpy as np
 import pytest
 
 import pdw
+from pdw.sim.batch import simulate_batch
 
 X = np.tile(np.array(pdw.X0_PAPER), (3, 1))
 
@@ -37,3 +39,37 @@ def test_integral_indices_still_record():
     assert sorted(b.recorded) == [0, 2]
     r = pdw.simulate(X[2], t_end=0.002)
     assert np.array_equal(b.recorded[2].x, r.x)
+
+
+X2 = np.tile(np.array(pdw.X0_PAPER), (2, 1))
+
+
+BATCH_CASES = [
+    (dict(flags0=(0.9, 1.9)), "flags0"),                 # was silently (0, 1)
+    (dict(flags0="01"), "flags0"),
+    (dict(flags0=[(0, 1), (2, 1)]), "flags0 row 1"),
+    (dict(fall_hip_height=float("nan")), "fall_hip_height"),   # was fall detection off
+    (dict(fall_hip_height="0.3"), "fall_hip_height"),    # was float("0.3")
+    (dict(fall_hip_height=[0.3, 0.3]), "fall_hip_height"),     # was a raw TypeError
+    (dict(x0=X2.astype(complex)), "x0"),                 # was the real part
+    (dict(x0=[["1"] * 8]), "x0"),                        # was float("1")
+    (dict(x0=np.ones((1, 8), bool)), "x0"),
+    (dict(vector="no"), "vector"),                       # was bool("no") = True
+    (dict(t_end=1e30), "t_end / dt"),                    # was a raw OverflowError
+    (dict(t_end=1.7e304), "t_end / dt"),                 # t_end/dt = inf (found by the fuzzer)
+]
+
+
+@pytest.mark.parametrize("kw,field", BATCH_CASES, ids=[c[1] + ":" + repr(c[0])[:30] for c in BATCH_CASES])
+def test_simulate_batch_refuses_malformed_input_naming_the_field(kw, field):
+    kw = {"t_end": 0.01, **kw}
+    x0 = kw.pop("x0", X2)
+    with pytest.raises(pdw.InvalidInputError, match=field.replace("(", r"\(")):
+        simulate_batch(x0, **kw)
+
+
+def test_simulate_batch_still_takes_well_formed_input():
+    b = simulate_batch(X2.tolist(), t_end=0.01, flags0=np.array([[0, 1], [0, 1]]),
+                       fall_hip_height=0.3, vector=np.bool_(False))
+    r = pdw.simulate(t_end=0.01, record_every=0, fall_hip_height=0.3)
+    assert np.array_equal(b.x_final[0], r.x_final) and list(b.status) == ["walked"] * 2

@@ -1,9 +1,11 @@
 """simulate(t_eval=..., dense_output=True): the interpolant between accepted steps."""
+
 import numpy as np
 import pytest
 
 import pdw
 from pdw.sim import dense
+from pdw.sim.buffers import RecordBuffer
 
 # flight: both feet swing, hip 1.5 m above the slope; smooth (gravity, hip spring and damper),
 # no flag change within T
@@ -139,3 +141,34 @@ def test_t_eval_with_another_normal_law_is_the_recorded_run(method, contact):
                                   anchors=tuple(an[i]), contact=contact)
         assert c_ok.F_n[0] == pytest.approx(r.Fn[i, 0], rel=1e-12)
         assert abs(c_no.F_n[0] - r.Fn[i, 0]) > 1e-3 * r.Fn[i, 0]
+
+
+@pytest.mark.parametrize("cap", [-1, "x", 1.5, float("nan"), 2 ** 41, None])
+def test_record_buffer_capacity_is_checked(cap):
+    with pytest.raises(pdw.InvalidInputError, match="capacity"):
+        RecordBuffer(cap)
+
+
+def test_a_well_formed_record_buffer_still_gives_the_same_run():
+    b = RecordBuffer(10)
+    r1 = pdw.simulate(t_end=0.01, out=b)
+    r2 = pdw.simulate(t_end=0.01)
+    assert np.array_equal(r1.x, r2.x) and b.capacity >= len(r2.t)
+
+
+@pytest.mark.parametrize("kw,field", [(dict(t_eval=np.array([0.01 + 1j])), "t_eval"),
+                                      (dict(t_eval=[0.0, float("nan")]), "t_eval"),
+                                      (dict(dense_output="yes"), "dense_output")])
+def test_dense_output_arguments_are_strict(kw, field):
+    """A complex t_eval was its real part; dense_output="yes" was True."""
+    with pytest.raises(pdw.InvalidInputError, match=field):
+        pdw.simulate(t_end=0.02, method="rodas4", **kw)
+
+
+@pytest.mark.parametrize("tq", ["0.01", 0.01 + 1j, np.full((2, 2), 0.01), float("nan"), 5.0])
+def test_dense_interpolant_refuses_bad_times(tq):
+    """sol("0.01") was parsed; complex and 2-D times gave raw TypeError / ValueError."""
+    sol = pdw.simulate(t_end=0.02, method="rodas4", dense_output=True).sol
+    with pytest.raises(pdw.InvalidInputError, match="t"):
+        sol(tq)
+    assert sol(0.01).shape == (8,) and sol([0.005, 0.01]).shape == (2, 8)

@@ -298,3 +298,83 @@ def test_one_module_owns_the_format_and_the_old_paths_are_aliases():
     assert pdw.load is files.load
     from pdw.sim import files as f2
     assert f2.load is pdw.load and f2.STATUSES
+
+
+@pytest.fixture(scope="module")
+def saved_run(tmp_path_factory):
+    path = tmp_path_factory.mktemp("load") / "good.npz"
+    pdw.simulate(t_end=0.02, record_energies=True).save(path)
+    with np.load(path) as z:
+        arrays = {k: z[k] for k in z.files}
+    return path, arrays, json.loads(str(arrays.pop("meta")))
+
+
+def _write_npz(path, arrays, meta):
+    np.savez(path, meta=np.array(json.dumps(meta)), **arrays)
+    return path
+
+
+TAMPER = [
+    ("x wrong columns", lambda a, m: a.update(x=a["x"][:, :3]), "'x'"),
+    ("x fewer rows", lambda a, m: a.update(x=a["x"][:5]), "'x'"),
+    # NaN in x is a run's data (a diverged run's state: it round-trips, tests/sim/test_io.py);
+    # NaN in t is not
+    ("t NaN", lambda a, m: a["t"].__setitem__(3, np.nan), "'t' must be finite"),
+    ("x strings", lambda a, m: a.update(x=np.array(["a"] * 8)), "'x'"),
+    ("flags 7", lambda a, m: a["flags"].__setitem__((1, 0), 7), "'flags'"),
+    ("flags float", lambda a, m: a.update(flags=a["flags"] + 0.5), "'flags'"),
+    ("no t", lambda a, m: a.pop("t"), "'t'"),
+    ("event kind 9", lambda a, m: a.update(events=np.array([[0.1, 1, 9, 0, 0]])), "'events'"),
+    ("event leg 5", lambda a, m: a.update(events=np.array([[0.1, 5, 0, 0, 0]])), "'events'"),
+    ("x_final short", lambda a, m: a.update(x_final=np.zeros(3)), "'x_final'"),
+    ("energy short", lambda a, m: a.update(energy_T=np.zeros(2)), "'energy_T'"),
+    ("no settings", lambda a, m: m.pop("settings"), "settings"),
+    ("unknown parameter", lambda a, m: m["settings"]["params"].update(zz=1), "settings.params"),
+    ("bad parameter", lambda a, m: m["settings"]["params"].update(k_n=-5.0), "k_n"),
+    ("unknown status", lambda a, m: m.update(status="bogus"), "status"),
+    ("dt a string", lambda a, m: m["settings"].update(dt="x"), "settings.dt"),
+    ("unknown method", lambda a, m: m["settings"].update(method="zzz"), "settings.method"),
+    ("unknown feature", lambda a, m: m["settings"].update(features=["zzz"]), "settings.features"),
+    ("t_final a string", lambda a, m: m.update(t_final="soon"), "t_final"),
+    ("failure without a state", lambda a, m: m.update(failure={"x": [1.0]}), "failure"),
+]
+
+
+@pytest.mark.parametrize("name,change,field", TAMPER, ids=[t[0] for t in TAMPER])
+def test_load_refuses_a_tampered_file_naming_the_field(saved_run, tmp_path, name, change, field):
+    """Each of these used to load into a Result that lied (or raised KeyError/IndexError)."""
+    path, arrays, meta = saved_run
+    a = {k: v.copy() for k, v in arrays.items()}
+    m = json.loads(json.dumps(meta))
+    change(a, m)
+    with pytest.raises(pdw.InvalidInputError, match=field):
+        pdw.load(_write_npz(tmp_path / "bad.npz", a, m))
+
+
+@pytest.mark.parametrize("content", ["truncated", "empty", "random", "missing", "bad json",
+                                     "pickled"])
+def test_load_refuses_an_unreadable_file(saved_run, tmp_path, content):
+    """BadZipFile, EOFError, FileNotFoundError, JSONDecodeError and numpy's pickle refusal
+    become one InvalidInputError naming the file."""
+    path, arrays, meta = saved_run
+    bad = tmp_path / "bad.npz"
+    raw = path.read_bytes()
+    if content == "truncated":
+        bad.write_bytes(raw[:len(raw) // 2])
+    elif content == "empty":
+        bad.write_bytes(b"")
+    elif content == "random":
+        bad.write_bytes(np.random.default_rng(0).bytes(1000))
+    elif content == "bad json":
+        np.savez(bad, meta=np.array("{not json"), **arrays)
+    elif content == "pickled":
+        np.savez(bad, meta=np.array(json.dumps(meta)), **dict(arrays, x=np.array([object()] * 8)))
+    with pytest.raises(pdw.InvalidInputError, match="bad.npz"):
+        pdw.load(bad)
+
+
+def test_load_of_an_untouched_file_gives_the_run_back(saved_run):
+    path, arrays, meta = saved_run
+    r = pdw.load(path)
+    assert np.array_equal(r.x, arrays["x"]) and r.status == meta["status"]
+    assert r.params == pdw.Params(**meta["settings"]["params"])

@@ -2,6 +2,8 @@
 import json
 import math
 import pathlib
+import subprocess
+import sys
 import tracemalloc
 
 import numpy as np
@@ -14,8 +16,9 @@ from pdw.core import _layout
 from pdw.present import cli
 from pdw.sim.gait import FIELDS
 from pdw.sim.scene import Forces, Integrator, Limits, Record, Scene, Stop
+from pdw.studies.study import parse_study
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 STEADY = pdw.Params.paper_steady()
 ALL_BUT_LAST_DS = [f for f in FIELDS if f not in ("double_support", "ds_fraction")]
 
@@ -385,3 +388,18 @@ def test_random_scenes_round_trip():
         assert Scene.from_toml(sc.to_toml()) == sc
 
     check()
+
+
+def test_deeply_nested_toml_is_an_input_error_not_a_recursion_error(tmp_path):
+    text = "a = " + "[" * 50000 + "]" * 50000 + "\n"
+    with pytest.raises(pdw.InvalidInputError, match="nested"):
+        pdw.Scene.from_toml(text)
+    with pytest.raises(pdw.InvalidInputError, match="nested"):
+        parse_study(text)
+    f = tmp_path / "deep.toml"
+    f.write_text(text)
+    out = subprocess.run([sys.executable, "-m", "pdw", "run", str(f)], capture_output=True,
+                         text=True, timeout=120)
+    assert out.returncode != 0
+    assert "Traceback" not in out.stderr and "RecursionError" not in out.stderr
+    assert "nested" in out.stderr + out.stdout

@@ -146,3 +146,44 @@ def test_bad_input_raises_a_clear_error(kwargs, field):
     with pytest.raises(pdw.InvalidInputError, match=field):
         pdw.simulate(**kwargs)
     assert issubclass(pdw.InvalidInputError, ValueError)
+
+
+def test_simulate_refuses_a_t_end_whose_step_count_overflows():
+    """t_end = 1.8e304 with dt = 1e-4: t_end/dt is inf, and round(inf) was a raw OverflowError
+    (found by the fuzzer)."""
+    with pytest.raises(pdw.InvalidInputError, match="t_end/dt"):
+        pdw.simulate(t_end=1.797693134862316e+304)
+
+
+X0 = np.array(pdw.X0_PAPER)
+
+
+@pytest.mark.parametrize("flags0", ["01", (1,), (0.9, 1.9), (0, 1, 0), (0, 5)])
+def test_simulate_refuses_malformed_flags0(flags0):
+    with pytest.raises(pdw.InvalidInputError, match="flags0"):
+        pdw.simulate(t_end=0.01, flags0=flags0)
+
+
+@pytest.mark.parametrize("x0,what", [
+    (np.tile(X0[:4], (2, 1)), "shape"),                 # (2, 4): 8 numbers, not a state
+    (X0.reshape(2, 4), "shape"),
+    (X0 + 0j, "real"),                                   # complex
+    ([str(v) for v in X0], "real"),                      # strings
+    (X0[:7], "shape"),
+])
+def test_simulate_refuses_states_that_are_not_states(x0, what):
+    with pytest.raises(pdw.InvalidInputError, match=what):
+        pdw.simulate(x0=x0, t_end=0.01)
+
+
+@pytest.mark.parametrize("value", [math.nan, math.inf, "0.2", True])
+def test_fall_hip_height_must_be_a_finite_number(value):
+    """fall_hip_height = nan switched fall detection off."""
+    with pytest.raises(pdw.InvalidInputError, match="fall_hip_height"):
+        pdw.simulate(t_end=0.01, fall_hip_height=value)
+
+
+@pytest.mark.parametrize("value", [math.nan, None, 2 ** 70, 1.5, -1, "1", True])
+def test_record_every_errors_name_the_field(value):
+    with pytest.raises(pdw.InvalidInputError, match="record_every"):
+        pdw.simulate(t_end=0.01, record_every=value)

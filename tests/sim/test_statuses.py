@@ -3,7 +3,15 @@ than ``fall_hip_height`` is a fall, a velocity above ``max_speed`` a divergence,
 first state that crosses the limit, with the right leg and reason. The reference is the same run
 recorded without the limit, read here sample by sample (cdm: the feet are checked at each
 sample before its forces, a new state before it is accepted; the failure's time and state are
-the last good sample's)."""
+the last good sample's).
+
+Honest statuses (issue 16, findings 6, 7 and 9): a runaway or airborne run is "diverged",
+a run without a touch-down "no_steps"; long compiled loops stop at a step budget with a clear
+error; energies are finite or the run is diverged; recording grows in chunks; an unestimable
+step limit is a warning; a tiny dt is refused.
+"""
+import warnings
+
 import numpy as np
 import pytest
 
@@ -112,3 +120,111 @@ def test_batch_no_steps_is_judged_on_touch_downs():
     b.t_final[2] = 1.99 * period                          # too short to judge
     honest(b, x0, pdw.Params.paper())
     assert list(b.status) == ["no_steps", "walked", "walked"]
+
+
+def test_cdm_blowup_with_stiff_ground_is_not_walked():
+    """cdm, dt = 1e-3, k_n = 1e9 used to return "walked" with the hip 14 m up and the legs at
+    -118 rad after no step (only a StepSizeWarning)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pdw.StepSizeWarning)
+        r = pdw.simulate(dt=1e-3, params=pdw.Params(k_n=1e9), on_failure="return")
+        assert r.status == "diverged" and not r.walked
+        assert "runaway" in r.failure["reason"]
+        assert r.failure["t"] < r.t_final
+        with pytest.raises(pdw.DivergedError, match="runaway"):
+            pdw.simulate(dt=1e-3, params=pdw.Params(k_n=1e9))
+
+
+def test_a_run_without_any_touch_down_is_not_walked():
+    """A walker standing astride (legs at +-0.3 rad) on flat ground for 4 s never steps:
+    "no_steps", not "walked"."""
+    p = pdw.Params(gamma=0.0)
+    x0 = np.zeros(8)
+    x0[2:4] = (0.3, -0.3)
+    x0[1] = p.r + (p.l - p.r) * np.cos(0.3) - 2e-4
+    r = pdw.simulate(x0=x0, params=p, t_end=4.0, flags0=(1, 1), method="rodas4",
+                     on_failure="return", record_every=0)
+    assert r.event_counts["touch_down"] == 0
+    assert r.status == "no_steps" and not r.walked
+    # the typical gait still walks
+    assert pdw.simulate(t_end=3.5, record_every=0).status == "walked"
+
+
+def test_a_stiff_friction_law_stops_at_the_step_budget():
+    """rodas4 with a valid v_s = 1e-12 took 1.8 M steps for 10 ms; now it stops at max_steps."""
+    r = pdw.simulate(method="rodas4", params=pdw.Params(v_s=1e-12), t_end=0.01, record_every=0,
+                     on_failure="return", max_steps=20000)
+    assert r.status == "diverged" and "step budget" in r.failure["reason"]
+    assert r.stats["steps"] + r.stats["rejected"] == 20000
+    with pytest.raises(pdw.DivergedError, match="max_steps"):
+        pdw.simulate(method="dopri5", params=pdw.Params(d_hip=1e12), t_end=1.0, record_every=0,
+                     max_steps=5000)
+
+
+def test_a_fixed_step_run_longer_than_the_budget_is_refused():
+    with pytest.raises(pdw.InvalidInputError, match="max_steps"):
+        pdw.simulate(t_end=10.0, dt=1e-4, max_steps=1000)
+
+
+def test_polling_changes_no_number():
+    """The loop returns to Python every POLL_EVERY iterations and resumes exactly: a run with a
+    poll every 7 iterations equals one with none, bit for bit (fixed and adaptive)."""
+    from pdw.core import _core
+    from pdw.core.model import kernel_index, parameter_vector
+    p = parameter_vector(pdw.Params.paper())
+    x0 = np.array(pdw.X0_PAPER)
+    for m in (0, pdw.METHODS.index("rodas4"), pdw.METHODS.index("rk4")):
+        kw = dict(rtol=1e-6, atol=1e-8, t_end=0.8)
+        a = _core.run(kernel_index("paper"), m, x0, p, 0, 1, 1e-4, 8000, 3, True, 0.25, 0.125,
+                      1e3, poll_every=0, **kw)
+        b = _core.run(kernel_index("paper"), m, x0, p, 0, 1, 1e-4, 8000, 3, True, 0.25, 0.125,
+                      1e3, poll_every=7, max_records=5, **kw)
+        assert a["status"] == b["status"] == 1
+        for key in ("t", "x", "flags", "contact", "events", "x_final"):
+            assert np.array_equal(a[key], b[key]), (m, key)
+
+
+def test_non_finite_energies_at_a_finite_state_make_the_run_diverged():
+    """Result.energies used to hold inf/NaN while x was finite (velocities near 1e160 with
+    max_speed out of the way): the status check now calls that run diverged, at the last
+    sample before the first non-finite energy."""
+    from pdw.sim.simulation import _honest
+    r = pdw.simulate(t_end=0.01, record_every=1, check_step="off", record_energies=True)
+    raw = {"x": r.x, "t": r.t, "x_final": r.x_final, "t_final": r.t_final,
+           "event_counts": {"touch_down": 1}, "failure": None}
+    energies = {k: v.copy() for k, v in r.energies.items()}
+    assert _honest(dict(raw), "done", r.params, r.x[0], energies) == "done"
+    energies["T"][40] = np.inf
+    energies["E"][40] = np.inf
+    raw2 = dict(raw)
+    assert _honest(raw2, "done", r.params, r.x[0], energies) == "diverged"
+    assert raw2["failure"]["t"] == r.t[39] and "energies" in raw2["failure"]["reason"]
+
+
+def test_an_early_fall_of_a_very_long_run_reserves_no_record_for_t_end():
+    """t_end = 1e5 s at dt = 1e-4 (1e9 steps) used to reserve the record for all of them (raw
+    MemoryError); the record now grows in chunks, and this walker falls after 1.2 s."""
+    x0 = np.array(pdw.X0_PAPER)
+    x0[4] = x0[6] = 0.0
+    r = pdw.simulate(x0=x0, t_end=1e5, dt=1e-4, on_failure="return", record_every=1)
+    assert r.status == "fell" and r.t_final < 2
+    assert len(r.t) >= r.n_steps and r.t[-1] <= r.t_final
+    assert np.array_equal(r.t[:100], np.arange(100) * 1e-4)
+
+
+def test_an_unestimable_step_limit_is_a_step_size_warning():
+    """A valid v_s <= 1e-150 made the default step check fail with LinAlgError."""
+    p = pdw.Params(v_s=1e-160)
+    with pytest.warns(pdw.StepSizeWarning):
+        try:
+            pdw.simulate(params=p, t_end=1e-3, dt=1e-4, on_failure="return")
+        except np.linalg.LinAlgError:               # pragma: no cover - the finding
+            pytest.fail("LinAlgError from the step check")
+
+
+def test_tiny_dt_is_refused_and_singular_advice_is_not_smaller_dt():
+    with pytest.raises(pdw.InvalidInputError, match="dt"):
+        pdw.simulate(dt=1e-160, t_end=1e-150)
+    import inspect
+    src = inspect.getsource(pdw.sim.simulation._result)
+    assert "Check the masses and inertias" in src

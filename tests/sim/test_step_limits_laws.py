@@ -12,7 +12,7 @@ import pytest
 import pdw
 from pdw.sim import stepsize
 
-RESULT = pathlib.Path(__file__).resolve().parent.parent / "benchmarks" / "results" / "step_limits_laws.txt"
+RESULT = pathlib.Path(__file__).resolve().parents[2] / "benchmarks" / "results" / "step_limits_laws.txt"
 P = pdw.Params.paper_steady()
 METHODS = ("cdm", "verlet", "rk4")
 

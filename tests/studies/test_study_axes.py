@@ -1,8 +1,10 @@
 """The axes of a parameter study (docs/studies.md): ``values``, a linear ``start``/``stop``/``num``
 range, and ``log = true``, a geometric one (equal ratios, not equal differences)."""
+
 import numpy as np
 import pytest
 
+import pdw
 from pdw.studies.study import parse_study
 
 
@@ -34,3 +36,46 @@ def test_values_axis_is_taken_as_given():
 def test_log_axis_needs_positive_bounds(bounds):
     with pytest.raises(ValueError, match="log axis needs start, stop > 0"):
         _axis(bounds + "\nnum = 3\nlog = true\n")
+
+
+_STUDY = """
+name = "s"
+[[axes]]
+name = "k_n"
+values = [1e5]
+[run]
+%(run)s
+[scene]
+%(scene)s
+[scene.stop]
+t_end = 1.0
+[scene.integrator]
+%(integrator)s
+"""
+
+
+@pytest.mark.parametrize("table,line,field", [
+    ("scene", 'x0 = ["0", "0.5", "0", "0", "0", "0", "0", "0"]', "x0"),
+    ("scene", "x0 = [0, 0.5, 0, 0]", "x0"),
+    ("scene", "flags0 = [5, 7]", "flags0"),
+    ("scene", "flags0 = [0.5, 1]", "flags0"),
+    ("integrator", "dt = 2.0", "dt"),
+    ("integrator", "rtol = nan", "rtol"),
+    ("integrator", "atol = -1.0", "atol"),
+    ("run", "period_tol = inf", "period_tol"),
+    ("run", "steady = 0", "steady"),
+])
+def test_study_values_are_checked_as_simulate_checks(table, line, field):
+    """Such [run] values loaded, and the sweep exited 0 with every row "error"."""
+    parts = {"run": "", "scene": "", "integrator": "", table: line}
+    with pytest.raises(pdw.InvalidInputError, match=field):
+        parse_study(_STUDY % parts)
+
+
+def test_a_huge_study_is_refused_before_any_allocation():
+    with pytest.raises(pdw.InvalidInputError, match="num"):
+        parse_study('name = "s"\n[[axes]]\nname = "k_n"\nstart = 1e4\nstop = 1e6\nnum = 10000000000000\n')
+    two = ('name = "s"\n[[axes]]\nname = "k_n"\nstart = 1e4\nstop = 1e6\nnum = 100000\n'
+           '[[axes]]\nname = "d_n"\nstart = 1e5\nstop = 1e6\nnum = 100000\n')
+    with pytest.raises(pdw.InvalidInputError, match="points"):
+        parse_study(two)

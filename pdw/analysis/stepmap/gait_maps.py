@@ -9,7 +9,7 @@ eigenvalues are the Floquet multipliers) and ``d P^n / d lambda``. Two models:
   integrated to the strike (the same Dormand-Prince 5(4) and tolerances as the map) and the
   saltation matrix of the heel-strike event times the derivative of the impact map
   (pdw/core/csrc/pdw_hybrid_var.c, emitted pieces from derive/hybrid.py). It agrees with central
-  differences to ~1e-9 at rtol = atol = 1e-12 (tests/test_continuation.py).
+  differences to ~1e-9 at rtol = atol = 1e-12 (tests/analysis/bifurcation/test_continuation.py).
 * `ContinuousProblem` (`pdw.limit_cycle`, compliant ground): z at the swing foot's
   touch-down (6 coordinates, or more with a contact law that has memory: ``options["contact"]``,
   `pdw.analysis.stepmap.section.section_names`). M by central differences of the rodas4 map (rtol 1e-10, atol 1e-12, event_tol

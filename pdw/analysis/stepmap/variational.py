@@ -26,7 +26,7 @@ spring-damper of Eqs. 7, 11 does not vanish with it): f- and f+ are the one-side
 Scope: the paper variant (the consistent variant's tangential anchors are not differentiated)
 and the default laws (`pdw.ode_function` has no contact argument). Slower than the finite
 differences (one Python integration of 72 equations), so not the continuation's default: it
-is the cross-check of `tests/test_continuation_variational.py` and of a user's doubts near a kink.
+is the cross-check of `tests/analysis/stepmap/test_continuation_variational.py` and of a user's doubts near a kink.
 """
 from __future__ import annotations
 

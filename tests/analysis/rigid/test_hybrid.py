@@ -8,9 +8,10 @@ import pytest
 import pdw
 from pdw import hybrid as H
 from pdw.analysis.gait_types import Gait, GaitNotFoundError
+from pdw.analysis.rigid import hybrid
 from pdw.core.errors import InvalidInputError, SimulationError
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = pathlib.Path(__file__).resolve().parents[3]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
@@ -322,3 +323,34 @@ def test_step_map_failures_and_bad_input():
         H.step_map([0.2, -0.2, np.nan, 0.0], COMPASS)
     with pytest.raises(InvalidInputError):
         H.step_map([0.2, -0.2, -1.0, 0.0], COMPASS, rtoll=1e-3)
+
+
+def test_hybrid_record_is_complete_or_not_ok():
+    """dt_out = 1e-5 over 10 steps used to end the trajectory at 2.0 s of a 5.64 s walk while
+    the status was "ok"; now the record covers every step of the walk."""
+    tr = hybrid.simulate_hybrid(n_steps=10, dt_out=1e-5)
+    total = sum(s["t_strike"] for s in tr.steps)
+    assert tr.status == "ok" and len(tr.steps) == 10
+    assert not any(s["rec_full"] for s in tr.steps)
+    assert tr.t[-1] == pytest.approx(total, abs=1e-12)
+    assert np.all(np.diff(tr.t) >= 0)
+    # every dt_out instant of the walk is sampled (besides the steps' start and pre-impact)
+    assert len(tr.t) >= int(total / 1e-5)
+    # the recorded part is the same walk as a coarse record of it
+    coarse = hybrid.simulate_hybrid(n_steps=10, dt_out=1e-3)
+    assert [s["t_strike"] for s in coarse.steps] == [s["t_strike"] for s in tr.steps]
+
+
+def test_hybrid_record_too_large_for_memory_is_an_error_naming_dt_out():
+    with pytest.raises(pdw.InvalidInputError, match="dt_out"):
+        hybrid.simulate_hybrid(n_steps=2000, dt_out=1e-9)
+
+
+def test_public_full_state_refuses_a_short_state():
+    """pdw.hybrid.full_state([3 values]) used to return memory read past the array."""
+    with pytest.raises(pdw.InvalidInputError, match=r"y must have shape \(4,\) or \(N, 4\)"):
+        pdw.hybrid.full_state([0.1, -0.1, 1.0])
+    with pytest.raises(pdw.InvalidInputError, match="shape"):
+        pdw.hybrid.full_state(np.zeros((2, 3)))
+    x = pdw.hybrid.full_state([0.2, -0.2, -1.0, -0.3])
+    assert x.shape == (8,) and np.isfinite(x).all()

@@ -2,10 +2,13 @@
 pdw/core/csrc/pdw_hybrid_sim.h) reaches its own field: each is shown by an effect that only
 that option has (a status, a bound on the step count, the event time's precision, the sample
 spacing), and options of the same kind given the same value do not give the same run."""
+import math
+
 import numpy as np
 import pytest
 
 import pdw
+from pdw.analysis.rigid import hybrid
 
 H = pdw.hybrid
 COMPASS = H.compass_gait_params()
@@ -69,3 +72,18 @@ def test_angles(gait, ref):
 def test_sample_spacing(gait):
     tr = H.simulate_hybrid(COMPASS, gait, 1, dt_out=0.05)
     np.testing.assert_allclose(np.diff(tr.t)[:-1], 0.05, rtol=1e-9)
+
+
+@pytest.mark.parametrize("opt,value", [("rtol", -1.0), ("atol", 0.0), ("min_step_angle", math.nan),
+                                       ("fall_angle", 10.0), ("max_steps", 0), ("dt_out", -1e-3),
+                                       ("h_max", math.inf), ("event_tol", "1e-9")])
+def test_hybrid_options_are_range_checked(opt, value):
+    """rtol = -1 was accepted; min_step_angle = nan reported a good step as "fell"."""
+    y = np.array([0.2, -0.2, -1.0, -0.4])
+    with pytest.raises(pdw.InvalidInputError, match=opt):
+        hybrid.step(y, **{opt: value})
+
+
+def test_hybrid_state_is_not_reshaped():
+    with pytest.raises(pdw.InvalidInputError, match="shape"):
+        hybrid.step(np.array([[0.2, -0.2], [-1.0, -0.4]]))

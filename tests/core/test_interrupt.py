@@ -1,4 +1,4 @@
-"""Issue 16, finding 7 on the loops merged after it: Ctrl-C stops every long loop within a
+"""Ctrl-C (`pdw.core.interrupt`; issue 16, finding 7, on the loops merged after it): it stops every long loop within a
 second with `KeyboardInterrupt` (and the partial result where the API has one).
 
 The hybrid walk polls at each step and every 4096 right-hand sides (pdw_hybrid_sim.c), the
@@ -127,3 +127,39 @@ def test_thread_map_keeps_order_and_reraises_a_task_error():
     inner = []
     interrupt.thread_map(lambda _: inner.append(interrupt.current() is not None), [0, 1], 2)
     assert inner == [True, True] and interrupt.current() is None
+
+
+_SIGINT_CHILD = """
+import signal, time, sys
+import pdw
+# Python's Ctrl-C handler (a background job of a non-interactive shell starts with SIGINT
+# ignored, and Python then leaves it ignored)
+signal.signal(signal.SIGINT, signal.default_int_handler)
+print("start", flush=True)
+t0 = time.time()
+try:
+    pdw.simulate(method="rodas4", params=pdw.Params(v_s=1e-12), t_end=1.0, record_every=1,
+                 max_steps=10**9)
+except KeyboardInterrupt as e:
+    r = e.result
+    print("INTERRUPTED", r.status, r.n_steps, len(r.t), r.t_final, flush=True)
+    sys.exit(0)
+print("FINISHED", time.time() - t0)
+"""
+
+
+def test_ctrl_c_stops_a_long_compiled_run_within_a_second_with_the_partial_result():
+    proc = subprocess.Popen([sys.executable, "-c", textwrap.dedent(_SIGINT_CHILD)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert proc.stdout.readline().strip() == "start"
+    time.sleep(1.5)                              # well inside the run (minutes without a stop)
+    sent = time.monotonic()
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=60)
+    took = time.monotonic() - sent
+    assert proc.returncode == 0, err[-2000:]
+    words = out.split()
+    assert words[0] == "INTERRUPTED", out
+    assert words[1] == "interrupted" and int(words[2]) > 0 and int(words[3]) > 0
+    assert 0 < float(words[4]) < 1.0
+    assert took < 2.0, took         # the poll is every 2000 iterations (~0.1 s); + the exit
