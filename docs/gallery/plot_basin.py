@@ -2,7 +2,7 @@
 A basin of attraction
 =====================
 
-Where the walker ends up from a grid of touch-down states (`pdw.analysis.basins.basin`): every grid
+Where the walker ends up from a grid of touch-down states (``pdw.analysis.basins.basin``): every grid
 point is one walker of the ensemble engine (`pdw.simulate_batch`, docs/ensemble.md), started
 at a touch-down with step angle phi and swing rate thetad2, run until its last four steps
 agree (a periodic gait) or it falls. The window is wide enough to hold the basin's edge on

@@ -2,7 +2,7 @@
 A parameter sweep
 =================
 
-A study (docs/studies.md) sweeps `Params` fields over ranges; each point is one `pdw.Scene`
+A study (docs/studies.md) sweeps `pdw.Params` fields over ranges; each point is one `pdw.Scene`
 run to its steady gait, and the table of steady descriptors is written as CSV (resumable)
 with a JSON record of how it was made. Here the hip mass m_h over five values, cdm at the
 paper's step for 8 s, the steady values the mean of the last four steps (the shipped studies

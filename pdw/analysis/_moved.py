@@ -5,7 +5,7 @@
 as its new path (``limit_cycle`` of ``pdw.analysis`` is ``stepmap.limit_cycle``), with a
 `DeprecationWarning` naming the new path. No file stays at an old path: a meta-path finder
 (`AliasFinder`, installed by ``pdw/analysis/__init__.py``) answers the old names and hands back
-the module of the new name from `sys.modules`. `tests/analysis/test_moved.py` pins the table.
+the module of the new name from `sys.modules`. `tests/analysis/test_moved_paths.py` pins the table.
 """
 from __future__ import annotations
 

@@ -21,7 +21,7 @@ class Gait:
     Attributes
     ----------
     state : ndarray
-        The state on the Poincaré section. For ``model == "hybrid"`` (`pdw.hybrid`): the
+        The state on the Poincaré section. For ``model == "hybrid"`` (``pdw.hybrid``): the
         reduced state just after heel strike, after relabelling, [theta_st, theta_sw,
         thetad_st, thetad_sw] (rad, rad/s; angles from the slope normal, docs/model.md section 2),
         with theta_sw = -theta_st (both feet on the ground).

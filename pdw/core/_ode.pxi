@@ -94,7 +94,7 @@ cdef class OdeFunction:
 
     @property
     def flags(self):
-        """Support flags (leg 1, leg 2) held fixed: 1 support, 0 swing."""
+        """The support flags (leg 1, leg 2) held fixed; 1 support, 0 swing."""
         return (self._flags[0], self._flags[1])
 
     @property

@@ -18,11 +18,11 @@ flores                 k delta^1.5 (1 + 8(1-e)/(5e) delta_dot/v0)     k [N/m^1.5
 =====================  ============================================  =====================
 
 Every damped law is clamped at 0 (the ground cannot pull). v0 = max(v_in, v_in_min), v_in the
-foot's approach speed captured at its touch-down. The laws whose k has `Params.k_n`'s units
-(N/m^1.5: hunt_crossley, hertz, lankarani_nikravesh, flores) default k to `Params.k_n`, and
-hunt_crossley d to `Params.d_n`. kelvin_voigt's k and d have other units (N/m, N s/m): they
+foot's approach speed captured at its touch-down. The laws whose k has ``Params.k_n``'s units
+(N/m^1.5: hunt_crossley, hertz, lankarani_nikravesh, flores) default k to ``Params.k_n``, and
+hunt_crossley d to ``Params.d_n``. kelvin_voigt's k and d have other units (N/m, N s/m): they
 never take `Params`' numbers, but default to the law's own calibration to the paper's ground
-(`KELVIN_VOIGT_DEFAULTS`: k = 7318 N/m, d = 112.2 N s/m, the static sink and the drop-test
+(``KELVIN_VOIGT_DEFAULTS``: k = 7318 N/m, d = 112.2 N s/m, the static sink and the drop-test
 restitution of `Params.paper_steady()`'s Hunt-Crossley ground, `pdw.analysis.numerics.calibration`;
 docs/contact_laws.md), filled in when the Contact is made, so its repr shows them.
 
@@ -36,7 +36,7 @@ lugre                  -(sigma0 z + sigma1 dz/dt + sigma2 v) F_n, with a bristle
 =====================  ====================================================================
 
 Both keep the tangential spring-damper of Eqs. 7, 11. LuGre's state is [q, qd, z1, z2]
-(`pdw.core._layout.STATE_LAYOUTS`); z is reset to 0 at the foot's touch-down.
+(``pdw.core._layout.STATE_LAYOUTS``); z is reset to 0 at the foot's touch-down.
 """
 from __future__ import annotations
 
@@ -66,8 +66,8 @@ UNITS = {
     "lankarani_nikravesh": {"k": "N/m^1.5", "e": "-", "v_in_min": "m/s"},
     "flores": {"k": "N/m^1.5", "e": "-", "v_in_min": "m/s"},
 }
-#: kelvin_voigt's defaults: its own calibration to the paper's ground (not `Params.k_n`,
-#: `Params.d_n`, whose units differ): k = W / delta_s (the Hunt-Crossley static sink under the
+#: kelvin_voigt's defaults: its own calibration to the paper's ground (not ``Params.k_n``,
+#: ``Params.d_n``, whose units differ): k = W / delta_s (the Hunt-Crossley static sink under the
 #: walker's weight W) and d such that the drop test at the typical landing gives Hunt-Crossley's
 #: restitution 0.1405 (`pdw.analysis.numerics.calibration.calibrate` of `Params.paper_steady()`: k =
 #: 7318.12 N/m, d = 112.211 N s/m; here to 4 figures; a test recomputes them).
@@ -82,7 +82,7 @@ LUGRE_PARAMETERS = {
     "v_s": (0.0, True, "m/s", "Stribeck velocity"),
 }
 #: LuGre's defaults for sigma0, sigma1, sigma2 (Canudas de Wit et al. 1995's values for a unit
-#: normal force); mu_s, mu_c, v_s default to the paper's law (`lugre_stribeck`).
+#: normal force); mu_s, mu_c, v_s default to the paper's law (``lugre_stribeck``).
 LUGRE_DEFAULTS = {"sigma0": 1e5, "sigma1": math.sqrt(1e5), "sigma2": 0.0}
 _LG_P = {"sigma0": "sigma0", "sigma1": "sigma1", "sigma2": "sigma2", "mu_s": "lg_mu_s",
          "mu_c": "lg_mu_c", "v_s": "lg_v_s"}
@@ -106,16 +106,16 @@ class Contact:
     Parameters
     ----------
     normal : str
-        Normal law, one of `NORMAL_LAWS`; default the paper's ``"hunt_crossley"``.
+        Normal law, one of ``NORMAL_LAWS``; default the paper's ``"hunt_crossley"``.
     friction : str
-        Friction law, one of `FRICTION_LAWS` (``"coulomb"``: the smooth law of Eq. 10 with the
+        Friction law, one of ``FRICTION_LAWS`` (``"coulomb"``: the smooth law of Eq. 10 with the
         tangential spring-damper of Eqs. 7, 11).
     k : float, optional
-        Normal stiffness [N/m^1.5; N/m for kelvin_voigt]; default `Params.k_n`, except
-        kelvin_voigt: its calibrated 7318 N/m (`KELVIN_VOIGT_DEFAULTS`, set on the Contact).
+        Normal stiffness [N/m^1.5; N/m for kelvin_voigt]; default ``Params.k_n``, except
+        kelvin_voigt: its calibrated 7318 N/m (``KELVIN_VOIGT_DEFAULTS``, set on the Contact).
     d : float, optional
         Normal damping of hunt_crossley [N s/m^2.5] or kelvin_voigt [N s/m]; default
-        `Params.d_n` for hunt_crossley, the calibrated 112.2 N s/m for kelvin_voigt.
+        ``Params.d_n`` for hunt_crossley, the calibrated 112.2 N s/m for kelvin_voigt.
     e : float, optional
         Coefficient of restitution of lankarani_nikravesh and flores, in (0, 1]; required there.
     v_in_min : float, optional
@@ -123,10 +123,10 @@ class Contact:
         lands slower than this, uses it); default 0.01 m/s.
     sigma0, sigma1, sigma2 : float, optional
         LuGre only: bristle stiffness (> 0) [1/m], bristle damping (>= 0) [s/m] and viscous
-        friction (>= 0) [s/m], per unit normal force; default `LUGRE_DEFAULTS`.
+        friction (>= 0) [s/m], per unit normal force; default ``LUGRE_DEFAULTS``.
     mu_s, mu_c, v_s : float, optional
         LuGre only: its Stribeck curve's static and Coulomb coefficients (> 0) [-] and Stribeck
-        velocity (> 0) [m/s]; default the paper's law matched (`lugre_stribeck`).
+        velocity (> 0) [m/s]; default the paper's law matched (``lugre_stribeck``).
 
     Raises
     ------
@@ -229,7 +229,7 @@ class Contact:
 
     @property
     def nx(self) -> int:
-        """Size of the continuous state under this friction law (`pdw.core._layout.STATE_LAYOUTS`)."""
+        """Size of the continuous state under this friction law (``pdw.core._layout.STATE_LAYOUTS``)."""
         return len(_layout.STATE_LAYOUTS[self.friction])
 
     @property
@@ -238,7 +238,7 @@ class Contact:
         return _layout.STATE_LAYOUTS[self.friction]
 
     def for_features(self, features) -> "Contact":
-        """The contact a run with only these force elements (`pdw.core._layout.FEATURES`)
+        """The contact a run with only these force elements (``pdw.core._layout.FEATURES``)
         simulates. Each element means under LuGre what it means under the default law:
         ``hip_spring``, ``hip_damper``, ``normal_damping`` and ``tangential`` (the spring-damper
         of Eqs. 7, 11, which LuGre keeps) are switched off by zeroing their parameters on the

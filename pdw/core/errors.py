@@ -50,7 +50,7 @@ class FellError(SimulationError):
 
 class StepSizeError(InvalidInputError):
     """A fixed step size above the method's estimated stability limit for the parameters
-    (`pdw.simulate(..., check_step="error")`, `pdw.sim.stepsize.step_limit`).
+    (`pdw.simulate(..., check_step="error") <pdw.simulate>`, ``pdw.sim.stepsize.step_limit``).
 
     Attributes: ``dt`` (the step asked for), ``limit`` (the estimated limit [s]) and ``force``
     (the force element that sets it)."""

@@ -137,8 +137,8 @@ def _check_patches(patches, blend):
 class Ground:
     """The ground under the walker: shape h(s) [m] and contact patches (module docstring).
 
-    Build one with the class methods (`flat`, `steps`, `profile`, `plane`, `sine`, `random`) or
-    `from_dict`; ``Ground()`` is flat. Frozen: ``replace``-style changes build a new one.
+    Build one with the class methods (``flat``, `steps`, ``profile``, ``plane``, ``sine``, ``random``) or
+    ``from_dict``; ``Ground()`` is flat. Frozen: ``replace``-style changes build a new one.
     """
 
     kind: str = "flat"
@@ -288,7 +288,7 @@ class Ground:
 
     @classmethod
     def coerce(cls, ground) -> "Ground":
-        """A `Ground` from None (flat), a Ground or a dict (`from_dict`)."""
+        """A `Ground` from None (flat), a Ground or a dict (``from_dict``)."""
         if ground is None:
             return cls()
         if isinstance(ground, cls):
@@ -441,7 +441,7 @@ class Ground:
 
     # ---- TOML -----------------------------------------------------------------------------------
     def to_dict(self) -> dict:
-        """The ``[ground]`` table (`from_dict` reads it back to an equal Ground)."""
+        """The ``[ground]`` table (``from_dict`` reads it back to an equal Ground)."""
         d: dict = {"kind": self.kind}
         for k, v in self.spec:
             d[k] = list(v) if isinstance(v, tuple) else v

@@ -42,7 +42,7 @@ def _kernel_index(variant: str = "paper", features=None, normal: str = "hunt_cro
     """Index of the generated kernel for ``variant`` with the given force elements, normal
     contact law (`pdw.core._layout.NORMAL_LAWS`) and friction law (`FRICTION_LAWS`).
 
-    ``features=None`` means every element (`pdw.core._layout.FEATURES`). A combination without
+    ``features=None`` means every element (``pdw.core._layout.FEATURES``). A combination without
     a specialized kernel falls back to the general one (of its normal law).
     """
     check_variant(variant)
@@ -94,7 +94,7 @@ def _states(x, name="x", width=_core.NX):
 
 
 def _discrete(flags, anchors, n):
-    """Flags (n, 2) and anchors (n, 2) (s0 only) or (n, NANCHOR) (`pdw.core._layout.ANCHORS`:
+    """Flags (n, 2) and anchors (n, 2) (s0 only) or (n, NANCHOR) (``pdw.core._layout.ANCHORS``:
     s0 and the approach speeds)."""
     f = checks.flags("flags", flags, n)
     f = np.ascontiguousarray(np.broadcast_to(np.asarray(f, dtype=np.intc), (n, 2)))
@@ -154,7 +154,7 @@ def rhs(x: ArrayLike, params: Params | None = None, flags: ArrayLike = _FLAGS0,
     variant : {"paper", "consistent"}
         docs/model.md section 6.
     features : iterable of str, optional
-        Force elements present (`pdw.core._layout.FEATURES`; default all).
+        Force elements present (``pdw.core._layout.FEATURES``; default all).
 
     Returns
     -------
@@ -216,7 +216,7 @@ def jacobian(x: ArrayLike, params: Params | None = None, flags: ArrayLike = (0, 
     variant : {"paper", "consistent"}
         docs/model.md section 6.
     features : iterable of str, optional
-        Force elements present (`pdw.core._layout.FEATURES`; default all).
+        Force elements present (``pdw.core._layout.FEATURES``; default all).
 
     Returns
     -------
@@ -298,11 +298,11 @@ def contact_forces(x: ArrayLike, params: Params | None = None, flags: ArrayLike 
     anchors : (float, float) or array_like (N, 2), or (4,) or (N, 4)
         Rolling coordinate s_i at the last touch-down of each foot [m]; only the
         ``consistent`` variant's tangential deformation uses them. Four columns: then the
-        approach speeds v_in1, v_in2 [m/s] (`pdw.core._layout.ANCHORS`).
+        approach speeds v_in1, v_in2 [m/s] (``pdw.core._layout.ANCHORS``).
     variant : {"paper", "consistent"}
         docs/model.md section 6.
     features : iterable of str, optional
-        Force elements present (`pdw.core._layout.FEATURES`; default all).
+        Force elements present (``pdw.core._layout.FEATURES``; default all).
     contact : pdw.Contact, optional
         Another normal law, or LuGre friction (its kernel, its state width); default the
         paper's. With ``features`` without ``friction``, LuGre's run contact

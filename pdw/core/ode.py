@@ -62,7 +62,7 @@ def ode_function(params: Params | None = None, variant: str = "paper",
         Rolling coordinate s_i at the last touch-down of each foot [m] (only the
         ``consistent`` variant uses them), held fixed.
     features : iterable of str, optional
-        Force elements present (`pdw.core._layout.FEATURES`; default all), as in `pdw.simulate`.
+        Force elements present (``pdw.core._layout.FEATURES``; default all), as in `pdw.simulate`.
 
     Returns
     -------

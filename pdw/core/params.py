@@ -31,7 +31,7 @@ class Params:
     construction: a NaN, a non-positive mass or length, ``r >= l``, or ``v_s >= v_d``
     raises `pdw.InvalidInputError` (a `ValueError`) naming the field and its allowed range.
 
-    Use `dataclasses.replace` (or `Params.replace`) to change fields.
+    Use ``dataclasses.replace`` (or `Params.replace`) to change fields.
     """
 
     l: float = _f(0.5, "m", "leg length, hip to foot", lo=0.0)
@@ -152,11 +152,11 @@ class Params:
         return dataclasses.replace(self, **changes)
 
     def as_array(self) -> np.ndarray:
-        """Physical parameters in the C layout (`pdw.core._layout.PARAMS`), shape (NPARAM,)."""
+        """Physical parameters in the C layout (``pdw.core._layout.PARAMS``), shape (NPARAM,)."""
         return np.array([getattr(self, n) for n in _layout.PARAMS], dtype=float)
 
     def as_dict(self) -> dict[str, float]:
-        """Every physical parameter by name (the order of `pdw.core._layout.PARAMS`), SI units."""
+        """Every physical parameter by name (the order of ``pdw.core._layout.PARAMS``), SI units."""
         return {n: getattr(self, n) for n in _layout.PARAMS}
 
     @property

@@ -94,15 +94,16 @@ class BatchResult:
         ``failure_x`` (N, 8) the last good state (NaN if none), ``failure_leg`` (N,) 1, 2 or 0.
     n_touch_down, n_lift_off, n_gait_steps : ndarray of int (N,)
         Event counts and complete gait steps (docs/model.md section 8) of each walker.
-    gait_rows : ndarray (N, STEP_RING, len(STEP))
+    gait_rows : ndarray, shape (N, S, C)
+        S = ``STEP_RING``, C = ``len(STEP)`` of ``pdw.core._layout``.
         The last ``min(n_gait_steps, STEP_RING)`` steps of each walker, oldest first (layout
-        `pdw.core._layout.STEP`, legs 0/1), NaN beyond; `steps(i)` gives them as `Steps`.
+        ``pdw.core._layout.STEP``, legs 0/1), NaN beyond; `steps(i) <pdw.steps>` gives them as `Steps`.
     dt, t_end : float
         Step and end time [s]; ``method``, ``variant``: as given.
     recorded : dict
         ``{i: Result}`` for the walkers listed in ``record`` (`simulate_batch`), else empty.
     engine : str
-        ``"batch"`` (the compiled lanes) or ``"scalar"`` (`pdw.sim.ensemble.scalar_batch`).
+        ``"batch"`` (the compiled lanes) or ``"scalar"`` (``pdw.sim.ensemble.scalar_batch``).
     """
 
     status: np.ndarray
@@ -253,12 +254,12 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
         step size, accept/reject and event location, and every walker is bitwise its
         `simulate` run (docs/ensemble.md). For the adaptive methods dt is the first step.
     integrator, stop, limits : pdw.Integrator, pdw.Stop, pdw.Limits, optional
-        As `simulate` (`pdw.sim.options`): the tolerances and step budget (of each walker),
+        As `simulate` (``pdw.sim.options``): the tolerances and step budget (of each walker),
         the stop conditions, the fall and divergence bounds (``fall_hip_height`` and
         ``fall_depth`` default to 0.5 l and 0.25 l of each walker's parameters). A divergence
         is a status here (``"diverged"``), never an error (``limits.on_failure`` does not
         apply); the end-of-run checks of `simulate` (runaway, ``"no_steps"``) are applied to
-        the final states (`pdw.sim.chunks.honest`).
+        the final states (``pdw.sim.chunks.honest``).
     flags0 : (2,) or (N, 2) ints in {0, 1}
         Initial support flags of legs 1, 2.
     threads : int, optional
@@ -285,12 +286,12 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
         Walkers whose trajectories are wanted: they are run again through the **scalar**
         `pdw.simulate` in this call (the compiled lane loop records nothing), with
         ``record_every`` and the same inputs (forces and events recorded,
-        ``on_failure="return"``), and returned in ``BatchResult.recorded`` as `Result`s. On the
+        ``on_failure="return"``), and returned in ``BatchResult.recorded`` as `Result` objects. On the
         bitwise path (``vector=False``) those runs are the lanes' arithmetic: same ``x_final``.
     record_every : int
         Sampling of the recorded walkers (every k-th step, >= 1).
     progress : bool or Progress
-        A progress bar over the walkers (`pdw.core.progress`): True draws on stderr when it is
+        A progress bar over the walkers (``pdw.core.progress``): True draws on stderr when it is
         a terminal, a `Progress` of the caller's gets N added to its total. The batch then
         runs in chunks (``chunk_size``, default N / 50 but at least one block per thread),
         bitwise the unchunked batch.
@@ -303,7 +304,7 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
     **_legacy
         The keywords of before (``rtol=``, ``stop_steps=``, ``max_speed=``, ...) and the
         positional form: they work for one release, each with a `DeprecationWarning` naming
-        its new spelling (`pdw.sim.options.LEGACY`).
+        its new spelling (``pdw.sim.options.LEGACY``).
 
     Returns
     -------

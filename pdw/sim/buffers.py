@@ -19,7 +19,7 @@ from ..core.errors import InvalidInputError
 class RecordBuffer:
     """Reusable record arrays for `pdw.simulate` (``out=``); grows when a run needs more rows.
 
-    The states are kept in one block of ``capacity * NX_MAX`` floats (`pdw.core._core.NX_MAX`,
+    The states are kept in one block of ``capacity * NX_MAX`` floats (``pdw.core._core.NX_MAX``,
     the widest state layout); ``x`` is a C-contiguous view of its first ``capacity * nx``
     entries, shape (capacity, nx), with the width of the last run's friction law (8 before the
     first run). A run of another width views the same block anew: nothing is allocated, and the

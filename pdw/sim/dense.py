@@ -21,7 +21,7 @@ interval before it ends at the swing value of z (`_left_limits`).
 The interpolant passes through the recorded states exactly, is C^1 inside each smooth stretch,
 and its error between steps converges with the method's order (tests/sim/test_dense_output.py,
 tests/sim/test_lugre_dense.py).
-The anchors (docs/model.md section 6, `pdw.core._layout.ANCHORS`) are not recorded; they are
+The anchors (docs/model.md section 6, ``pdw.core._layout.ANCHORS``) are not recorded; they are
 rebuilt from the touch-downs as the loops set them: the rolling coordinate s_i and the approach
 speed max(-v_y, 0) of foot i at the step where flag i became 1 (or at the start, for a foot
 that starts in support). The approach speeds are the discrete values of the Lankarani-Nikravesh
@@ -39,7 +39,7 @@ from ..core.model import contact_forces, kernel_index, parameter_vector
 
 def _anchors(x, flags, params, variant):
     """Anchors in force at each recorded step, shape (N, 4): s0_1, s0_2 [m], v_in1, v_in2 [m/s]
-    (`pdw.core._layout.ANCHORS`)."""
+    (``pdw.core._layout.ANCHORS``)."""
     # s and v_y use no anchors and no bristle states
     cs = contact_forces(x[:, :_core.NX], params, flags=(0, 0), variant=variant)
     s, vin = np.atleast_2d(cs.s), np.maximum(-np.atleast_2d(cs.v_y), 0.0)
@@ -75,7 +75,7 @@ class DenseOutput:
     """Piecewise Hermite interpolant of a recorded run; ``sol(t)`` -> (nx,) or (len(t), nx).
 
     Attributes ``t`` (N,), ``x`` (N, nx), ``flags`` (N, 2), ``anchors`` (N, 4) (layout
-    `pdw.core._layout.ANCHORS`) are the recorded steps; ``nx`` the width of the run's state
+    ``pdw.core._layout.ANCHORS``) are the recorded steps; ``nx`` the width of the run's state
     (8, or 10 with LuGre's bristle states: `pdw.Contact.nx`); ``order`` is 3 (cubic) or 5
     (quintic); ``contact`` the run's `pdw.Contact` (its normal and friction laws' f is
     interpolated).

@@ -70,7 +70,7 @@ def scalar_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None = N
     `pdw.simulate`'s ``features`` and ``contact``. ``threads`` (default os.cpu_count()) run
     walkers in parallel (the compiled loop releases the GIL). Any method of `pdw.METHODS`.
     The keywords of before (``rtol=``, ``stop_steps=``, ...) work for one release, warning
-    (`pdw.sim.options.LEGACY`).
+    (``pdw.sim.options.LEGACY``).
     """
     settled = _opt.settle(
         "scalar_batch", _positional, _legacy, integrator=integrator, stop=stop, limits=limits,
@@ -189,7 +189,7 @@ def simulate_many(x0: ArrayLike, t_end: float | None = None, dt: float | None = 
         (the batch engine has neither).
     **_legacy
         The keywords of before (``rtol=``, ``stop_steps=``, ...) work for one release, warning
-        (`pdw.sim.options.LEGACY`).
+        (``pdw.sim.options.LEGACY``).
 
     Returns
     -------

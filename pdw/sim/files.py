@@ -217,7 +217,7 @@ def load(path: str | os.PathLike):
     ----------
     path : str or path-like
         A `Result` (``.npz`` or ``.nc``, `Result.save`), a `BatchResult` (``.npz``,
-        `BatchResult.save`), another registered kind (a continuation `Branch`), or a sweep's
+        ``BatchResult.save``), another registered kind (a continuation `Branch`), or a sweep's
         CSV (``.csv``: `pdw.load_sweep`).
 
     Returns

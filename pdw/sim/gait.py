@@ -14,7 +14,7 @@ A *step* ends at a touch-down of the swing leg j (time t_td, contact point x_td)
   the other leg does not lift off before the next touch-down.
 
 The compiled loops compute the same descriptors online, as the events happen (pdw/core/csrc/
-pdw_discrete.c, layout `pdw.core._layout.STEP`), keeping the last `pdw.core._layout.STEP_RING` steps:
+pdw_discrete.c, layout `pdw.core._layout.STEP`), keeping the last ``pdw.core._layout.STEP_RING`` steps:
 `Result.gait`. `steps` recomputes every step from a run's events; for a run that did not keep
 its events (``record_events=False``) it returns `Result.gait`.
 """
@@ -45,8 +45,9 @@ class Steps:
 
     Attributes
     ----------
-    table : dict of str -> ndarray (n_steps,)
-        ``leg`` (the swing leg, 1 or 2), ``t_lift_off`` and ``t_touch_down`` [s], step length
+    table : dict
+        Column name -> ndarray (n_steps,): ``leg`` (the swing leg, 1 or 2), ``t_lift_off``
+        and ``t_touch_down`` [s], step length
         ``L`` and hip ``travel`` [m], step period ``P`` [s], speed ``v`` [m/s], ``cycle`` [s],
         ``double_support`` [s] and its share of the step, ``ds_fraction`` [-].
         ``steps["L"]`` is ``steps.table["L"]``; ``len(steps)`` the number of steps.
@@ -104,7 +105,7 @@ class Steps:
         return out
 
     def to_dataframe(self) -> pandas.DataFrame:
-        """One row per step as a pandas DataFrame (`steps_to_dataframe`; needs
+        """One row per step as a pandas DataFrame (``steps_to_dataframe``; needs
         pandas): the columns of `table`, units in ``df.attrs["units"]``."""
         return steps_to_dataframe(self)
 
@@ -163,7 +164,7 @@ def steps(result_or_events: Result | Sequence[Event]) -> Steps:
         A `pdw.simulate` result, or its ``events`` (time-ordered touch-downs and lift-offs,
         legs numbered 1 and 2). For a result that did not keep its events
         (``record_events=False``): its online descriptors, `Result.gait` (the last
-        `pdw.core._layout.STEP_RING` steps).
+        ``pdw.core._layout.STEP_RING`` steps).
 
     Returns
     -------

@@ -444,9 +444,9 @@ class Outcome(str, enum.Enum):
     """How a run ended: one value, from which `Result.status` and `Result.stop_reason` follow
     (``Outcome.STEPS.status == "walked"``, ``Outcome.STEPS.stop_reason == "steps"``).
 
-    T_END: walked to t_end. STEPS: walked the requested number of gait steps (`Stop.steps`).
-    TOUCH_DOWN: stopped at the requested touch-down (`Stop.touch_down`). PERIODIC: the last
-    steps agreed (`Stop.periodic`). FELL: the hip dropped or a foot sank too deep (`Limits`).
+    T_END: walked to t_end. STEPS: walked the requested number of gait steps (`Stop.steps <pdw.steps>`).
+    TOUCH_DOWN: stopped at the requested touch-down (``Stop.touch_down``). PERIODIC: the last
+    steps agreed (``Stop.periodic``). FELL: the hip dropped or a foot sank too deep (`Limits`).
     DIVERGED: a non-finite, runaway or singular state, or the step budget used up. NO_STEPS:
     reached t_end without a touch-down in two pendulum periods or more. INTERRUPTED: Ctrl-C.
     """

@@ -182,7 +182,7 @@ class Scene(_Section):
     Build one in Python (``Scene(preset="paper_steady", record=Record.descriptors_only(),
     stop={"t_end": 20.0, "periodic": True})`` -- a table may be given as a dict), read one
     (`Scene.load`, `Scene.from_toml`), write one (`Scene.save`, `Scene.to_toml`; the text reads
-    back to an equal scene), change one (`Scene.replace`), run one (`Scene.run`, `pdw.run`,
+    back to an equal scene), change one (``Scene.replace``), run one (`Scene.run`, `pdw.run`,
     ``pdw.simulate(scene)``).
     """
 

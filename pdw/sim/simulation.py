@@ -98,7 +98,7 @@ class Result:
     t : ndarray (N,)
         Recorded times [s] (every ``record_every``-th step).
     x : ndarray (N, nx)
-        Recorded states, columns `state_names`: layout `pdw.STATE` (nx = 8), with LuGre's
+        Recorded states, columns ``state_names``: layout `pdw.STATE` (nx = 8), with LuGre's
         bristle states z1, z2 [m] after it (nx = 10).
     flags : ndarray (N, 2)
         Support flags of legs 1, 2 at those times.
@@ -111,7 +111,7 @@ class Result:
         ``"walked"`` (reached t_end, or the requested number of gait steps, having stepped),
         ``"periodic"`` (stopped because the last steps agreed), ``"fell"`` (see `failure`),
         ``"diverged"`` (non-finite, runaway or airborne state, non-finite energies, step
-        budget), ``"no_steps"`` (reached t_end without a touch-down in `NO_STEP_PERIODS`
+        budget), ``"no_steps"`` (reached t_end without a touch-down in ``NO_STEP_PERIODS``
         pendulum periods or more) or ``"interrupted"`` (Ctrl-C: the partial result rides on
         the ``KeyboardInterrupt`` as ``.result``).
     failure : dict or None
@@ -132,10 +132,10 @@ class Result:
         ``"t_end"``, ``"steps"`` (stop_steps reached), ``"periodic"``, or the failure status.
     energies : dict or None
         With ``record_energies``: T, V_gravity, V_hip and E [J] at the recorded samples.
-    sol : DenseOutput or None
-        With ``dense_output=True``: the interpolant between accepted steps (`pdw.sim.dense`).
-    integrator, record, stop, limits : option objects
-        The options the run was made with (`pdw.sim.options`; ``integrator`` with the method
+    sol : pdw.sim.dense.DenseOutput or None
+        With ``dense_output=True``: the interpolant between accepted steps (``pdw.sim.dense``).
+    integrator, record, stop, limits : pdw.Integrator, pdw.Record, pdw.Stop, pdw.Limits
+        The options the run was made with (``pdw.sim.options``; ``integrator`` with the method
         and dt run, ``stop`` with the t_end run).
     outcome : Outcome
         How the run ended (`pdw.sim.options.Outcome`), of which `status` and `stop_reason`
@@ -195,7 +195,7 @@ class Result:
         return self.contact.state_names if self.contact is not None else STATE
 
     def state(self, name: str) -> np.ndarray:
-        """Recorded time series of one state component by name (`state_names`), e.g.
+        """Recorded time series of one state component by name (``state_names``), e.g.
         ``res.state("thetad1")``: ndarray (M,) aligned with ``res.t`` [m, rad, m/s or rad/s]."""
         return self.x[:, self.state_names.index(name)]
 
@@ -217,13 +217,13 @@ class Result:
         return "\n".join(lines) + ">"
 
     def to_dataframe(self) -> pandas.DataFrame:
-        """The recorded samples as a pandas DataFrame (`pdw.sim.io.result_to_dataframe`; needs
+        """The recorded samples as a pandas DataFrame (``pdw.sim.io.result_to_dataframe``; needs
         pandas): one row per sample, index t [s], columns the state (`pdw.STATE`), the flags,
         the forces and (if recorded) the energies; units in ``df.attrs["units"]``."""
         return _io.result_to_dataframe(self)
 
     def to_xarray(self) -> xarray.Dataset:
-        """The run as an xarray Dataset (`pdw.sim.files.result_to_xarray`; needs xarray):
+        """The run as an xarray Dataset (``pdw.sim.files.result_to_xarray``; needs xarray):
         ``x`` (time x state), ``flags`` and forces (time x leg), units in each variable's
         ``attrs["units"]``, provenance and settings in ``ds.attrs``."""
         return _files.result_to_xarray(self)
@@ -240,7 +240,7 @@ class Result:
         Returns
         -------
         pathlib.Path
-            The file written (`pdw.sim.files`: every Result pdw returns -- any status, contact
+            The file written (``pdw.sim.files``: every Result pdw returns -- any status, contact
             law, dense output, features, t_eval -- is read back by `pdw.load` as it was, NaN
             and inf data included).
         """
@@ -301,7 +301,7 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
     variant : {"paper", "consistent"}
         Contact reading of docs/model.md section 6.
     method : str, optional
-        Integrator (`pdw.core.integrators.INTEGRATORS`, docs/integrators.md), the short form
+        Integrator (``pdw.core.integrators.INTEGRATORS``, docs/integrators.md), the short form
         of ``integrator=Integrator(method=...)``: ``"cdm"`` (default) is the paper's central
         difference method (docs/model.md section 7); ``"verlet"``, ``"rk4"`` are fixed-step,
         ``"dopri5"`` and ``"rodas4"`` (stiff, recommended) adaptive.
@@ -311,9 +311,9 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
         [s] and end a step there; fixed-step methods switch at step boundaries), their step
         budget max_steps (default 10^6 + 2 10^6 t_end/s; fixed-step methods take t_end/dt
         steps and refuse a budget below that), and check_step: fixed-step methods compare dt
-        with `pdw.sim.stepsize.step_limit` (the method's estimated stability limit for these
+        with ``pdw.sim.stepsize.step_limit`` (the method's estimated stability limit for these
         parameters; with another contact law, times the law's factor
-        `pdw.sim.stepsize.LAW_CALIBRATION`) and warn (`pdw.StepSizeWarning`, ``"warn"``),
+        ``pdw.sim.stepsize.LAW_CALIBRATION``) and warn (`pdw.StepSizeWarning`, ``"warn"``),
         refuse (`pdw.StepSizeError`, ``"error"``) or do not check (``"off"``). Fields:
         `pdw.sim.options.Integrator`.
     record : pdw.Record, optional
@@ -322,7 +322,7 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
         counts and the online gait analysis, O(1) memory however long the run), ``t_eval``
         (times [s], non-decreasing, in [0, t_end]: ``Result.t`` is then t_eval up to the run's
         end and x, flags, Fn, Ft, energies their values there from the method's dense output,
-        `pdw.sim.dense`), ``dense_output`` (also ``Result.sol(t)``, exact at every accepted
+        ``pdw.sim.dense``), ``dense_output`` (also ``Result.sol(t)``, exact at every accepted
         step), ``out`` (a `pdw.RecordBuffer`: record into its reusable arrays; the Result's
         arrays are then views into it). t_eval and dense_output need every = 1.
     stop : pdw.Stop, optional
@@ -331,7 +331,7 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
         the last ``periodic_steps`` steps agree, each of L, travel, P and cycle within
         ``periodic_tol`` relative: ``max - min <= tol * abs(latest)``), ``touch_down`` (1 or
         2: at that leg's first touch-down, the final state the event's; the touch-down
-        Poincare map's end, `pdw.limit_cycle`). Its ``t_end`` is the default of ``t_end``.
+        Poincare map's end, ``pdw.limit_cycle``). Its ``t_end`` is the default of ``t_end``.
     limits : pdw.Limits, optional
         When the run fell or diverged: ``fall_hip_height`` (the hip lower than this above the
         slope [m]; default 0.5 l), ``fall_depth`` (a foot deeper than this below the ground
@@ -343,7 +343,7 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
         Normal and friction contact laws and their parameters (`pdw.Contact`,
         docs/contact_laws.md); default the paper's Hunt-Crossley and smooth Coulomb laws.
     features : iterable of str, optional
-        Force elements present (`pdw.core._layout.FEATURES`; default all). The absent ones are
+        Force elements present (``pdw.core._layout.FEATURES``; default all). The absent ones are
         switched off: a specialized generated kernel if there is one, else the general kernel
         with their parameters zeroed (`Params.without`). Under LuGre friction the same, except
         that a run without ``friction`` has no bristles: it runs the normal law with the
@@ -361,7 +361,7 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
         The keywords of before (``record_every=``, ``rtol=``, ``stop_steps=``, ...) and the
         positional form ``simulate(x0, t_end, dt, params, variant, method, ...)``: they work
         for one release, each with a `DeprecationWarning` naming its new spelling
-        (`pdw.sim.options.LEGACY`).
+        (``pdw.sim.options.LEGACY``).
 
     Returns
     -------

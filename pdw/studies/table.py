@@ -1,7 +1,7 @@
 """A study's CSV: its columns and their types, the resumable rows, and reading it back.
 
-`run_study` (`pdw.studies.sweep`) appends one row per finished point and resumes from the rows
-already there. The CSV is typed by its columns (`COLUMN_TYPES`): ``index`` and ``n_steps``
+``run_study`` (`pdw.studies.sweep`) appends one row per finished point and resumes from the rows
+already there. The CSV is typed by its columns (``COLUMN_TYPES``): ``index`` and ``n_steps``
 integers, the axes and the descriptors real numbers, ``status``, ``gait``, ``source``,
 ``error``, ``settings`` text; an empty cell is a value not computed. A row read back has the
 types a computed row has, so a resumed row is written again as it was (``6`` stays ``6``,
@@ -61,7 +61,7 @@ class _Corrupt(ValueError):
 
 
 def parse(column, text):
-    """A cell of ``column`` in its type (`COLUMN_TYPES`; an axis: float); "" stays "" (not
+    """A cell of ``column`` in its type (``COLUMN_TYPES``; an axis: float); "" stays "" (not
     computed) except for ``index``. A cell that does not parse raises ValueError."""
     kind = COLUMN_TYPES.get(column, float)
     if kind is str:
@@ -132,7 +132,7 @@ def read_rows(path, study) -> dict:
 
 
 def load_sweep(path, *, as_frame: bool | None = None):
-    """A study's CSV (written by `pdw sweep` / `run_study`) in one call, without the Study.
+    """A study's CSV (written by ``pdw sweep`` / ``run_study``) in one call, without the Study.
 
     Parameters
     ----------
@@ -146,7 +146,7 @@ def load_sweep(path, *, as_frame: bool | None = None):
     Returns
     -------
     pandas.DataFrame or numpy.ndarray
-        One row per point, the columns of the CSV in their types (`COLUMN_TYPES`; the axes
+        One row per point, the columns of the CSV in their types (``COLUMN_TYPES``; the axes
         float): integers as int64 (an empty ``n_steps`` as -1 in the structured array, NA in
         the DataFrame), reals as float64 (empty: NaN), text as str. Torn lines are skipped;
         a corrupt row is `pdw.InvalidInputError` naming the file and the line.
@@ -155,7 +155,7 @@ def load_sweep(path, *, as_frame: bool | None = None):
     ------
     pdw.InvalidInputError
         No such file, or not a study's CSV (its first column must be ``index``, and the
-        descriptor columns of `pdw.studies.study.COLUMNS` must be there).
+        descriptor columns of ``pdw.studies.study.COLUMNS`` must be there).
     """
     path = pathlib.Path(path)
     try:

@@ -123,7 +123,7 @@ class Branch:
     sorted by decreasing modulus, ``stable`` (all moduli < 1), ``state`` (N, 4 hybrid /
     8 continuous, 10 with LuGre: the `Gait.state` of each point), ``z`` (N, dim) section
     coordinates (dim: 3 hybrid; continuous 6, or more with a contact law that has memory,
-    `pdw.analysis.stepmap.section.section_names`),
+    ``pdw.analysis.stepmap.section.section_names``),
     ``orbit`` (N, n, dim) the n section points of each period-n gait (``orbit[:, 0] == z``),
     ``tangents`` (N, dim + 1), ``step_size`` (N: the arclength step that reached the point;
     0 for the first), ``newton_iterations`` (N).

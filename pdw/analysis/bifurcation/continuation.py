@@ -133,7 +133,7 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
         Continue until the parameter reaches ``stop`` (or the family ends, or ``max_points``).
     model : {"continuous", "hybrid"}
         The compliant-ground walker (`pdw.find_gait`'s map) or the rigid-ground one
-        (`pdw.hybrid`).
+        (``pdw.hybrid``).
     variant : str
         Contact variant of the continuous model.
     period : int
@@ -141,7 +141,7 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
     step : float
         First step, in parameter units (log: in log(parameter)); default 1/50 of the range.
     start : Gait or array_like, optional
-        The first gait (a `Gait`, e.g. from `Branch.switch`, or a section point / state);
+        The first gait (a `Gait`, e.g. from ``Branch.switch``, or a section point / state);
         default: the model's ``find_gait`` at ``params``.
     value : float, optional
         The parameter's value at the start (default: ``getattr(params, parameter)``, or the
@@ -163,7 +163,7 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
     log : bool
         Continue in log(parameter) (for parameters spanning decades, e.g. k_n).
     detect : tuple of str
-        Which built-in test functions to watch (`pdw.analysis.bifurcation.testfunctions.BUILTIN`: "fold",
+        Which built-in test functions to watch (``pdw.analysis.bifurcation.testfunctions.BUILTIN``: "fold",
         "period_doubling", "neimark_sacker", "end", "branch_point").
     max_newton : int
         Newton iterations of the corrector per point (>= 1).
@@ -172,23 +172,23 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
     fd_step : float
         Central-difference step of the continuous model's Jacobian.
     options : dict
-        Step-map options (hybrid: `pdw.hybrid.DEFAULT_OPTIONS`; continuous: rtol, atol,
+        Step-map options (hybrid: ``pdw.hybrid.DEFAULT_OPTIONS``; continuous: rtol, atol,
         event_tol, t_max, dt, contact: with a contact law that has memory (LuGre friction,
         lankarani_nikravesh, flores) the section and z have its extra coordinates,
-        `pdw.analysis.stepmap.section.section_names`).
+        ``pdw.analysis.stepmap.section.section_names``).
     at : sequence of float
         Parameter values at which the branch gets a point of its own (a natural correction
         there, when the branch passes the value), e.g. to compare with a table.
     progress : bool or pdw.Progress
         A bar over the branch's points (up to ``max_points``) on stderr when it is a terminal
-        (`pdw.core.progress`).
+        (``pdw.core.progress``).
     events : sequence of TestFunction
         User test functions, e.g. ``pdw.analysis.bifurcation.testfunctions.Event("step_length", 0.4)``
         (step length = 0.4 m): located like bifurcations and reported with them (kind
         ``"event"``, label UZ).
     monodromy : {"differences", "exact"}
         The continuous model's M: central differences (default), or exact from the variational
-        equations with saltation matrices (`pdw.analysis.stepmap.variational`; default laws, paper
+        equations with saltation matrices (``pdw.analysis.stepmap.variational``; default laws, paper
         variant, period 1; 25-40x the CPU time per point).
     stall_points, stall_length : int, float
         The continuation stops as *stalled* when the last ``stall_points`` steps together
@@ -417,7 +417,7 @@ def _branch(eng, pts, bifs, stop_reason, prob, wall, settings) -> Branch:
 def load_branch(path: str | os.PathLike) -> Branch:
     """Read a branch written by `Branch.save` (also reached through `pdw.load`). The problem is
     rebuilt from the saved base parameters, model, variant, contact and period, so the branch
-    can be extended (`Branch.extend`) and switched (`Branch.switch`); a branch continued with
+    can be extended (`Branch.extend`) and switched (``Branch.switch``); a branch continued with
     ``params_of`` is read without it (extend it with ``params_of=`` again)."""
     try:
         with np.load(path, allow_pickle=False) as f:

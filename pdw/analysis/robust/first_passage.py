@@ -5,7 +5,7 @@ A walker on rough ground is *metastable* (Byl & Tedrake, "Metastable walking mac
 falling at a step is nearly constant, so the number of steps to the fall is close to
 geometric. `first_passage` walks ``walkers`` walkers, each on its own random disturbance from
 its own seed, for at most ``max_steps`` steps, and estimates the MFPT (the expected number of
-steps up to and including the failing one) by `mfpt_estimate`: the constant-hazard maximum-
+steps up to and including the failing one) by ``mfpt_estimate``: the constant-hazard maximum-
 likelihood estimate with censoring (walkers still walking at ``max_steps`` count their steps
 as exposure, not as failures) and an exact Poisson (Garwood) confidence interval.
 
@@ -36,7 +36,7 @@ _STATUSES = frozenset(_hybrid.STATUS) | {"walked", "periodic", "fell", "diverged
 
 @dataclass
 class FirstPassage:
-    """Outcome of `first_passage` (or `mfpt_estimate` alone).
+    """Outcome of `first_passage` (or ``mfpt_estimate`` alone).
 
     Attributes
     ----------
@@ -174,10 +174,10 @@ def first_passage(params=None, *, sigma=None, ground=None, walkers=400, max_step
         Hybrid model: the standard deviation [m] of i.i.d. Gaussian step heights (the ground
         under each landing foot relative to the stance foot's level, drawn anew every step;
         Byl & Tedrake's stochastic terrain). Walker i draws them from ``[seed, i]``
-        (`dh_sequence`).
+        (``dh_sequence``).
     ground : pdw.Ground, optional
         Continuous model: a ``Ground.random(sigma=..., ...)``; walker i walks its own ground,
-        the same but of seed ``seed + i`` (`pdw.analysis.robust.robustness_continuous.chunk`).
+        the same but of seed ``seed + i`` (``pdw.analysis.robust.robustness_continuous.chunk``).
     walkers, max_steps : int
         Walkers, and the steps after which a walker still walking is censored.
     model : {"hybrid", "continuous"}
@@ -192,7 +192,7 @@ def first_passage(params=None, *, sigma=None, ground=None, walkers=400, max_step
         depends on (not ``walkers``: a study extended by more walkers runs only the new ones);
         a file of another study is refused.
     confidence : float
-        Of the interval (`mfpt_estimate`).
+        Of the interval (``mfpt_estimate``).
     gait : Gait, optional
         The start (default: the model's period-one gait).
     progress : pdw.Progress, optional

@@ -6,7 +6,7 @@ stance foot) give the next state y' = P(y, dh) or a failure. `markov_chain` disc
 Byl & Tedrake do ("Metastable walking machines", Sec. 4): a mesh of the states reachable from
 the gait, built outward from the gait's state one generation at a time, and the step-height
 distribution as ``n_dh`` values: the conditional means of equal-width bins, weighted by the
-bins' probabilities (`dh_nodes`). The mesh is a grid of cells of side ``resolution`` in the scaled coordinates
+bins' probabilities (``dh_nodes``). The mesh is a grid of cells of side ``resolution`` in the scaled coordinates
 u = (theta_st, theta_sw, thetad_st / w, thetad_sw / w), w = sqrt(g / l); each cell is
 represented by the first reachable state that fell in it, and a transition goes to the cell of
 the next state. A failing step goes to the absorbing state. With Q the transient block of the
@@ -137,7 +137,7 @@ def markov_chain(params=None, *, sigma, n_dh=41, resolution=0.01, max_cells=2000
     sigma : float
         Standard deviation of the step heights [m] (> 0).
     n_dh : int
-        Step heights of the discretized distribution (`dh_nodes`).
+        Step heights of the discretized distribution (``dh_nodes``).
     resolution : float
         Side of the mesh's cells in the scaled state u (module docstring).
     max_cells : int

@@ -11,11 +11,11 @@ The hybrid model (`pdw.hybrid`, docs/hybrid.md) meets a floor-height disturbance
 step map's floor offset ``dh`` (the ground under the swing foot relative to the stance foot's
 level): a step down of height H is ``dh = -H`` at one step and 0 after it, since the walker's
 dynamics depend only on the relative levels. Its step map has an exact Jacobian
-(`pdw.hybrid.step_jacobian`) and exact sensitivities to ``dh`` (`pdw.core._hybrid.step_sens`),
+(`pdw.hybrid.step_jacobian`) and exact sensitivities to ``dh`` (``pdw.core._hybrid.step_sens``),
 which `gait_sensitivity` uses.
 
 The continuous (compliant) model needs a `pdw.Ground` with the step (terrain's branch) and is
-run by `pdw.simulate_batch` (see `_continuous`).
+run by `pdw.simulate_batch` (see ``_continuous``).
 """
 from __future__ import annotations
 
@@ -158,7 +158,7 @@ def max_step(params=None, *, direction="down", model="hybrid", h_max=None, h_tol
     to the mean slope, and stays at that level. A height *succeeds* when the walker then walks
     ``budget`` more steps without failing and *returns*: from some step on its step length and
     step time stay within ``return_tol`` (relative) of the gait's to the end, at least 5 steps
-    (`returned`). The search is a multisection: each round tries ``trials_per_round`` heights
+    (``returned``). The search is a multisection: each round tries ``trials_per_round`` heights
     evenly inside the bracket (one batch of walkers), the bracket becomes (the largest height
     with every smaller one tried a success, the first failure), until it is shorter than
     ``h_tol`` [m] or after ``max_rounds``.
@@ -183,13 +183,13 @@ def max_step(params=None, *, direction="down", model="hybrid", h_max=None, h_tol
     return_tol : float
         Relative tolerance of step length and step time for "returned".
     gait : Gait, optional
-        The undisturbed gait (default: `pdw.hybrid.find_gait(params)`).
+        The undisturbed gait (default: ``pdw.hybrid.find_gait(params)``).
     threads : int
         Threads sharing each round's walkers (hybrid).
     executor, ground
-        Continuous model only (see `_continuous`).
+        Continuous model only (see ``_continuous``).
     options
-        Hybrid step-map options (`pdw.hybrid.DEFAULT_OPTIONS`, without ``dh``).
+        Hybrid step-map options (``pdw.hybrid.DEFAULT_OPTIONS``, without ``dh``).
 
     Returns
     -------
@@ -327,17 +327,17 @@ def gait_sensitivity(params=None, *, indicators=("step_time",), model="hybrid", 
     The disturbance e is a floor-height change [m] at one step (the ground under the landing
     foot is e higher, and stays so); the gait indicators g_i(k) are measured at that step
     (k = 0) and every later one. The norm is sqrt(sum_i sum_k (dg_i(k)/de)^2), from the
-    linearized step map x(k+1) = A x(k) + B e(k), g(k) = C x(k) + D e(k) (`h2_norm`).
+    linearized step map x(k+1) = A x(k) + B e(k), g(k) = C x(k) + D e(k) (``h2_norm``).
 
     Parameters
     ----------
     params : Params
         Default `Params.paper_steady()`.
     indicators : sequence of str
-        From `INDICATORS`; Hobbelen & Wisse's usual choice is step time alone.
+        From ``INDICATORS``; Hobbelen & Wisse's usual choice is step time alone.
     model : {"hybrid", "continuous"}
         ``"hybrid"``: A, B, C, D exact (variational equations of the stance, the saltation of
-        the heel strike, the impact map's derivative: `pdw.core._hybrid.step_sens`), checked
+        the heel strike, the impact map's derivative: ``pdw.core._hybrid.step_sens``), checked
         against central differences. ``"continuous"``: see docs/robustness.md (needs a Ground).
     gait : Gait, optional
     fd_step : float

@@ -24,7 +24,7 @@ so the mechanical section is 6-dimensional, with coordinates (`SECTION`)
          trailing leg's rate, leading (swing) leg's rate)        [rad, rad, m/s, m/s, rad/s, rad/s]
 
 A contact law with memory adds the trailing foot's share of it (`section_names(contact)`,
-`pdw.analysis.stepmap.section`): with LuGre friction its bristle deflection ``z1_um`` [um] (the leading
+``pdw.analysis.stepmap.section``): with LuGre friction its bristle deflection ``z1_um`` [um] (the leading
 foot's is 0: reset at its touch-down), with the lankarani_nikravesh and flores normal laws its
 approach speed ``v_in1`` [m/s] captured at its own touch-down (the leading foot's is -v_y of the
 section state). The map then is the continuous run's, on and off a fixed point, for period-n
@@ -78,7 +78,7 @@ section's constraint); multipliers far below the Jacobian's noise
 (~1e-4 in modulus) are not resolved. ``details["multipliers_check"]`` repeats them with
 10 x ``fd_step``.
 
-Starting guesses (`default_guesses`): the paper's initial condition and its disturbed start
+Starting guesses (``default_guesses``): the paper's initial condition and its disturbed start
 (Fig. 9), and the hybrid model's gait (pre-impact state, `pdw.hybrid`), each first walked for
 ``settle_time`` seconds in one simulation (a stable gait attracts them); Newton starts from the
 last touch-down of that walk.
@@ -135,7 +135,7 @@ from .step_maps import (  # noqa: F401  (many maps at once, re-exported)
 def jacobian(z, params=None, variant="paper", method="rodas4", *, fd_step=1e-5, period=1,
              workers=None, **options):
     """(J, P^n(z), steps at z): central-difference Jacobian of P^n at z (n = len(z) square,
-    `section_names`), step ``fd_step`` (absolute, every coordinate in its unit of `UNITS`); the
+    ``section_names``), step ``fd_step`` (absolute, every coordinate in its unit of ``UNITS``); the
     2 n + 1 evaluations run in ``workers`` threads, the 2 n perturbed ones through the ensemble
     engine where it takes them (`compose_points`: the same numbers). J is NaN where a perturbed
     step failed."""
@@ -210,15 +210,15 @@ def find_gait(params: Params | None = None, variant: str = "paper",
         Contact reading (docs/model.md section 6).
     guess : array_like, or a `Gait` (hybrid or continuous), optional
         A section point (``len(section_names(contact))`` entries, or the 6 mechanical ones: the
-        law's extras then get `extend`'s defaults), a full state at a touch-down (8 entries, or
-        LuGre's 10), or a gait. Default: `default_guesses` in turn. A guess is used as it is
+        law's extras then get ``extend``'s defaults), a full state at a touch-down (8 entries, or
+        LuGre's 10), or a gait. Default: ``default_guesses`` in turn. A guess is used as it is
         (no settling walk).
     method : str
         Integrator of the step map; ``rodas4`` (default) locates the touch-down to ``event_tol``.
     period : int
         Solve P^period(z) = z (2 for a period-two gait, ...).
     tol : float
-        Newton converges when max|P^n(z) - z| < tol (every coordinate in its unit of `UNITS`:
+        Newton converges when max|P^n(z) - z| < tol (every coordinate in its unit of ``UNITS``:
         rad, m/s, rad/s, um for the bristle).
     max_iter : int
         Newton iterations per guess.
@@ -229,9 +229,9 @@ def find_gait(params: Params | None = None, variant: str = "paper",
     workers : int
         Threads for the Jacobian's 2 len(z) + 1 map evaluations (default: all cores).
     options
-        Step-map options: rtol, atol, event_tol (default `TIGHT`), t_max, dt, and
+        Step-map options: rtol, atol, event_tol (default ``TIGHT``), t_max, dt, and
         ``contact`` (`pdw.Contact`: the normal and friction laws). The section follows the law
-        (`section_names`, `pdw.analysis.stepmap.section`): with LuGre friction it carries the trailing
+        (``section_names``, ``pdw.analysis.stepmap.section``): with LuGre friction it carries the trailing
         foot's bristle ``z1_um`` [um], with lankarani_nikravesh or flores the trailing foot's
         approach speed ``v_in1`` [m/s], so the map is the continuous run's for every law.
 
