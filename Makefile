@@ -48,7 +48,7 @@ test-quick: $(STAMP)
 	$(PY) -m pytest -q -m "quick and not slow"
 
 ## lint: ruff (rules in pyproject.toml), the import contract (layers, no cycles: docs/architecture.md)
-## and mypy on the public modules ([tool.mypy] in pyproject.toml)
+## and mypy on every module of pdw ([tool.mypy] in pyproject.toml)
 lint: $(STAMP)
 	$(VENV)/bin/ruff check pdw tests benchmarks derive
 	$(VENV)/bin/lint-imports --no-cache

@@ -57,7 +57,8 @@ def _bootstrap(filename: str) -> bool:
 def _caller_stacklevel() -> int:
     """The stacklevel of the first frame outside the import machinery and this mechanism, so
     that the warning points at the line that imported the old path."""
-    frame, level = sys._getframe(1), 1
+    frame: types.FrameType | None = sys._getframe(1)
+    level = 1
     while frame is not None and _ours(frame.f_code.co_filename):
         frame = frame.f_back
         # `warnings.warn` does not count the frames of importlib._bootstrap (it skips them)
@@ -84,7 +85,8 @@ class AliasFinder(importlib.abc.MetaPathFinder, importlib.abc.Loader):
 
     def exec_module(self, module: types.ModuleType) -> None:
         # the module ran under its new name already; give it back its own spec
-        module.__spec__ = module.__spec__.loader_state
+        if module.__spec__ is not None:
+            module.__spec__ = module.__spec__.loader_state
 
 
 def install() -> None:

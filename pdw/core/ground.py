@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
@@ -476,10 +477,11 @@ class Ground:
                 g = g + cls.from_dict(p)
             return g.with_patches(common.get("patches", ()), blend=common.get("blend")) \
                 if common.get("patches") else g
-        makers = {"flat": (cls.flat, ()), "steps": (cls.steps, ("edges", "heights")),
-                  "profile": (cls.profile, ("s", "h")), "plane": (cls.plane, ("slope",)),
-                  "sine": (cls.sine, ("amplitude", "wavelength")),
-                  "random": (cls.random, ("sigma",))}
+        makers: dict[str, tuple[Callable[..., Ground], tuple[str, ...]]] = {
+            "flat": (cls.flat, ()), "steps": (cls.steps, ("edges", "heights")),
+            "profile": (cls.profile, ("s", "h")), "plane": (cls.plane, ("slope",)),
+            "sine": (cls.sine, ("amplitude", "wavelength")),
+            "random": (cls.random, ("sigma",))}
         optional = {"flat": (), "steps": ("width",), "profile": ("order",), "plane": (),
                     "sine": ("phase",), "random": ("correlation", "seed", "modes")}
         if kind not in makers:

@@ -72,7 +72,7 @@ def describe(path: pathlib.Path) -> str:
     """An example file's description: the first sentence of its leading comment (the comment
     lines before the first key, joined; a sentence ends at ". " before a capital letter or at
     the end of the comment), whole: never cut inside a parenthesis."""
-    words = []
+    words: list[str] = []
     for line in path.read_text().splitlines():
         if not line.startswith("#"):
             if words or line.strip():

@@ -133,8 +133,8 @@ def check_spec(spec: dict, where: str = "spec") -> dict:
     spec["couple"] = couple = _table(where, spec, "couple")
     _unknown(where, couple, set(Params.__dataclass_fields__) - {par},
              "[couple] (fields other than the parameter %r) " % par)
-    for k, e in couple.items():
-        couple[k] = checks.number("%s: [couple] %s" % (where, k), e, lo=-100.0, hi=100.0)
+    for k, expo in couple.items():
+        couple[k] = checks.number("%s: [couple] %s" % (where, k), expo, lo=-100.0, hi=100.0)
     if couple:
         if not (start != 0 and stop / start > 0):
             raise InvalidInputError("%s: [couple] scales fields by (value / start)^exponent: "
@@ -144,8 +144,8 @@ def check_spec(spec: dict, where: str = "spec") -> dict:
             try:
                 params.replace(**{par: v}, **{f: getattr(params.replace(**{par: start}), f)
                                               * (v / start) ** e for f, e in couple.items()})
-            except (ValueError, OverflowError) as e:
-                raise InvalidInputError("%s: [couple] at %s = %r: %s" % (where, par, v, e)) \
+            except (ValueError, OverflowError) as err:
+                raise InvalidInputError("%s: [couple] at %s = %r: %s" % (where, par, v, err)) \
                     from None
     # [continuation]
     spec["continuation"] = cont = _table(where, spec, "continuation")
@@ -154,9 +154,9 @@ def check_spec(spec: dict, where: str = "spec") -> dict:
     for k, (lo, hi) in COUNTS.items():
         if k in cont:
             cont[k] = checks.count(w + k, cont[k], lo=lo, hi=hi)
-    for k, hi in POSITIVE.items():
+    for k, top in POSITIVE.items():
         if k in cont:
-            cont[k] = checks.number(w + k, cont[k], lo=0.0, lo_open=True, hi=hi)
+            cont[k] = checks.number(w + k, cont[k], lo=0.0, lo_open=True, hi=top)
     if cont.get("step_min", 0.0) > cont.get("step_max", math.inf):
         raise InvalidInputError("%sstep_min (%r) must be <= step_max (%r)"
                                 % (w, cont["step_min"], cont["step_max"]))

@@ -188,6 +188,6 @@ def record_subset(b, record, record_every, x0, params, flags0, options) -> dict:
     kw["limits"] = (kw.get("limits") or Limits()).replace(on_failure="return")
     kw["record"] = Record(every=every)
     grounds = options.get("ground")         # None, or each walker's Ground (simulate_batch)
-    return {i: simulate(x0[i], params=plist[i], flags0=tuple(int(v) for v in f0[i]),
+    return {i: simulate(x0[i], params=plist[i], flags0=(int(f0[i][0]), int(f0[i][1])),
                         **(kw if grounds is None else dict(kw, ground=grounds[i])))
             for i in idx}

@@ -108,7 +108,7 @@ def step_matrix(method: str, J, h: float) -> np.ndarray:
     if method in ("rk4", "dopri5"):
         A, b = _rk(method)
         eye = np.eye(NX)
-        K = []
+        K: list[np.ndarray] = []
         for i in range(len(b)):
             X = eye + h * sum(A[i, j] * K[j] for j in range(i)) if i else eye
             K.append(J @ X)
@@ -203,7 +203,7 @@ def sensitivity(params: Params, method: str, variant: str = "paper", factor: flo
 
 def limiting_force(sens: dict) -> str:
     """The parameter with the most negative exponent in a `sensitivity` dict."""
-    return min(sens, key=sens.get)
+    return min(sens, key=lambda k: sens[k])
 
 
 # --------------------------------------------------------------------------------------------

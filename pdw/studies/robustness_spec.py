@@ -33,6 +33,7 @@ import os
 import platform
 import sys
 import time
+from typing import Any, Callable
 
 import numpy as np
 
@@ -44,7 +45,7 @@ from ..core.errors import InvalidInputError, PdwError
 from ..core.params import Params
 from ..core.provenance import source_revision
 
-MEASURES = {"max_step": _rb.max_step, "gait_sensitivity": _rb.gait_sensitivity,
+MEASURES: dict[str, Callable[..., Any]] = {"max_step": _rb.max_step, "gait_sensitivity": _rb.gait_sensitivity,
             "first_passage": _fp.first_passage, "markov_chain": _mk.markov_chain}
 PRESETS = ("paper", "paper_steady")
 _TOP = ("name", "title", "measure", "model", "preset", "params", "options", "sweep", "ground")

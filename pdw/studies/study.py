@@ -75,7 +75,7 @@ class Study:
         return self.scene.variant
 
     @property
-    def method(self) -> str:
+    def method(self) -> str | None:
         return self.scene.integrator.method
 
     @property
@@ -177,7 +177,7 @@ def parse_study(text, name="study", path="") -> Study:
     axes_in = data.get("axes", [])
     if not 1 <= len(axes_in) <= 2:
         raise InvalidInputError("%s: need one or two [[axes]], got %d" % (where, len(axes_in)))
-    axes = []
+    axes: list[tuple[str, np.ndarray]] = []
     for i, ax in enumerate(axes_in):
         w = "%s [[axes]] #%d" % (where, i + 1)
         if not isinstance(ax, dict):

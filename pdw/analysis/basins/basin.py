@@ -240,7 +240,8 @@ def plot(b: Basin, ax=None, title=None):
     from matplotlib.colors import ListedColormap
     if ax is None:
         _, ax = plt.subplots(figsize=(6, 4.5))
-    cmap_ = ListedColormap(["#d9d9d9", "#2b8cbe", "#fdae61", "#ffffbf"])
+    colors = ["#d9d9d9", "#2b8cbe", "#fdae61", "#ffffbf"]
+    cmap_ = ListedColormap(colors)
     dphi = (b.phi[1] - b.phi[0]) / 2 if len(b.phi) > 1 else 0.5e-3
     dth = (b.thetad2[1] - b.thetad2[0]) / 2 if len(b.thetad2) > 1 else 0.5e-2
     ax.imshow(b.outcome, origin="lower", aspect="auto", cmap=cmap_, vmin=-0.5, vmax=3.5,
@@ -250,7 +251,7 @@ def plot(b: Basin, ax=None, title=None):
     ax.set_xlabel(r"$\phi = \theta_2 - \theta_1$ at touch-down [rad]")
     ax.set_ylabel(r"$\dot\theta_2$ at touch-down [rad/s]")
     from matplotlib.patches import Patch
-    ax.legend(handles=[Patch(color=c, label=n) for c, n in zip(cmap_.colors, OUTCOMES)],
+    ax.legend(handles=[Patch(color=c, label=n) for c, n in zip(colors, OUTCOMES)],
               loc="upper right", fontsize=8)
     ax.set_title(title or "basin (%d x %d, %.0f%% gait)" % (len(b.phi), len(b.thetad2),
                                                             100 * b.fraction()))

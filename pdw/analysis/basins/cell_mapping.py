@@ -167,7 +167,7 @@ class CellMap:
     group: np.ndarray
     steps: np.ndarray
     periodic: list
-    params: Params = None
+    params: Params | None = None
     variant: str = "paper"
     info: dict = field(default_factory=dict)
 

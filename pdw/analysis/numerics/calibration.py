@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
@@ -144,7 +145,7 @@ class Landing:
     n: int
 
 
-def typical_landing(params: Params | None = None, variant: str = "paper", t_end: float = 6.0,
+def typical_landing(params: Params | None = None, variant: Literal["paper", "consistent"] = "paper", t_end: float = 6.0,
                     skip: int = 3) -> Landing:
     """Measure the touch-downs of the default (Hunt-Crossley) walker from the paper's start:
     a cdm run at dt = 1e-4 s, the state one step before each touch-down after the first
@@ -202,7 +203,7 @@ def _bisect(fun, lo, hi, target, log=False, n=40):
     return math.sqrt(lo * hi) if log else 0.5 * (lo + hi)
 
 
-def calibrate(params: Params | None = None, variant: str = "paper",
+def calibrate(params: Params | None = None, variant: Literal["paper", "consistent"] = "paper",
               landing: Landing | None = None) -> Calibration:
     """Parameters of every normal law matched to ``params``' Hunt-Crossley ground.
 

@@ -386,7 +386,7 @@ def energy_balance(result, quadrature: str = "simpson") -> dict:
         raise InvalidInputError("energy_balance needs a recorded run (record_every=1)")
     an = _anchors(result) if result.variant == "consistent" else np.zeros((len(t), 2))
     en = energies(x, P_)
-    E = en["E"]
+    E = np.asarray(en["E"])                   # (N,): x holds N states
     h = np.diff(t)
     p0 = power(x[:-1], fl[:-1], an[:-1], P_, result.variant)
     p1 = power(x[1:], fl[:-1], an[:-1], P_, result.variant)      # same discrete state
@@ -404,7 +404,8 @@ def energy_balance(result, quadrature: str = "simpson") -> dict:
         dW = h / 6.0 * (p0 + 4.0 * pm + p1)
     W = np.concatenate([[0.0], np.cumsum(dW)])
     res = E - E[0] - W
-    Wg = -(en["V_gravity"] - en["V_gravity"][0])
+    Vg = np.asarray(en["V_gravity"])
+    Wg = -(Vg - Vg[0])
     td = [e.t for e in result.events if e.kind == "touch_down"]
     idx = [min(int(np.searchsorted(t, tt)), len(t) - 1) for tt in td]
     step_res = np.array([res[b] - res[a] for a, b in zip(idx[:-1], idx[1:])])

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...core import _hybrid, checks, interrupt
+from ...core import _hybrid, checks, interrupt  # type: ignore[attr-defined]  # compiled, no stub
 from ...core.errors import InvalidInputError
 from . import robustness as _rb
 

@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from ...core import _hybrid, checks, interrupt
+from ...core import _hybrid, checks, interrupt  # type: ignore[attr-defined]  # compiled, no stub
 from ...core.errors import InvalidInputError
 from ...core.model import parameter_vector
 from ...core.params import Params
