@@ -15,7 +15,8 @@ T_END = 1.0
 
 @pytest.fixture(scope="module")
 def rodas4_events():
-    r = pdw.simulate(method="rodas4", t_end=T_END, rtol=1e-10, atol=1e-12, record_every=0)
+    r = pdw.simulate(method="rodas4", t_end=T_END,
+                     integrator=pdw.Integrator(rtol=1e-10, atol=1e-12), record=pdw.Record(every=0))
     assert r.walked
     return r
 

@@ -15,7 +15,7 @@ x0 = np.array(pdw.X0_PAPER)
 f = pdw.ode_function(flags=(0, 1))
 sol = solve_ivp(f, (0.0, 0.2), x0, method="Radau", jac=f.jac, rtol=1e-9, atol=1e-11,
                 dense_output=True)
-ours = pdw.simulate(t_end=0.2, method="rodas4", rtol=1e-9, atol=1e-11)
+ours = pdw.simulate(t_end=0.2, integrator=pdw.Integrator(method="rodas4", rtol=1e-9, atol=1e-11))
 err = np.abs(sol.sol(ours.t).T - ours.x).max(axis=1)
 print("largest difference over the stretch: %.2e" % err.max())
 

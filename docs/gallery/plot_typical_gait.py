@@ -11,7 +11,8 @@ import numpy as np
 import pdw
 
 t = np.linspace(0.0, 3.5, 701)
-res = pdw.simulate(method="rodas4", rtol=1e-7, atol=1e-9, t_eval=t)
+res = pdw.simulate(integrator=pdw.Integrator(method="rodas4", rtol=1e-7, atol=1e-9),
+                   record=pdw.Record(t_eval=t))
 print(res.summary())
 print(res.gait.to_text())
 

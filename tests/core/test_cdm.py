@@ -84,7 +84,8 @@ def test_first_steps_follow_eqs_13_to_17(variant, x0):
     p = pdw.Params.paper()
     x0 = np.asarray(x0, float)
     anchors = (0.0, float(pdw.contact_forces(x0, p, variant=variant).s[1]))
-    r = pdw.simulate(x0, t_end=2 * DT, dt=DT, variant=variant, record_every=1, check_step="off")
+    r = pdw.simulate(x0, t_end=2 * DT, dt=DT, variant=variant,
+                     integrator=pdw.Integrator(check_step="off"), record=pdw.Record(every=1))
     flags = tuple(int(f) for f in r.flags[0])
     assert tuple(r.flags[1]) == tuple(r.flags[2]) == flags
     u_m1 = _start(x0, p, flags, anchors, variant)
@@ -102,7 +103,8 @@ def test_steps_of_a_walk_follow_eqs_14_to_17():
     forces do not depend on the anchors): U_n+1 and U'_n+1 from the recorded U_n-1, U_n, U'_n
     and the recorded flags of step n."""
     p = pdw.Params.paper()
-    r = pdw.simulate(t_end=3.0, dt=DT, record_every=1, check_step="off")
+    r = pdw.simulate(t_end=3.0, dt=DT, integrator=pdw.Integrator(check_step="off"),
+                     record=pdw.Record(every=1))
     assert r.status == "walked" and len(r.events) >= 8
     flags_seen = set()
     for n in range(1, len(r.t) - 1, 250):
@@ -116,7 +118,8 @@ def test_steps_of_a_walk_follow_eqs_14_to_17():
 def test_velocity_is_eq_17_as_printed():
     """Eq. 17 as printed: the centred difference of the positions two steps apart, not the
     backward difference of the last step (the two differ by ~dt/2 |U''|)."""
-    r = pdw.simulate(t_end=0.05, dt=DT, record_every=1, check_step="off")
+    r = pdw.simulate(t_end=0.05, dt=DT, integrator=pdw.Integrator(check_step="off"),
+                     record=pdw.Record(every=1))
     U = r.x[:, :4]
     centred = (U[2:] - U[:-2]) / (2 * DT)
     np.testing.assert_allclose(r.x[2:, 4:], centred, rtol=0, atol=1e-8)

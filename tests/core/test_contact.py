@@ -94,11 +94,12 @@ def test_a_stiff_kelvin_voigt_ground_gets_the_step_size_warning():
         r = pdw.simulate(t_end=0.01, contact=c, on_failure="return", record_every=0)
     assert r.status == "diverged"
     with pytest.raises(pdw.StepSizeError):
-        pdw.simulate(t_end=0.01, contact=c, check_step="error")
+        pdw.simulate(t_end=0.01, contact=c, integrator=pdw.Integrator(check_step="error"))
     from pdw.sim.stepsize import step_limit
     lim = step_limit(pdw.Params.paper(), "cdm", contact=c)
     assert lim.dt_max < 5e-6
-    ok = pdw.simulate(t_end=0.01, dt=lim.dt_max, contact=c, record_every=0, check_step="off")
+    ok = pdw.simulate(t_end=0.01, dt=lim.dt_max, contact=c,
+                      integrator=pdw.Integrator(check_step="off"), record=pdw.Record(every=0))
     assert ok.status == "walked"
 
 

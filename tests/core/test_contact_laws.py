@@ -145,7 +145,7 @@ def test_scene_contact_table_runs_as_simulate():
     assert pdw.Scene.from_toml(scene.to_toml()) == scene
     a = scene.run()
     b = pdw.simulate(params=pdw.Params.paper_steady(), t_end=0.5, method="rodas4",
-                     record_every=0, contact=dict(normal="flores", e=0.3))
+                     contact=dict(normal="flores", e=0.3), record=pdw.Record(every=0))
     assert np.array_equal(a.x_final, b.x_final)
     with pytest.raises(pdw.InvalidInputError, match="contact"):
         pdw.Scene.from_toml('[contact]\nnormal = "flores"\n')        # e is required

@@ -76,8 +76,9 @@ def test_first_step_is_accepted_by_the_rms_norm(rtol, atol):
         h = _h_for(target, x, rtol, atol)
         xn, e = _dp5(x, h)
         assert _norm(x, xn, e, rtol, atol) == pytest.approx(target, rel=1e-3)
-        r = pdw.simulate(x, t_end=h, dt=h, method="dopri5", flags0=FLAGS, rtol=rtol, atol=atol,
-                         record_every=1, check_step="off")
+        r = pdw.simulate(x, t_end=h, dt=h, method="dopri5", flags0=FLAGS,
+                         integrator=pdw.Integrator(rtol=rtol, atol=atol, check_step="off"),
+                         record=pdw.Record(every=1))
         assert (r.stats["rejected"] > 0) == bool(rejected), (target, r.stats)
         if not rejected:
             assert r.stats["steps"] == 1
@@ -85,15 +86,17 @@ def test_first_step_is_accepted_by_the_rms_norm(rtol, atol):
 
 
 def _fixed(method, h, t_end):
-    return pdw.simulate(_x0(), t_end=t_end, dt=h, h_max=h, method=method, flags0=FLAGS,
-                        rtol=1e3, atol=1e3, record_every=0, check_step="off").x_final
+    return pdw.simulate(_x0(), t_end=t_end, dt=h, method=method, flags0=FLAGS,
+                        integrator=pdw.Integrator(h_max=h, rtol=1e3, atol=1e3, check_step="off"),
+                        record=pdw.Record(every=0)).x_final
 
 
 @pytest.mark.parametrize("method, order, h", [("rodas4", 4, 4e-3), ("dopri5", 5, 1e-2)])
 def test_fixed_step_order(method, order, h):
     t_end = 0.048
-    ref = pdw.simulate(_x0(), t_end=t_end, method="dopri5", flags0=FLAGS, rtol=1e-13,
-                       atol=1e-15, record_every=0, check_step="off").x_final
+    ref = pdw.simulate(_x0(), t_end=t_end, method="dopri5", flags0=FLAGS,
+                       integrator=pdw.Integrator(rtol=1e-13, atol=1e-15, check_step="off"),
+                       record=pdw.Record(every=0)).x_final
     e1 = np.max(np.abs(_fixed(method, h, t_end) - ref))
     e2 = np.max(np.abs(_fixed(method, h / 2, t_end) - ref))
     assert e2 > 1e-13, "the error must be above rounding for the order to show"

@@ -161,7 +161,7 @@ def test_rodas4_sticks_without_chatter_at_large_steps():
     foot sticks, its slip speed stays below v_s = 1e-4 m/s with RODAS4 at steps of milliseconds
     (the friction eigenvalue is near -1e6 /s). cdm at the paper's dt = 1e-4 chatters."""
     v_s = pdw.Params.paper().v_s
-    r = simulate(t_end=0.33, method="rodas4", rtol=1e-5, atol=1e-7)
+    r = simulate(t_end=0.33, method="rodas4", integrator=pdw.Integrator(rtol=1e-5, atol=1e-7))
     assert not r.events
     h = np.diff(r.t)
     assert np.median(h) > 1e-3 and r.stats["steps"] < 0.33 / 1e-4 / 10
@@ -180,8 +180,9 @@ def test_rodas4_sticks_without_chatter_at_large_steps():
 @pytest.fixture(scope="module")
 def early_events():
     """Events up to 0.4 s (first touch-down of leg 1, lift-off of leg 2), very accurate."""
-    r = simulate(t_end=0.4, method="rodas4", rtol=1e-12, atol=1e-14, event_tol=1e-13,
-                 record_every=0)
+    r = simulate(t_end=0.4, method="rodas4",
+                 integrator=pdw.Integrator(rtol=1e-12, atol=1e-14, event_tol=1e-13),
+                 record=pdw.Record(every=0))
     assert [(e.leg, e.kind) for e in r.events] == [(1, "touch_down"), (2, "lift_off")]
     return r.events
 
@@ -191,8 +192,9 @@ def early_events():
 def test_events_located_to_event_tol(name, rtol, event_tol, early_events):
     """A located switch ends its step at most event_tol after the crossing (the step is cut at
     the right end of the bisection bracket, where the switch condition holds)."""
-    r = simulate(t_end=0.4, method=name, rtol=rtol, atol=rtol * 1e-2, event_tol=event_tol,
-                 record_every=0)
+    r = simulate(t_end=0.4, method=name,
+                 integrator=pdw.Integrator(rtol=rtol, atol=rtol * 1e-2, event_tol=event_tol),
+                 record=pdw.Record(every=0))
     ev, ref = r.events, early_events
     assert [(e.leg, e.kind) for e in ev] == [(e.leg, e.kind) for e in ref]
     slack = 2e-9                                          # integration error at this rtol
@@ -219,7 +221,9 @@ GAIT_RUNS = [
 
 @pytest.fixture(scope="module")
 def gait_reference():
-    return simulate(method="rodas4", rtol=1e-11, atol=1e-13, event_tol=1e-12, record_every=0)
+    return simulate(method="rodas4",
+                    integrator=pdw.Integrator(rtol=1e-11, atol=1e-13, event_tol=1e-12),
+                    record=pdw.Record(every=0))
 
 
 @pytest.mark.parametrize("name,kw,bound", GAIT_RUNS)
@@ -235,13 +239,15 @@ def test_methods_agree_on_typical_gait(name, kw, bound, gait_reference):
 # ------------------------------------------------------------------ bookkeeping
 
 def test_adaptive_records_every_step_and_grows_buffer():
-    r = simulate(method="rodas4", rtol=1e-9, atol=1e-11, record_every=1)
+    r = simulate(method="rodas4", integrator=pdw.Integrator(rtol=1e-9, atol=1e-11),
+                 record=pdw.Record(every=1))
     n = r.stats["steps"]
     assert n > 4096                                # beyond the first record buffer
     assert len(r.t) == n + 1 and r.t[0] == 0.0 and r.t[-1] == 3.5
     assert (np.diff(r.t) > 0).all()
     assert np.array_equal(r.x[-1], r.x_final)
-    r3 = simulate(method="rodas4", rtol=1e-9, atol=1e-11, record_every=3)
+    r3 = simulate(method="rodas4", integrator=pdw.Integrator(rtol=1e-9, atol=1e-11),
+                  record=pdw.Record(every=3))
     assert len(r3.t) == n // 3 + 1 + (n % 3 != 0)
     assert np.array_equal(r3.t[:-1], r.t[:n + 1:3][:len(r3.t) - 1])
     assert r3.Fn.shape == (len(r3.t), 2)
@@ -265,7 +271,7 @@ def test_resumption_after_full_event_buffer_is_exact(name):
 
 @pytest.mark.parametrize("name", list(INTEGRATORS))
 def test_work_counters(name):
-    r = simulate(t_end=0.05, method=name, dt=1e-5, record_every=0)
+    r = simulate(t_end=0.05, method=name, dt=1e-5, record=pdw.Record(every=0))
     st = r.stats
     info = INTEGRATORS[name]
     assert st["rhs"] >= info.rhs_per_step * st["steps"]

@@ -99,7 +99,7 @@ def test_a_cancelled_pool_stops_its_workers_compiled_loops():
         try:
             if what == "simulate":
                 pdw.simulate(method="rodas4", params=pdw.Params(v_s=1e-12), t_end=1.0,
-                             max_steps=10**9)
+                             integrator=pdw.Integrator(max_steps=10**9))
             elif what == "batch":
                 pdw.simulate_batch(np.tile(pdw.X0_PAPER, (N, 1)), t_end=3.5, threads=1)
             else:

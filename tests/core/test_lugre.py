@@ -199,8 +199,9 @@ def test_exports_carry_the_bristle_columns(tmp_path):
 def test_x0_mechanical_or_full():
     c = calibrate_lugre().contact
     x8 = np.array(pdw.simulate(t_end=1e-3).x[0])
-    a = pdw.simulate(x8, t_end=0.05, contact=c, check_step="off")
-    b = pdw.simulate(np.concatenate([x8, [0.0, 0.0]]), t_end=0.05, contact=c, check_step="off")
+    a = pdw.simulate(x8, t_end=0.05, contact=c, integrator=pdw.Integrator(check_step="off"))
+    b = pdw.simulate(np.concatenate([x8, [0.0, 0.0]]), t_end=0.05, contact=c,
+                     integrator=pdw.Integrator(check_step="off"))
     np.testing.assert_array_equal(a.x, b.x)
     with pytest.raises(pdw.InvalidInputError, match="x0"):
         pdw.simulate(np.concatenate([x8, [0.0, 0.0]]), t_end=0.05)
@@ -225,7 +226,7 @@ def test_a_frictionless_preset_needs_lugre_coefficients():
     with pytest.raises(pdw.InvalidInputError, match=r"contact.mu_s .*Params.mu_s"):
         pdw.simulate(params=P, t_end=0.01, contact=dict(friction="lugre"))
     r = pdw.simulate(params=P, t_end=0.01, contact=dict(friction="lugre", mu_s=0.5, mu_c=0.4),
-                     check_step="off")
+                     integrator=pdw.Integrator(check_step="off"))
     assert np.isfinite(r.x).all()
 
 
@@ -246,8 +247,10 @@ def test_simulate_many_runs_lugre_on_the_scalar_path():
     from pdw.sim.ensemble import simulate_many
     c = calibrate_lugre().contact
     x0 = np.tile(np.array(pdw.X0_PAPER), (2, 1))
-    out = simulate_many(x0, t_end=0.05, dt=2e-5, contact=c, check_step="off")
-    one = pdw.simulate(x0[0], t_end=0.05, dt=2e-5, contact=c, record_every=0, check_step="off")
+    out = simulate_many(x0, t_end=0.05, dt=2e-5, contact=c,
+                        integrator=pdw.Integrator(check_step="off"))
+    one = pdw.simulate(x0[0], t_end=0.05, dt=2e-5, contact=c,
+                       integrator=pdw.Integrator(check_step="off"), record=pdw.Record(every=0))
     assert out.x_final.shape == (2, len(_layout.STATE_LAYOUTS["lugre"]))
     np.testing.assert_array_equal(out.x_final[0], one.x_final)
 

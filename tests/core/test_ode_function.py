@@ -111,7 +111,8 @@ def test_solve_ivp_reproduces_simulate_rodas4_between_flag_changes():
     """A stretch of the typical gait without a flag change (leg 2 in stance, stuck): Radau
     with the model object and its Jacobian against pdw's own rodas4, both at tight
     tolerances."""
-    ref = pdw.simulate(X0, t_end=0.3, method="rodas4", rtol=1e-10, atol=1e-12, dt=1e-6)
+    ref = pdw.simulate(X0, t_end=0.3, method="rodas4", dt=1e-6,
+                       integrator=pdw.Integrator(rtol=1e-10, atol=1e-12))
     t_first = min((e.t for e in ref.events), default=np.inf)
     T = 0.2
     assert T < t_first, "the stretch must hold no flag change (first event at %g s)" % t_first
@@ -119,7 +120,8 @@ def test_solve_ivp_reproduces_simulate_rodas4_between_flag_changes():
     sol = scipy_integrate.solve_ivp(f, (0.0, T), X0, method="Radau", jac=f.jac,
                                     rtol=1e-10, atol=1e-12, dense_output=True)
     assert sol.success
-    ours = pdw.simulate(X0, t_end=T, method="rodas4", rtol=1e-10, atol=1e-12, dt=1e-6)
+    ours = pdw.simulate(X0, t_end=T, method="rodas4", dt=1e-6,
+                        integrator=pdw.Integrator(rtol=1e-10, atol=1e-12))
     assert ours.events == []
     err = np.abs(sol.y[:, -1] - ours.x_final)
     scale = np.abs(ours.x_final) + 1e-3

@@ -98,7 +98,8 @@ def test_flags_of_crafted_states_follow_the_rules(variant, method):
                           "below_no_touch_down_unarmed", "below_no_touch_down_moving_up"], 0)
     for x0, flags0 in _crafted(rng, 160):
         r = pdw.simulate(x0, t_end=3 * DT, dt=DT, method=method, variant=variant, flags0=flags0,
-                         record_every=1, on_failure="return", check_step="off")
+                         integrator=pdw.Integrator(check_step="off"), record=pdw.Record(every=1),
+                         limits=pdw.Limits(on_failure="return"))
         _replay(r, flags0, variant, seen)
     # every branch taken and not taken (a rule never exercised is not tested); an armed foot
     # below the ground moving up needs the paper's v_y (dy/dt + r thetad): with the consistent
@@ -116,8 +117,9 @@ def test_flags_of_a_walk_follow_the_rules(variant):
                            "disarmed", "uphill_unarmed", "armed", "touch_down",
                            "below_no_touch_down_unarmed", "below_no_touch_down_moving_up")}
     for x0 in (pdw.X0_PAPER, pdw.X0_DISTURBED):
-        r = pdw.simulate(x0, t_end=2.0, dt=DT, variant=variant, record_every=1, on_failure="return",
-                         check_step="off")
+        r = pdw.simulate(x0, t_end=2.0, dt=DT, variant=variant,
+                         integrator=pdw.Integrator(check_step="off"), record=pdw.Record(every=1),
+                         limits=pdw.Limits(on_failure="return"))
         _replay(r, (0, 1), variant, seen)
     assert seen["touch_down"] >= 4 and seen["lift_off"] >= 4 and seen["uphill_unarmed"] >= 1, seen
 
@@ -146,8 +148,9 @@ def test_touch_down_needs_armed_below_and_moving_down(case, expect):
     """Eq. 18b and the guard on hand-made states (paper variant), one step of cdm: the outcome
     is the rules' (stated per case), not whatever another copy of the rule says."""
     x0 = _state(**case)
-    r = pdw.simulate(x0, t_end=2 * DT, dt=DT, flags0=(0, 0), record_every=1, on_failure="return",
-                     check_step="off")
+    r = pdw.simulate(x0, t_end=2 * DT, dt=DT, flags0=(0, 0),
+                     integrator=pdw.Integrator(check_step="off"), record=pdw.Record(every=1),
+                     limits=pdw.Limits(on_failure="return"))
     td = [e for e in r.events if e.leg == 1 and e.kind == "touch_down"]
     assert len(td) == expect, (case, r.events)
     if expect:
@@ -159,8 +162,9 @@ def test_lift_off_needs_above_and_moving_up(h2, dy2, expect):
     """Eq. 18a at t = 0 (consistent variant: v_y = dy_D/dt): a support foot lifts off only when
     above the ground and moving up."""
     x0 = _state(-0.1, 0.2, h2, dy2, 0.0)[[0, 1, 3, 2, 4, 5, 7, 6]]     # the foot as leg 2
-    r = pdw.simulate(x0, t_end=DT, dt=DT, variant="consistent", flags0=(0, 1), record_every=1,
-                     on_failure="return", check_step="off")
+    r = pdw.simulate(x0, t_end=DT, dt=DT, variant="consistent", flags0=(0, 1),
+                     integrator=pdw.Integrator(check_step="off"), record=pdw.Record(every=1),
+                     limits=pdw.Limits(on_failure="return"))
     lo = [e for e in r.events if e.leg == 2 and e.kind == "lift_off" and e.t == 0.0]
     assert len(lo) == expect, r.events
 
@@ -201,6 +205,7 @@ def test_adaptive_methods_settle_a_lift_off_and_its_arming_together(method):
     of the first step, which is then the full trial step, not one cut at the arming."""
     x0 = _state(0.2, -0.1, 1e-6, 0.3, 0.0)
     r = pdw.simulate(x0, t_end=2e-3, dt=1e-4, method=method, variant="consistent", flags0=(1, 1),
-                     record_every=1, on_failure="return", check_step="off")
+                     integrator=pdw.Integrator(check_step="off"), record=pdw.Record(every=1),
+                     limits=pdw.Limits(on_failure="return"))
     assert [(e.t, e.leg, e.kind) for e in r.events] == [(0.0, 1, "lift_off")]
     assert r.t[1] - r.t[0] == pytest.approx(1e-4, rel=1e-12)

@@ -103,8 +103,9 @@ def test_adaptive_methods_never_step_over_a_patch_edge(method):
     g = Ground.flat(offset=0.0, blend=0.004).with_patches(
         [dict(s_a=0.05, s_b=0.09, k_n=3e4, d_n=3e5), dict(s_a=0.47, s_b=0.5, k_n=4e5)])
     zones = g.table().zones
-    r = pdw.simulate(params=P, ground=g, t_end=2.0, method=method, record_every=1, rtol=1e-5,
-                     atol=1e-7, h_max=0.05)
+    r = pdw.simulate(params=P, ground=g, t_end=2.0, method=method,
+                     integrator=pdw.Integrator(rtol=1e-5, atol=1e-7, h_max=0.05),
+                     record=pdw.Record(every=1))
     s = _contact_s(r.x)
     crossed = hit = 0
     for i in range(2):
@@ -119,7 +120,8 @@ def test_adaptive_methods_never_step_over_a_patch_edge(method):
 
 def test_off_ground_is_a_status():
     g = Ground.flat(extent=(-1.0, 1.5)).with_patches([dict(s_a=0.2, s_b=0.3, k_n=1e5)])
-    r = pdw.simulate(params=P, ground=g, t_end=3.0, record_every=0, on_failure="return")
+    r = pdw.simulate(params=P, ground=g, t_end=3.0, record=pdw.Record(every=0),
+                     limits=pdw.Limits(on_failure="return"))
     assert r.status == "off_ground"
     assert "defined extent" in r.failure["reason"]
     assert r.failure["x"][0] + P.l > 1.5 - 1e-3
@@ -183,7 +185,7 @@ def test_walk_figures_draw_the_ground(tmp_path):
     matplotlib.use("Agg")
     from pdw.present import animation, plots
     g = Ground.steps([0.3], [-0.004], width=0.2).with_patches([dict(s_a=0.1, s_b=0.25, k_n=5e4)])
-    r = pdw.simulate(params=P, t_end=0.6, ground=g, record_every=50)
+    r = pdw.simulate(params=P, t_end=0.6, ground=g, record=pdw.Record(every=50))
     fig = plots.fig_stick(r)
     ys = [line.get_ydata() for line in fig.axes[0].lines if len(line.get_ydata()) == 1200]
     assert ys and np.ptp(ys[0]) > 0.004            # the surface drawn is the step's, not a line
@@ -215,9 +217,10 @@ steady = 1
     for index, values in study.points()[:1]:
         row = points.run_point(study.task(index, values))
         r = pdw.simulate(params=pdw.Params.paper_steady().replace(k_hip=0.9), t_end=1.5,
-                         method=study.scene.integrator.method, rtol=study.scene.integrator.rtol,
-                         atol=study.scene.integrator.atol, ground=study.scene.ground,
-                         record_every=study.scene.record.every, on_failure="return")
+                         method=study.scene.integrator.method, ground=study.scene.ground,
+                         integrator=pdw.Integrator(rtol=study.scene.integrator.rtol, atol=study.scene.integrator.atol),
+                         record=pdw.Record(every=study.scene.record.every),
+                         limits=pdw.Limits(on_failure="return"))
         assert row["t_final"] == r.t_final and row["status"] == r.status
 
 

@@ -6,6 +6,8 @@ import sys
 import numpy as np
 import pytest
 
+import pdw
+
 pytest.importorskip("matplotlib")
 PIL_Image = pytest.importorskip("PIL.Image")
 
@@ -160,7 +162,7 @@ def test_double_support_zoom_without_double_support_raises():
 
 
 def test_contact_needs_forces():
-    r = simulate(t_end=0.1, record_forces=False)
+    r = simulate(t_end=0.1, record=pdw.Record(forces=False))
     with pytest.raises(ValueError, match="contact forces"):
         plots.fig_contact(r)
 

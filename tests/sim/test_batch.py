@@ -52,7 +52,7 @@ def test_every_walker_is_the_scalar_run(n, lanes, threads):
     """Batch of 1, non-full last blocks (11 = 2*4 + 3, 13 = 8 + 5), threads over ranges."""
     x = _states(n)
     b = simulate_batch(x, t_end=T_END, lanes=lanes, threads=threads, vector=False,
-                       check_step="off")
+                       integrator=pdw.Integrator(check_step="off"))
     statuses = set()
     for i in range(n):
         r = _scalar(x[i], pdw.Params.paper())
@@ -67,7 +67,7 @@ def test_per_walker_params_and_stop_steps():
     x[:, 6] = pdw.X0_PAPER[6]                         # all start as the paper's walker...
     params = [pdw.Params.paper(d_hip=d) for d in np.linspace(0.005, 0.03, 6)]   # ...not alike
     b = simulate_batch(x, t_end=T_END, params=params, lanes=4, threads=1, vector=False,
-                       stop_steps=2, check_step="off")
+                       integrator=pdw.Integrator(check_step="off"), stop=pdw.Stop(steps=2))
     for i in range(6):
         _assert_same(b, i, _scalar(x[i], params[i], stop_steps=2))
     assert len(set(np.round(b.x_final[:, 6], 9))) > 1      # the parameters did act
@@ -76,10 +76,11 @@ def test_per_walker_params_and_stop_steps():
 def test_lanes_and_threads_do_not_change_results():
     """Each lane is independent: the vector path gives the same per-walker answer in any lane."""
     x = _states(20, seed=2)
-    ref = simulate_batch(x, t_end=T_END, lanes=1, threads=1, vector=True, check_step="off")
+    ref = simulate_batch(x, t_end=T_END, lanes=1, threads=1, vector=True,
+                         integrator=pdw.Integrator(check_step="off"))
     for lanes, threads in ((8, 1), (5, 2), (16, 2)):
         b = simulate_batch(x, t_end=T_END, lanes=lanes, threads=threads, vector=True,
-                           check_step="off")
+                           integrator=pdw.Integrator(check_step="off"))
         np.testing.assert_array_equal(b.x_final, ref.x_final)
         np.testing.assert_array_equal(b.status, ref.status)
         np.testing.assert_array_equal(b.n_touch_down, ref.n_touch_down)
@@ -90,7 +91,8 @@ def test_vector_path_agrees_in_outcome():
     turn that into step-sized shifts of events, so the states are not 1e-12 close (see
     docs/ensemble.md), but each walker's outcome and event counts are the scalar run's."""
     x = _states(12, seed=3)
-    b = simulate_batch(x, t_end=T_END, lanes=8, threads=1, vector=True, check_step="off")
+    b = simulate_batch(x, t_end=T_END, lanes=8, threads=1, vector=True,
+                       integrator=pdw.Integrator(check_step="off"))
     for i in range(12):
         r = _scalar(x[i], pdw.Params.paper())
         assert b.status[i] == r.status
@@ -115,7 +117,8 @@ def test_bad_row_is_named():
     with pytest.raises(pdw.InvalidInputError, match="vector"):
         simulate_batch(_states(2), t_end=T_END, method="dopri5", vector=True)
     with pytest.raises(pdw.InvalidInputError, match="rtol"):
-        simulate_batch(_states(2), t_end=T_END, method="rodas4", rtol=0.0)
+        simulate_batch(_states(2), t_end=T_END, method="rodas4",
+                       integrator=pdw.Integrator(rtol=0.0))
     with pytest.raises(pdw.InvalidInputError, match="row 1"):
         simulate_batch(_states(2), t_end=T_END, method="rodas4",
                        params=[pdw.Params.paper(), None])
@@ -124,7 +127,7 @@ def test_bad_row_is_named():
 def test_dataframe():
     pd = pytest.importorskip("pandas")
     x = _states(3)
-    b = simulate_batch(x, t_end=T_END, check_step="off")
+    b = simulate_batch(x, t_end=T_END, integrator=pdw.Integrator(check_step="off"))
     df = b.to_dataframe()
     assert isinstance(df, pd.DataFrame) and len(df) == 3
     np.testing.assert_array_equal(df["x_thetad1"].to_numpy(), b.x_final[:, 6])
@@ -151,8 +154,9 @@ def test_basin_points_are_scalar_walks():
     for j, th in enumerate(b.thetad2):
         for i, ph in enumerate(b.phi):
             x = lc.embed(cmap.cell_state(ph, th, rest, p), p)
-            r = pdw.simulate(x, t_end=6.0, params=p, flags0=(1, 1), record_every=0,
-                             periodic_steps=4, on_failure="return")
+            r = pdw.simulate(x, t_end=6.0, params=p, flags0=(1, 1), record=pdw.Record(every=0),
+                             stop=pdw.Stop(periodic=True, periodic_steps=4),
+                             limits=pdw.Limits(on_failure="return"))
             assert b.n_steps[j, i] == r.n_gait_steps
             expect = {"fell": B.FELL, "diverged": B.FELL, "walked": B.UNDECIDED}.get(r.status)
             if r.status == "periodic":
@@ -185,8 +189,8 @@ def test_rodas4_lanes_are_the_scalar_runs_bitwise(n, lanes, threads):
     step at a time it is bit for bit `simulate(method="rodas4")`: batch of 1, non-full last
     blocks, threads, a mix of falls and walks."""
     x = _states(n, seed=4)
-    b = simulate_batch(x, t_end=T_END, dt=1e-4, method="rodas4", rtol=1e-6, atol=1e-8,
-                       lanes=lanes, threads=threads)
+    b = simulate_batch(x, t_end=T_END, dt=1e-4, method="rodas4", lanes=lanes, threads=threads,
+                       integrator=pdw.Integrator(rtol=1e-6, atol=1e-8))
     statuses = set()
     for i in range(n):
         r = _scalar(x[i], pdw.Params.paper(), method="rodas4", rtol=1e-6, atol=1e-8)
@@ -212,7 +216,8 @@ def test_rodas4_per_walker_params_tolerances_and_stop_conditions():
 
 def test_rodas4_step_budget_is_per_walker():
     x = _states(3, seed=6)
-    b = simulate_batch(x, t_end=T_END, method="rodas4", max_steps=50, lanes=2, threads=1)
+    b = simulate_batch(x, t_end=T_END, method="rodas4", lanes=2, threads=1,
+                       integrator=pdw.Integrator(max_steps=50))
     for i in range(3):
         r = _scalar(x[i], pdw.Params.paper(), method="rodas4", max_steps=50)
         _assert_bitwise(b, i, r)
@@ -225,11 +230,13 @@ def test_other_methods_are_the_scalar_runs_bitwise(method, dt):
     at, past a lift-off and a touch-down)."""
     x = _states(3, seed=7)
     b = simulate_batch(x, t_end=0.4, dt=dt, method=method, lanes=2, threads=1,
-                       check_step="off")
+                       integrator=pdw.Integrator(check_step="off"))
     assert np.all(b.n_touch_down >= 1) and np.all(b.n_lift_off >= 1)
     for i in range(3):
-        r = pdw.simulate(x[i], t_end=0.4, dt=dt, method=method, record_every=1,
-                         record_forces=False, on_failure="return", check_step="off")
+        r = pdw.simulate(x[i], t_end=0.4, dt=dt, method=method,
+                         integrator=pdw.Integrator(check_step="off"),
+                         record=pdw.Record(every=1, forces=False),
+                         limits=pdw.Limits(on_failure="return"))
         _assert_bitwise(b, i, r)
 
 
@@ -248,7 +255,7 @@ def test_every_lane_loop_is_bitwise_the_scalar_run(isa, variant, n, lanes, monke
     monkeypatch.setenv(ISA_ENV, isa)
     x = _states(n, seed=8)
     b = simulate_batch(x, t_end=T_END, lanes=lanes, threads=1, variant=variant,
-                       check_step="off")
+                       integrator=pdw.Integrator(check_step="off"))
     statuses = set()
     for i in range(n):
         r = _scalar(x[i], pdw.Params.paper(), variant=variant)
@@ -292,7 +299,8 @@ def test_cdm_lanes_do_the_work():
     of the widest instruction set commits all but the event steps."""
     x = _states(13, seed=8)
     _batch.lane_steps(reset=True)
-    b = simulate_batch(x, t_end=T_END, lanes=8, threads=1, check_step="off")
+    b = simulate_batch(x, t_end=T_END, lanes=8, threads=1,
+                       integrator=pdw.Integrator(check_step="off"))
     in_lanes = _batch.lane_steps(reset=True)
     assert 0.99 * b.n_steps.sum() <= in_lanes < b.n_steps.sum()
 
@@ -356,8 +364,8 @@ def test_lane_loops_stop_on_a_cancel_token(method, isa, monkeypatch):
         interrupt._local.token = token
         t0 = time.monotonic()
         try:
-            simulate_batch(np.tile(pdw.X0_PAPER, (3000, 1)), t_end=3.5, method=method,
-                           threads=1, check_step="off")
+            simulate_batch(np.tile(pdw.X0_PAPER, (3000, 1)), t_end=3.5, method=method, threads=1,
+                           integrator=pdw.Integrator(check_step="off"))
             out["r"] = ("finished", time.monotonic() - t0, None)
         except KeyboardInterrupt as e:
             out["r"] = ("interrupted", time.monotonic() - t0, e.result)

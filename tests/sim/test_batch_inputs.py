@@ -70,6 +70,6 @@ def test_simulate_batch_refuses_malformed_input_naming_the_field(kw, field):
 
 def test_simulate_batch_still_takes_well_formed_input():
     b = simulate_batch(X2.tolist(), t_end=0.01, flags0=np.array([[0, 1], [0, 1]]),
-                       fall_hip_height=0.3, vector=np.bool_(False))
-    r = pdw.simulate(t_end=0.01, record_every=0, fall_hip_height=0.3)
+                       vector=np.bool_(False), limits=pdw.Limits(fall_hip_height=0.3))
+    r = pdw.simulate(t_end=0.01, record=pdw.Record(every=0), limits=pdw.Limits(fall_hip_height=0.3))
     assert np.array_equal(b.x_final[0], r.x_final) and list(b.status) == ["walked"] * 2

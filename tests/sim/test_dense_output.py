@@ -25,11 +25,16 @@ def reference():
 @pytest.mark.parametrize("method", pdw.METHODS)
 def test_t_eval_at_the_recorded_steps_is_the_recorded_state(method):
     dt = 1e-3
-    r = pdw.simulate(pdw.X0_PAPER, t_end=0.4, method=method, dt=2e-6 if method in ("rk4", "dopri5")
-                     else dt, check_step="off", dense_output=True)
+    r = pdw.simulate(pdw.X0_PAPER, t_end=0.4, method=method,
+                     dt=2e-6 if method in ("rk4", "dopri5")
+                     else dt,
+                     integrator=pdw.Integrator(check_step="off"),
+                     record=pdw.Record(dense_output=True))
     pick = r.t[:: max(1, len(r.t) // 50)]
-    s = pdw.simulate(pdw.X0_PAPER, t_end=0.4, method=method, dt=2e-6 if method in ("rk4", "dopri5")
-                     else dt, check_step="off", t_eval=pick)
+    s = pdw.simulate(pdw.X0_PAPER, t_end=0.4, method=method,
+                     dt=2e-6 if method in ("rk4", "dopri5")
+                     else dt,
+                     integrator=pdw.Integrator(check_step="off"), record=pdw.Record(t_eval=pick))
     np.testing.assert_array_equal(s.t, pick)
     idx = np.searchsorted(r.t, pick, side="right") - 1
     np.testing.assert_array_equal(s.x, r.x[idx])
@@ -88,7 +93,7 @@ def test_quintic_interpolant_is_exact_for_quintics():
 @pytest.mark.parametrize("bad", [[0.2, 0.1], [-0.1], [0.0, 99.0], [[0.1]], [np.nan]])
 def test_bad_t_eval_is_refused(bad):
     with pytest.raises(pdw.InvalidInputError, match="t_eval"):
-        pdw.simulate(t_end=0.5, t_eval=bad)
+        pdw.simulate(t_end=0.5, record=pdw.Record(t_eval=bad))
 
 
 def test_t_eval_needs_every_step_recorded():
@@ -99,16 +104,18 @@ def test_t_eval_needs_every_step_recorded():
 @pytest.mark.parametrize("method", ["cdm", "rodas4"])
 def test_record_buffer_gives_the_same_run(method):
     buf = pdw.RecordBuffer()
-    fresh = pdw.simulate(t_end=0.8, method=method, check_step="off")
-    a = pdw.simulate(t_end=0.8, method=method, check_step="off", out=buf)
+    fresh = pdw.simulate(t_end=0.8, method=method, integrator=pdw.Integrator(check_step="off"))
+    a = pdw.simulate(t_end=0.8, method=method, integrator=pdw.Integrator(check_step="off"),
+                     record=pdw.Record(out=buf))
     for k in ("t", "x", "flags", "Fn", "Ft"):
         np.testing.assert_array_equal(getattr(a, k), getattr(fresh, k))
     if method == "cdm":
         assert np.shares_memory(a.x, buf.x)
-        b = pdw.simulate(t_end=0.8, x0=pdw.X0_DISTURBED, method=method, check_step="off", out=buf)
+        b = pdw.simulate(t_end=0.8, x0=pdw.X0_DISTURBED, method=method,
+                         integrator=pdw.Integrator(check_step="off"), record=pdw.Record(out=buf))
         assert np.array_equal(a.x, b.x)          # a view: overwritten by the next run
     with pytest.raises(pdw.InvalidInputError, match="out"):
-        pdw.simulate(t_end=0.1, out=np.zeros(3))
+        pdw.simulate(t_end=0.1, record=pdw.Record(out=np.zeros(3)))
 
 
 @pytest.mark.parametrize("method", pdw.METHODS)
@@ -151,7 +158,7 @@ def test_record_buffer_capacity_is_checked(cap):
 
 def test_a_well_formed_record_buffer_still_gives_the_same_run():
     b = RecordBuffer(10)
-    r1 = pdw.simulate(t_end=0.01, out=b)
+    r1 = pdw.simulate(t_end=0.01, record=pdw.Record(out=b))
     r2 = pdw.simulate(t_end=0.01)
     assert np.array_equal(r1.x, r2.x) and b.capacity >= len(r2.t)
 
@@ -168,7 +175,7 @@ def test_dense_output_arguments_are_strict(kw, field):
 @pytest.mark.parametrize("tq", ["0.01", 0.01 + 1j, np.full((2, 2), 0.01), float("nan"), 5.0])
 def test_dense_interpolant_refuses_bad_times(tq):
     """sol("0.01") was parsed; complex and 2-D times gave raw TypeError / ValueError."""
-    sol = pdw.simulate(t_end=0.02, method="rodas4", dense_output=True).sol
+    sol = pdw.simulate(t_end=0.02, method="rodas4", record=pdw.Record(dense_output=True)).sol
     with pytest.raises(pdw.InvalidInputError, match="t"):
         sol(tq)
     assert sol(0.01).shape == (8,) and sol([0.005, 0.01]).shape == (2, 8)

@@ -38,7 +38,8 @@ def test_scalar_path_is_the_batch_bitwise():
     """scalar_batch (pdw.simulate per walker) and the compiled lanes: the same BatchResult."""
     x = _states(13)
     params = [pdw.Params.paper(d_hip=d) for d in np.linspace(0.005, 0.03, 13)]
-    b = simulate_batch(x, t_end=T_END, params=params, threads=1, check_step="off")
+    b = simulate_batch(x, t_end=T_END, params=params, threads=1,
+                       integrator=pdw.Integrator(check_step="off"))
     s = E.scalar_batch(x, t_end=T_END, params=params, threads=2, check_step="off")
     assert s.engine == "scalar" and b.engine == "batch"
     assert {"walked", "fell"} <= set(b.status)
@@ -49,23 +50,24 @@ def test_fallback_for_a_method_the_engine_refuses(monkeypatch):
     """simulate_many: the batch engine where it runs the method, pdw.simulate otherwise."""
     x = _states(5, seed=4)
     assert E.supports("cdm")
-    m = E.simulate_many(x, t_end=T_END, threads=1, check_step="off")
+    m = E.simulate_many(x, t_end=T_END, threads=1, integrator=pdw.Integrator(check_step="off"))
     assert m.engine == "batch"
     # a method the engine refuses (rodas4 today; if it learns rodas4, force the refusal)
     E.supports.cache_clear()
     real = E.supports.__wrapped__
     monkeypatch.setattr(E, "supports", lambda method, variant="paper": False
                         if method in ("rodas4", "cdm") else real(method, variant))
-    r = E.simulate_many(x, t_end=T_END, method="rodas4", rtol=1e-6, atol=1e-8, threads=2,
-                        check_step="off")
+    r = E.simulate_many(x, t_end=T_END, method="rodas4", threads=2,
+                        integrator=pdw.Integrator(rtol=1e-6, atol=1e-8, check_step="off"))
     assert r.engine == "scalar"
     for i in range(len(x)):
-        s = pdw.simulate(x[i], t_end=T_END, method="rodas4", rtol=1e-6, atol=1e-8,
-                         record_every=1, on_failure="return", check_step="off")
+        s = pdw.simulate(x[i], t_end=T_END, method="rodas4",
+                         integrator=pdw.Integrator(rtol=1e-6, atol=1e-8, check_step="off"),
+                         record=pdw.Record(every=1), limits=pdw.Limits(on_failure="return"))
         assert r.status[i] == s.status and r.n_steps[i] == s.n_steps
         np.testing.assert_array_equal(r.x_final[i], s.x_final)
         assert tuple(r.flags_final[i]) == tuple(s.flags[-1])
-    c = E.simulate_many(x, t_end=T_END, threads=1, check_step="off")   # cdm, forced scalar
+    c = E.simulate_many(x, t_end=T_END, threads=1, integrator=pdw.Integrator(check_step="off"))   # cdm, forced scalar
     assert c.engine == "scalar"
     _assert_identical(c, m)
 
@@ -73,10 +75,11 @@ def test_fallback_for_a_method_the_engine_refuses(monkeypatch):
 def test_non_default_contact_law_takes_the_scalar_path():
     x = _states(2, seed=5)
     law = pdw.Contact(normal="kelvin_voigt")
-    r = E.simulate_many(x, t_end=0.3, threads=1, check_step="off", contact=law)
+    r = E.simulate_many(x, t_end=0.3, threads=1, contact=law,
+                        integrator=pdw.Integrator(check_step="off"))
     assert r.engine == "scalar"
-    s = pdw.simulate(x[1], t_end=0.3, contact=law, record_every=0, on_failure="return",
-                     check_step="off")
+    s = pdw.simulate(x[1], t_end=0.3, contact=law, integrator=pdw.Integrator(check_step="off"),
+                     record=pdw.Record(every=0), limits=pdw.Limits(on_failure="return"))
     np.testing.assert_array_equal(r.x_final[1], s.x_final)
 
 
@@ -86,7 +89,8 @@ def test_chunks_over_an_executor_are_the_unchunked_batch(pool):
     x = _states(11, seed=6)
     params = [pdw.Params.paper(k_hip=k) for k in np.linspace(0.5, 1.5, 11)]
     f0 = [(0, 1) if i % 3 else (1, 1) for i in range(11)]
-    ref = simulate_batch(x, t_end=T_END, params=params, flags0=f0, threads=1, check_step="off")
+    ref = simulate_batch(x, t_end=T_END, params=params, flags0=f0, threads=1,
+                         integrator=pdw.Integrator(check_step="off"))
     with pool(2) as ex:
         b = simulate_batch(x, t_end=T_END, params=params, flags0=f0, threads=1,
                            check_step="off", executor=ex, chunk_size=4, record=[2, 9],
@@ -95,8 +99,8 @@ def test_chunks_over_an_executor_are_the_unchunked_batch(pool):
     assert sorted(b.recorded) == [2, 9]
     for i in (2, 9):
         np.testing.assert_array_equal(b.recorded[i].x_final, ref.x_final[i])
-    serial = simulate_batch(x, t_end=T_END, params=params, flags0=f0, threads=1,
-                            check_step="off", chunk_size=3)
+    serial = simulate_batch(x, t_end=T_END, params=params, flags0=f0, threads=1, chunk_size=3,
+                            integrator=pdw.Integrator(check_step="off"))
     _assert_identical(ref, serial)
     with pytest.raises(pdw.InvalidInputError, match="chunk_size"):
         simulate_batch(x, t_end=T_END, chunk_size=0)
@@ -115,8 +119,8 @@ def test_recorded_subset_is_scalar_simulate():
                        record_every=7)
     assert sorted(b.recorded) == [0, 3, 5]
     for i, r in b.recorded.items():
-        s = pdw.simulate(x[i], t_end=T_END, record_every=7, on_failure="return",
-                         check_step="off")
+        s = pdw.simulate(x[i], t_end=T_END, integrator=pdw.Integrator(check_step="off"),
+                         record=pdw.Record(every=7), limits=pdw.Limits(on_failure="return"))
         np.testing.assert_array_equal(r.t, s.t)
         np.testing.assert_array_equal(r.x, s.x)
         np.testing.assert_array_equal(r.flags, s.flags)
@@ -128,7 +132,7 @@ def test_recorded_subset_is_scalar_simulate():
         assert r.status == b.status[i] and r.n_gait_steps == b.n_gait_steps[i]
         assert np.all(np.diff(r.t) > 0) and r.t[-1] <= b.t_final[i]
     with pytest.raises(pdw.InvalidInputError, match="record"):
-        simulate_batch(x, t_end=T_END, record=[6], check_step="off")
+        simulate_batch(x, t_end=T_END, record=[6], integrator=pdw.Integrator(check_step="off"))
     with pytest.raises(pdw.InvalidInputError, match="record_every"):
         simulate_batch(x, t_end=T_END, record=[1], record_every=0, check_step="off")
 
@@ -141,10 +145,12 @@ def test_end_of_run_checks_as_simulate():
     for a in (0.2, 0.3):
         x.append([0.0, p.r + (p.l - p.r) * math.cos(a), -a, a, 0, 0, 0, 0])
     x = np.vstack([x, _states(1)])
-    b = simulate_batch(x, t_end=8.0, params=p, flags0=(1, 1), threads=1, check_step="off")
+    b = simulate_batch(x, t_end=8.0, params=p, flags0=(1, 1), threads=1,
+                       integrator=pdw.Integrator(check_step="off"))
     for i in range(3):
-        s = pdw.simulate(x[i], t_end=8.0, params=p, flags0=(1, 1), record_every=0,
-                         on_failure="return", check_step="off")
+        s = pdw.simulate(x[i], t_end=8.0, params=p, flags0=(1, 1),
+                         integrator=pdw.Integrator(check_step="off"), record=pdw.Record(every=0),
+                         limits=pdw.Limits(on_failure="return"))
         assert b.status[i] == s.status
         assert b.stop_reason[i] == s.stop_reason
     assert list(b.status[:2]) == ["no_steps", "no_steps"]
@@ -259,10 +265,10 @@ def test_chunks_over_a_dask_executor():
     """The same interface as sweeps: a Dask client's executor takes the chunks."""
     distributed = pytest.importorskip("distributed")
     x = _states(9, seed=8)
-    ref = simulate_batch(x, t_end=T_END, threads=1, check_step="off")
+    ref = simulate_batch(x, t_end=T_END, threads=1, integrator=pdw.Integrator(check_step="off"))
     with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
                                   dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
-        b = simulate_batch(x, t_end=T_END, threads=1, check_step="off",
-                           executor=client.get_executor(), chunk_size=4)
+        b = simulate_batch(x, t_end=T_END, threads=1, executor=client.get_executor(), chunk_size=4,
+                           integrator=pdw.Integrator(check_step="off"))
     _assert_identical(ref, b)

@@ -12,7 +12,8 @@ from pdw.core import provenance
 
 @pytest.fixture(scope="module")
 def res():
-    return pdw.simulate(t_end=1.3, method="rodas4", record_energies=True, rtol=1e-6)
+    return pdw.simulate(t_end=1.3, method="rodas4", integrator=pdw.Integrator(rtol=1e-6),
+                        record=pdw.Record(energies=True))
 
 
 def _same_result(a, b):

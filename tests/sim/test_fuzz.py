@@ -162,7 +162,7 @@ def test_rodas4_runs_return_a_valid_result_or_a_pdw_error(P, s, rtol, variant):
 
 @pytest.mark.parametrize("method", ["rodas4", "dopri5"])
 def test_adaptive_runs_end_at_t_end(method):
-    r = pdw.simulate(method=method, t_end=0.25, dt=0.1, record_every=0)
+    r = pdw.simulate(method=method, t_end=0.25, dt=0.1, record=pdw.Record(every=0))
     assert r.t_final == pytest.approx(0.25)      # ended at 0.2 s = round(t_end/dt)*dt before the fix
 
 
@@ -649,7 +649,8 @@ def _buffer(data):
         if data.draw(st.integers(0, 3)) == 0:
             setattr(b, name, data.draw(arrays(shape, dt)))
     try:
-        r = pdw.simulate(t_end=0.005, out=b, check_step="off")
+        r = pdw.simulate(t_end=0.005, integrator=pdw.Integrator(check_step="off"),
+                         record=pdw.Record(out=b))
     except pdw.InvalidInputError:
         return
     assert np.isfinite(r.x).all() and len(r.t) == len(r.x) == 51
@@ -666,7 +667,7 @@ def _saved():
         import tempfile
         d = tempfile.mkdtemp(prefix="pdw-fuzz-")
         path = os.path.join(d, "good.npz")
-        pdw.simulate(t_end=0.02, record_energies=True).save(path)
+        pdw.simulate(t_end=0.02, record=pdw.Record(energies=True)).save(path)
         with np.load(path) as z:
             arrays_ = {k: z[k] for k in z.files}
         _SAVED.update(dir=d, arrays=arrays_, meta=json.loads(str(arrays_.pop("meta"))))
@@ -767,7 +768,7 @@ _NAN_ENTRIES = {
     "ode_batch": lambda x: pdw.ode_function().batch(np.ascontiguousarray(x[None])),
     "hybrid_rhs": lambda x: pdw.hybrid.stance_rhs(x[:4]),
     "hybrid_step": lambda x: pdw.hybrid.step_map(x[:4]),
-    "simulate": lambda x: pdw.simulate(x, t_end=0.001, check_step="off"),
+    "simulate": lambda x: pdw.simulate(x, t_end=0.001, integrator=pdw.Integrator(check_step="off")),
 }
 
 
@@ -833,7 +834,7 @@ _SHORT = {}
 
 def _short_run():
     if not _SHORT:
-        _SHORT["r"] = pdw.simulate(t_end=1.2, record_every=0)
+        _SHORT["r"] = pdw.simulate(t_end=1.2, record=pdw.Record(every=0))
     return _SHORT["r"]
 
 

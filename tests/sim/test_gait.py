@@ -64,7 +64,7 @@ def test_text_table_lists_every_step():
 
 def test_typical_gait_descriptors_are_close_to_the_paper():
     """paper_steady (docs/model.md section 8): footprint L and P within about 10 % of the paper's."""
-    r = pdw.simulate(t_end=12.0, params=pdw.Params.paper_steady(), record_every=0)
+    r = pdw.simulate(t_end=12.0, params=pdw.Params.paper_steady(), record=pdw.Record(every=0))
     sd = pdw.steps(r).steady(4)
     assert sd["L"] == pytest.approx(0.397, rel=0.12)
     assert sd["P"] == pytest.approx(0.621, rel=0.12)
@@ -90,7 +90,8 @@ def _fell_after_one_step():
     (found by a scan of the start's rates)."""
     x = np.array(pdw.X0_PAPER)
     x[6] *= 0.8
-    r = pdw.simulate(x, t_end=3.5, record_every=0, on_failure="return")
+    r = pdw.simulate(x, t_end=3.5, record=pdw.Record(every=0),
+                     limits=pdw.Limits(on_failure="return"))
     assert r.status == "fell" and len(pdw.steps(r)) == 1
     return r
 
@@ -104,11 +105,11 @@ def test_steady_of_a_run_that_fell_after_one_step_is_not_converged():
 
 
 def test_steady_of_a_transient_is_not_converged_and_of_a_converged_gait_is():
-    r = pdw.simulate(t_end=3.5, record_every=0)             # the paper's start: 5 steps, decaying
+    r = pdw.simulate(t_end=3.5, record=pdw.Record(every=0))             # the paper's start: 5 steps, decaying
     sd = pdw.steps(r).steady()
     assert r.status == "walked" and sd["last"] == 4 and sd["converged"] is False
     assert sd["spread_L"] > 1e-3 * sd["L"]
-    r = pdw.simulate(t_end=20, params=pdw.Params.paper_steady(), record_every=0)
+    r = pdw.simulate(t_end=20, params=pdw.Params.paper_steady(), record=pdw.Record(every=0))
     sd = pdw.steps(r).steady()
     assert sd["converged"] is True
     assert sd["spread_L"] <= 1e-3 * sd["L"] and sd["spread_P"] <= 1e-3 * sd["P"]
@@ -117,7 +118,7 @@ def test_steady_of_a_transient_is_not_converged_and_of_a_converged_gait_is():
 
 
 def test_steady_checks_its_arguments():
-    st = pdw.steps(pdw.simulate(t_end=1.0, record_every=0))
+    st = pdw.steps(pdw.simulate(t_end=1.0, record=pdw.Record(every=0)))
     for bad in (0, 1.5, "4", True):
         with pytest.raises(pdw.InvalidInputError, match="last"):
             st.steady(bad)

@@ -85,20 +85,23 @@ def _standing():
     p = pdw.Params.paper(gamma=0.0)
     a = 0.2
     x = [0.0, p.r + (p.l - p.r) * np.cos(a), -a, a, 0, 0, 0, 0]
-    return pdw.simulate(x, t_end=8.0, params=p, flags0=(1, 1), record_every=200,
-                        on_failure="return", check_step="off")
+    return pdw.simulate(x, t_end=8.0, params=p, flags0=(1, 1),
+                        integrator=pdw.Integrator(check_step="off"), record=pdw.Record(every=200),
+                        limits=pdw.Limits(on_failure="return"))
 
 
 RUNS = {
-    "walked": lambda: pdw.simulate(t_end=0.4, record_energies=True),
+    "walked": lambda: pdw.simulate(t_end=0.4, record=pdw.Record(energies=True)),
     "periodic": lambda: pdw.simulate(t_end=12.0, params=pdw.Params.paper_steady(),
-                                     periodic_steps=4, periodic_tol=1e-3, record_every=50),
+                                     record=pdw.Record(every=50),
+                                     stop=pdw.Stop(periodic=True, periodic_steps=4, periodic_tol=1e-3)),
     "fell_inf_force": _fell_with_inf,
     "diverged_nonfinite_energies": _diverged_nonfinite_energies,
     "diverged_rodas4": lambda: _quiet(x0=np.r_[X0[:6], 1e160, X0[7]], t_end=0.01,
                                       on_failure="return", method="rodas4", max_speed=1e308),
     "no_steps": lambda: _standing(),
-    "hertz": lambda: pdw.simulate(t_end=0.3, contact=pdw.Contact("hertz"), on_failure="return"),
+    "hertz": lambda: pdw.simulate(t_end=0.3, contact=pdw.Contact("hertz"),
+                                  limits=pdw.Limits(on_failure="return")),
     "kelvin_voigt": lambda: pdw.simulate(t_end=0.3, contact=pdw.Contact("kelvin_voigt")),
     "flores_rodas4": lambda: pdw.simulate(t_end=0.3, method="rodas4",
                                           contact=pdw.Contact("flores", e=0.3)),
@@ -107,14 +110,15 @@ RUNS = {
     "lugre": lambda: _quiet(t_end=0.3, method="rodas4", contact=pdw.Contact(friction="lugre")),
     "lugre_dense": lambda: _quiet(t_end=0.2, method="rodas4", dense_output=True,
                                   contact=pdw.Contact(friction="lugre", sigma1=10.0)),
-    "dense_cdm": lambda: pdw.simulate(t_end=0.2, dense_output=True),
-    "dense_rodas4_t_eval": lambda: pdw.simulate(t_end=0.3, method="rodas4", dense_output=True,
-                                                t_eval=np.linspace(0, 0.3, 31)),
-    "t_eval": lambda: pdw.simulate(t_end=0.3, t_eval=[0.0, 0.1, 0.25]),
+    "dense_cdm": lambda: pdw.simulate(t_end=0.2, record=pdw.Record(dense_output=True)),
+    "dense_rodas4_t_eval": lambda: pdw.simulate(t_end=0.3, method="rodas4",
+                                                record=pdw.Record(dense_output=True, t_eval=np.linspace(0, 0.3, 31))),
+    "t_eval": lambda: pdw.simulate(t_end=0.3, record=pdw.Record(t_eval=[0.0, 0.1, 0.25])),
     "features": lambda: pdw.simulate(t_end=0.3, features=("hip_spring", "friction")),
     "consistent_no_events": lambda: pdw.simulate(t_end=0.3, variant="consistent",
-                                                 record_events=False, record_every=0),
-    "steps_stop": lambda: pdw.simulate(t_end=3.0, stop_steps=2, record_every=10),
+                                                 record=pdw.Record(events=False, every=0)),
+    "steps_stop": lambda: pdw.simulate(t_end=3.0, record=pdw.Record(every=10),
+                                       stop=pdw.Stop(steps=2)),
 }
 
 
@@ -303,7 +307,7 @@ def test_one_module_owns_the_format_and_the_old_paths_are_aliases():
 @pytest.fixture(scope="module")
 def saved_run(tmp_path_factory):
     path = tmp_path_factory.mktemp("load") / "good.npz"
-    pdw.simulate(t_end=0.02, record_energies=True).save(path)
+    pdw.simulate(t_end=0.02, record=pdw.Record(energies=True)).save(path)
     with np.load(path) as z:
         arrays = {k: z[k] for k in z.files}
     return path, arrays, json.loads(str(arrays.pop("meta")))

@@ -213,9 +213,9 @@ def test_record_buffer_of_the_default_law_unchanged():
     """The default law's buffer is what it was: x (capacity, 8), the same run, no realloc."""
     buf = pdw.RecordBuffer(100)
     assert buf.x.shape == (100, NX)
-    r = pdw.simulate(t_end=0.005, out=buf)
+    r = pdw.simulate(t_end=0.005, record=pdw.Record(out=buf))
     x = buf.x
-    r2 = pdw.simulate(t_end=0.005, out=buf)
+    r2 = pdw.simulate(t_end=0.005, record=pdw.Record(out=buf))
     assert buf.x is x and np.shares_memory(r2.x, x)
     np.testing.assert_array_equal(r.x, pdw.simulate(t_end=0.005).x)
 
@@ -224,8 +224,8 @@ def test_record_buffer_refuses_foreign_arrays_of_the_wrong_width(contact):
     buf = pdw.RecordBuffer(600)
     buf.x = np.zeros((600, NX))                   # the user's own array: not re-viewed
     with pytest.raises(pdw.InvalidInputError, match=r"out.x .*\(600, 10\)"):
-        pdw.simulate(params=P, t_end=0.005, dt=2e-5, contact=contact, out=buf,
-                     check_step="off")
+        pdw.simulate(params=P, t_end=0.005, dt=2e-5, contact=contact,
+                     integrator=pdw.Integrator(check_step="off"), record=pdw.Record(out=buf))
 
 
 # --- features ---------------------------------------------------------------------------------
@@ -296,14 +296,14 @@ def test_features_without_friction_drops_the_bristles(normal, contact):
     with pytest.warns(pdw.StepSizeWarning):
         pdw.simulate(params=P, t_end=0.01, dt=2e-4, contact=c, check_step="warn")
     pdw.simulate(params=P, t_end=0.01, dt=2e-4, contact=c, features=_without("friction"),
-                 check_step="error")
+                 integrator=pdw.Integrator(check_step="error"))
 
 
 def test_contact_forces_evaluates_the_lugre_kernel(contact):
     """`pdw.contact_forces(contact=LuGre)` takes the 10-entry state and gives the run's forces
     (it gave the Coulomb kernel's for 8 entries before)."""
     r = pdw.simulate(params=P, t_end=0.05, dt=2e-5, method="rk4", contact=contact,
-                     check_step="off")
+                     integrator=pdw.Integrator(check_step="off"))
     cs = pdw.contact_forces(r.x, r.params, flags=r.flags, contact=contact)
     np.testing.assert_array_equal(cs.F_t, r.Ft)
     with pytest.raises(pdw.InvalidInputError, match="x"):

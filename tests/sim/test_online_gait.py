@@ -117,7 +117,8 @@ def _spread(tab, n, k):
 def test_periodic_stop_window_is_the_last_k_steps(k):
     """With a tolerance between what k - 1 and k steps need, the run stops where exactly k
     steps agree: not one step early (a window of k - 1) nor late (k + 1)."""
-    full = pdw.simulate(t_end=12.0, params=STEADY, record_every=0, check_step="off")
+    full = pdw.simulate(t_end=12.0, params=STEADY, integrator=pdw.Integrator(check_step="off"),
+                        record=pdw.Record(every=0))
     tab = pdw.steps(full).table
     N = len(tab["L"])
     # a tolerance whose stop under windows k - 1, k and k + 1 differ
@@ -129,8 +130,9 @@ def test_periodic_stop_window_is_the_last_k_steps(k):
             break
     else:
         pytest.fail("no tolerance separates the windows")
-    r = pdw.simulate(t_end=12.0, params=STEADY, record_every=0, periodic_steps=k, periodic_tol=tol,
-                     check_step="off")
+    r = pdw.simulate(t_end=12.0, params=STEADY, integrator=pdw.Integrator(check_step="off"),
+                     record=pdw.Record(every=0),
+                     stop=pdw.Stop(periodic=True, periodic_steps=k, periodic_tol=tol))
     assert r.status == "periodic"
     assert r.n_gait_steps == first[k], (first, tol)
     assert r.t_final == tab["t_touch_down"][first[k] - 1]
@@ -153,7 +155,7 @@ def test_steady_averages_the_last_steps():
 
 
 def test_steady_of_a_run_is_the_mean_of_its_last_steps():
-    r = pdw.simulate(t_end=8.0, params=STEADY, record_every=0)
+    r = pdw.simulate(t_end=8.0, params=STEADY, record=pdw.Record(every=0))
     st = pdw.steps(r)
     for last in (1, 2, 4):
         sd = st.steady(last)

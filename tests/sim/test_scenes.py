@@ -43,14 +43,14 @@ def _agree(table, n, k, tol):
 @pytest.fixture(scope="module")
 def full_10s():
     """paper_steady from the paper's x0, 10 s, everything recorded (events included)."""
-    return pdw.simulate(t_end=10.0, params=STEADY, record_every=1, record_forces=True)
+    return pdw.simulate(t_end=10.0, params=STEADY, record=pdw.Record(every=1, forces=True))
 
 
 # ------------------------------------------------------------------ online gait analysis
 
 def test_descriptors_only_gives_the_steps_of_a_full_run(full_10s):
-    d = pdw.simulate(t_end=10.0, params=STEADY, record_every=0, record_forces=False,
-                     record_events=False)
+    d = pdw.simulate(t_end=10.0, params=STEADY,
+                     record=pdw.Record(every=0, forces=False, events=False))
     assert d.walked and d.events == [] and len(d.t) == 0 and d.Fn.shape == (0, 2)
     assert np.array_equal(d.x_final, full_10s.x_final)          # recording changes nothing
     ref = pdw.steps(full_10s)
@@ -66,14 +66,14 @@ def test_descriptors_only_gives_the_steps_of_a_full_run(full_10s):
 
 def test_online_steps_of_the_paper_run_match_pdw_steps_for_every_variant():
     for variant in _layout.VARIANTS:
-        r = pdw.simulate(variant=variant, record_every=0)
+        r = pdw.simulate(variant=variant, record=pdw.Record(every=0))
         _assert_steps_equal(r.gait, pdw.steps(r))
         assert len(r.gait) >= 3
 
 
 def test_ring_keeps_the_last_steps_of_a_long_run():
-    full = pdw.simulate(t_end=25.0, params=STEADY, record_every=0)
-    d = pdw.simulate(t_end=25.0, params=STEADY, record_every=0, record_events=False)
+    full = pdw.simulate(t_end=25.0, params=STEADY, record=pdw.Record(every=0))
+    d = pdw.simulate(t_end=25.0, params=STEADY, record=pdw.Record(every=0, events=False))
     ref = pdw.steps(full)
     assert len(ref) > _layout.STEP_RING and d.n_gait_steps == len(ref)
     assert len(d.gait) == _layout.STEP_RING
@@ -83,9 +83,9 @@ def test_ring_keeps_the_last_steps_of_a_long_run():
 
 def test_descriptors_only_memory_does_not_grow_with_the_run():
     def peak(t_end):
-        pdw.simulate(t_end=t_end, params=STEADY, record_every=0, record_events=False)
+        pdw.simulate(t_end=t_end, params=STEADY, record=pdw.Record(every=0, events=False))
         tracemalloc.start()
-        r = pdw.simulate(t_end=t_end, params=STEADY, record_every=0, record_events=False)
+        r = pdw.simulate(t_end=t_end, params=STEADY, record=pdw.Record(every=0, events=False))
         _, p = tracemalloc.get_traced_memory()
         tracemalloc.stop()
         assert r.walked
@@ -100,8 +100,8 @@ def test_descriptors_only_memory_does_not_grow_with_the_run():
 
 @pytest.mark.parametrize("k, tol", [(3, 1e-3), (4, 2e-3), (5, 5e-4)])
 def test_stop_when_periodic_stops_as_soon_as_the_last_k_steps_agree(k, tol, full_10s):
-    r = pdw.simulate(t_end=10.0, params=STEADY, record_every=0, periodic_steps=k,
-                     periodic_tol=tol)
+    r = pdw.simulate(t_end=10.0, params=STEADY, record=pdw.Record(every=0),
+                     stop=pdw.Stop(periodic=True, periodic_steps=k, periodic_tol=tol))
     assert r.status == "periodic" and r.stop_reason == "periodic" and r.walked
     assert r.t_final < 10.0
     ref = pdw.steps(full_10s)
@@ -123,7 +123,8 @@ def test_stop_when_periodic_stops_as_soon_as_the_last_k_steps_agree(k, tol, full
 
 def test_a_gait_that_does_not_converge_is_not_stopped():
     """The paper's d_hip = 0.018 gait decays and falls (docs/model.md section 8): no periodic stop."""
-    r = pdw.simulate(t_end=8.0, record_every=0, periodic_steps=4, periodic_tol=1e-4)
+    r = pdw.simulate(t_end=8.0, record=pdw.Record(every=0),
+                     stop=pdw.Stop(periodic=True, periodic_steps=4, periodic_tol=1e-4))
     assert r.status == "fell" and r.stop_reason == "fell"
 
 
@@ -144,8 +145,8 @@ def test_every_method_stops_after_n_steps(method, kw):
 
 @pytest.mark.parametrize("method", ["cdm", "rodas4"])
 def test_every_method_stops_when_periodic(method):
-    r = pdw.simulate(t_end=12.0, params=STEADY, method=method, record_every=0,
-                     periodic_steps=3, periodic_tol=2e-3)
+    r = pdw.simulate(t_end=12.0, params=STEADY, method=method, record=pdw.Record(every=0),
+                     stop=pdw.Stop(periodic=True, periodic_steps=3, periodic_tol=2e-3))
     assert r.status == "periodic" and r.t_final < 12.0
     assert _agree(r.gait.table, len(r.gait), 3, 2e-3)
 
@@ -181,8 +182,9 @@ def test_recording_options_do_what_they_say():
 
 def test_switched_off_forces_use_the_specialized_kernel_and_equal_zeroed_parameters():
     feats = ("normal_damping", "tangential", "friction")          # no hip spring or damper
-    a = pdw.simulate(t_end=0.6, params=STEADY, features=feats, record_every=50)
-    b = pdw.simulate(t_end=0.6, params=STEADY.replace(k_hip=0.0, d_hip=0.0), record_every=50)
+    a = pdw.simulate(t_end=0.6, params=STEADY, features=feats, record=pdw.Record(every=50))
+    b = pdw.simulate(t_end=0.6, params=STEADY.replace(k_hip=0.0, d_hip=0.0),
+                     record=pdw.Record(every=50))
     assert a.params == STEADY.replace(k_hip=0.0, d_hip=0.0)
     assert a.features == feats and a.status == b.status
     np.testing.assert_allclose(a.x, b.x, rtol=1e-9, atol=1e-9)
@@ -198,8 +200,8 @@ def test_scene_runs_like_simulate_with_its_settings():
                stop={"t_end": 2.0})
     a = pdw.run(sc)
     b = pdw.simulate(sc)
-    c = pdw.simulate(t_end=2.0, params=pdw.Params.paper_steady(k_hip=0.9), record_every=0,
-                     record_forces=False)
+    c = pdw.simulate(t_end=2.0, params=pdw.Params.paper_steady(k_hip=0.9),
+                     record=pdw.Record(every=0, forces=False))
     assert a.scene is sc and b.scene == sc
     assert np.array_equal(a.x_final, c.x_final) and a.events == c.events == b.events
     with pytest.raises(pdw.InvalidInputError, match="dt"):

@@ -26,8 +26,8 @@ def test_cdm_converges_at_first_order_without_ground():
     dts = np.array([1e-3, 5e-4, 2.5e-4, 1.25e-4])
     err = []
     for dt in dts:
-        r = pdw.simulate(FLIGHT_X0, 0.5, dt, params=p, flags0=(0, 0), record_every=0,
-                         check_step="off")  # no ground: no contact step limit
+        r = pdw.simulate(FLIGHT_X0, 0.5, dt, params=p, flags0=(0, 0),
+                         integrator=pdw.Integrator(check_step="off"), record=pdw.Record(every=0))  # no ground: no contact step limit
         assert r.status == "walked" and r.events == []
         err.append(np.abs(r.x_final - ref).max())
     slope = np.polyfit(np.log(dts), np.log(err), 1)[0]
@@ -79,12 +79,12 @@ def test_a_foot_touching_down_ahead_is_caught():
 def test_paper_params_fall_after_a_few_steps_paper_steady_walks():
     """docs/model.md section 8: with d_hip = 0.018 the gait decays and falls after 6-9 steps (4-6 s)."""
     for variant in ("paper", "consistent"):
-        r = pdw.simulate(t_end=20.0, variant=variant, record_every=0)
+        r = pdw.simulate(t_end=20.0, variant=variant, record=pdw.Record(every=0))
         assert r.status == "fell", variant
         assert 3.0 < r.failure["t"] < 7.0
         assert 4 <= len(pdw.steps(r)) <= 10
         steady = pdw.simulate(t_end=20.0, variant=variant, params=pdw.Params.paper_steady(),
-                              record_every=0)
+                              record=pdw.Record(every=0))
         assert steady.status == "walked"
         st = pdw.steps(steady).steady(4)
         assert st["spread_L"] < 1e-3 and st["spread_P"] < 1e-3
@@ -92,8 +92,8 @@ def test_paper_params_fall_after_a_few_steps_paper_steady_walks():
 
 def test_recording_is_optional_and_events_are_always_kept():
     full = pdw.simulate(t_end=1.5)
-    none = pdw.simulate(t_end=1.5, record_every=0)
-    every10 = pdw.simulate(t_end=1.5, record_every=10, record_forces=False)
+    none = pdw.simulate(t_end=1.5, record=pdw.Record(every=0))
+    every10 = pdw.simulate(t_end=1.5, record=pdw.Record(every=10, forces=False))
     assert none.x.shape == (0, 8) and none.events == full.events
     assert every10.events == full.events
     assert len(full.t) == 15001 and len(every10.t) == 1501
@@ -123,7 +123,8 @@ def test_divergence_stops_with_time_state_and_reason():
     assert 0 <= err.t < 3.5 and err.x.shape == (8,) and np.isfinite(err.x).all()
     assert "diverged at t =" in str(err) and err.reason
     assert err.result is not None and err.result.status == "diverged"
-    r = pdw.simulate(dt=1e-3, t_end=3.5, params=p, on_failure="return", check_step="off")
+    r = pdw.simulate(dt=1e-3, t_end=3.5, params=p, integrator=pdw.Integrator(check_step="off"),
+                     limits=pdw.Limits(on_failure="return"))
     assert r.status == "diverged" and r.failure["t"] == err.t
     assert np.isfinite(r.x).all()
 
@@ -180,7 +181,7 @@ def test_simulate_refuses_states_that_are_not_states(x0, what):
 def test_fall_hip_height_must_be_a_finite_number(value):
     """fall_hip_height = nan switched fall detection off."""
     with pytest.raises(pdw.InvalidInputError, match="fall_hip_height"):
-        pdw.simulate(t_end=0.01, fall_hip_height=value)
+        pdw.simulate(t_end=0.01, limits=pdw.Limits(fall_hip_height=value))
 
 
 @pytest.mark.parametrize("value", [math.nan, None, 2 ** 70, 1.5, -1, "1", True])

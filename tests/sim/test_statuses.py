@@ -26,8 +26,9 @@ REASON = {"foot": "a foot sank deeper than fall_depth below the ground",
 @pytest.fixture(scope="module")
 def free():
     """The paper's run, 2 s, every sample, no fall limits in reach."""
-    return pdw.simulate(t_end=2.0, dt=DT, record_every=1, check_step="off", fall_depth=1.0,
-                        fall_hip_height=0.0)
+    return pdw.simulate(t_end=2.0, dt=DT, integrator=pdw.Integrator(check_step="off"),
+                        record=pdw.Record(every=1),
+                        limits=pdw.Limits(fall_depth=1.0, fall_hip_height=0.0))
 
 
 @pytest.mark.parametrize("depth", [0.0035, 0.0041, 0.0042])
@@ -36,8 +37,9 @@ def test_a_foot_too_deep_is_a_fall_of_that_leg(free, depth):
     n = int(np.argmax((d > depth).any(axis=1)))
     assert (d[n] > depth).any() and not (d[:n] > depth).any()
     leg = int(np.argmax(d[n] > depth)) + 1
-    r = pdw.simulate(t_end=2.0, dt=DT, record_every=1, check_step="off", fall_depth=depth,
-                     on_failure="return")
+    r = pdw.simulate(t_end=2.0, dt=DT, integrator=pdw.Integrator(check_step="off"),
+                     record=pdw.Record(every=1),
+                     limits=pdw.Limits(fall_depth=depth, on_failure="return"))
     assert r.status == "fell" and r.failure["reason"] == REASON["foot"]
     assert r.failure["leg"] == leg
     assert r.failure["t"] == pytest.approx(free.t[n], abs=1e-12)
@@ -48,8 +50,9 @@ def test_a_foot_too_deep_is_a_fall_of_that_leg(free, depth):
 def test_a_low_hip_is_a_fall(free, height):
     n = int(np.argmax(free.x[:, 1] < height))              # the first state below
     assert n > 0 and free.x[n, 1] < height <= free.x[:n, 1].min()
-    r = pdw.simulate(t_end=2.0, dt=DT, record_every=1, check_step="off", fall_hip_height=height,
-                     on_failure="return")
+    r = pdw.simulate(t_end=2.0, dt=DT, integrator=pdw.Integrator(check_step="off"),
+                     record=pdw.Record(every=1),
+                     limits=pdw.Limits(fall_hip_height=height, on_failure="return"))
     assert r.status == "fell" and r.failure["reason"] == REASON["hip"]
     assert r.failure["leg"] is None
     assert r.failure["t"] == pytest.approx(free.t[n - 1], abs=1e-12)
@@ -82,12 +85,13 @@ def test_a_leg_turning_past_a_full_turn_is_a_runaway(leg):
     x0 = np.array(pdw.X0_PAPER, float)
     x0[1] += 1.0
     x0[5 + leg] = 300.0
-    r = pdw.simulate(x0, t_end=0.05, dt=1e-5, method="rk4", flags0=(0, 0), record_every=10,
-                     check_step="off", on_failure="return")
+    r = pdw.simulate(x0, t_end=0.05, dt=1e-5, method="rk4", flags0=(0, 0),
+                     integrator=pdw.Integrator(check_step="off"), record=pdw.Record(every=10),
+                     limits=pdw.Limits(on_failure="return"))
     assert abs(r.x_final[1 + leg]) > 2 * np.pi > abs(r.x_final[4 - leg])       # only this leg
     assert r.status == "diverged" and "runaway" in r.failure["reason"], r.status
     b = pdw.simulate_batch(x0[None, :], t_end=0.05, dt=1e-5, method="rk4", flags0=(0, 0),
-                           check_step="off")
+                           integrator=pdw.Integrator(check_step="off"))
     assert b.status[0] == "diverged" and "runaway" in b.failure_reason[0]
 
 
@@ -111,7 +115,7 @@ def test_batch_no_steps_is_judged_on_touch_downs():
     is enough to be "walked"."""
     from pdw.sim.chunks import honest
     x0 = np.tile(np.asarray(pdw.X0_PAPER, float), (3, 1))
-    b = pdw.simulate_batch(x0, t_end=0.2, check_step="off")
+    b = pdw.simulate_batch(x0, t_end=0.2, integrator=pdw.Integrator(check_step="off"))
     assert list(b.status) == ["walked"] * 3
     period = 2 * np.pi * np.sqrt(pdw.Params.paper().l / pdw.Params.paper().g)
     b.t_final[:] = 2.01 * period
@@ -143,27 +147,28 @@ def test_a_run_without_any_touch_down_is_not_walked():
     x0[2:4] = (0.3, -0.3)
     x0[1] = p.r + (p.l - p.r) * np.cos(0.3) - 2e-4
     r = pdw.simulate(x0=x0, params=p, t_end=4.0, flags0=(1, 1), method="rodas4",
-                     on_failure="return", record_every=0)
+                     record=pdw.Record(every=0), limits=pdw.Limits(on_failure="return"))
     assert r.event_counts["touch_down"] == 0
     assert r.status == "no_steps" and not r.walked
     # the typical gait still walks
-    assert pdw.simulate(t_end=3.5, record_every=0).status == "walked"
+    assert pdw.simulate(t_end=3.5, record=pdw.Record(every=0)).status == "walked"
 
 
 def test_a_stiff_friction_law_stops_at_the_step_budget():
     """rodas4 with a valid v_s = 1e-12 took 1.8 M steps for 10 ms; now it stops at max_steps."""
-    r = pdw.simulate(method="rodas4", params=pdw.Params(v_s=1e-12), t_end=0.01, record_every=0,
-                     on_failure="return", max_steps=20000)
+    r = pdw.simulate(method="rodas4", params=pdw.Params(v_s=1e-12), t_end=0.01,
+                     integrator=pdw.Integrator(max_steps=20000), record=pdw.Record(every=0),
+                     limits=pdw.Limits(on_failure="return"))
     assert r.status == "diverged" and "step budget" in r.failure["reason"]
     assert r.stats["steps"] + r.stats["rejected"] == 20000
     with pytest.raises(pdw.DivergedError, match="max_steps"):
-        pdw.simulate(method="dopri5", params=pdw.Params(d_hip=1e12), t_end=1.0, record_every=0,
-                     max_steps=5000)
+        pdw.simulate(method="dopri5", params=pdw.Params(d_hip=1e12), t_end=1.0,
+                     integrator=pdw.Integrator(max_steps=5000), record=pdw.Record(every=0))
 
 
 def test_a_fixed_step_run_longer_than_the_budget_is_refused():
     with pytest.raises(pdw.InvalidInputError, match="max_steps"):
-        pdw.simulate(t_end=10.0, dt=1e-4, max_steps=1000)
+        pdw.simulate(t_end=10.0, dt=1e-4, integrator=pdw.Integrator(max_steps=1000))
 
 
 def test_polling_changes_no_number():
@@ -189,7 +194,8 @@ def test_non_finite_energies_at_a_finite_state_make_the_run_diverged():
     max_speed out of the way): the status check now calls that run diverged, at the last
     sample before the first non-finite energy."""
     from pdw.sim.simulation import _honest
-    r = pdw.simulate(t_end=0.01, record_every=1, check_step="off", record_energies=True)
+    r = pdw.simulate(t_end=0.01, integrator=pdw.Integrator(check_step="off"),
+                     record=pdw.Record(every=1, energies=True))
     raw = {"x": r.x, "t": r.t, "x_final": r.x_final, "t_final": r.t_final,
            "event_counts": {"touch_down": 1}, "failure": None}
     energies = {k: v.copy() for k, v in r.energies.items()}
@@ -206,7 +212,8 @@ def test_an_early_fall_of_a_very_long_run_reserves_no_record_for_t_end():
     MemoryError); the record now grows in chunks, and this walker falls after 1.2 s."""
     x0 = np.array(pdw.X0_PAPER)
     x0[4] = x0[6] = 0.0
-    r = pdw.simulate(x0=x0, t_end=1e5, dt=1e-4, on_failure="return", record_every=1)
+    r = pdw.simulate(x0=x0, t_end=1e5, dt=1e-4, record=pdw.Record(every=1),
+                     limits=pdw.Limits(on_failure="return"))
     assert r.status == "fell" and r.t_final < 2
     assert len(r.t) >= r.n_steps and r.t[-1] <= r.t_final
     assert np.array_equal(r.t[:100], np.arange(100) * 1e-4)

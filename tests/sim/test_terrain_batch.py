@@ -39,16 +39,18 @@ def test_each_walker_on_its_ground_is_its_scalar_run(method, lanes, threads):
     gs = _grounds()
     x = np.tile(np.asarray(pdw.X0_PAPER, float), (len(gs), 1))
     b = simulate_batch(x, t_end=T_END, params=P, method=method, lanes=lanes, threads=threads,
-                       ground=gs, check_step="off")
+                       ground=gs, integrator=pdw.Integrator(check_step="off"))
     statuses = set()
     for i, g in enumerate(gs):
-        r = pdw.simulate(x[i], t_end=T_END, params=P, method=method, record_every=0,
-                         on_failure="return", check_step="off", ground=g)
+        r = pdw.simulate(x[i], t_end=T_END, params=P, method=method, ground=g,
+                         integrator=pdw.Integrator(check_step="off"), record=pdw.Record(every=0),
+                         limits=pdw.Limits(on_failure="return"))
         _assert_same(b, i, r)
         statuses.add(r.status)
     assert "off_ground" in statuses and "walked" in statuses
     # the grounds matter: the same walkers on flat ground end elsewhere
-    flat = simulate_batch(x, t_end=T_END, params=P, method=method, check_step="off")
+    flat = simulate_batch(x, t_end=T_END, params=P, method=method,
+                          integrator=pdw.Integrator(check_step="off"))
     assert np.abs(flat.x_final[1] - b.x_final[1]).max() > 1e-6
     assert np.array_equal(flat.x_final[0], b.x_final[0])
 
@@ -57,9 +59,10 @@ def test_one_ground_for_all_and_chunks():
     x = np.tile(np.asarray(pdw.X0_PAPER, float), (5, 1))
     x[:, 6] += np.linspace(-0.2, 0.2, 5)
     g = Ground.step(0.7, -0.004)
-    a = simulate_batch(x, t_end=T_END, params=P, ground=g, check_step="off")
-    c = simulate_batch(x, t_end=T_END, params=P, ground=[g] * 5, chunk_size=2, check_step="off",
-                       record=[3])
+    a = simulate_batch(x, t_end=T_END, params=P, ground=g,
+                       integrator=pdw.Integrator(check_step="off"))
+    c = simulate_batch(x, t_end=T_END, params=P, ground=[g] * 5, chunk_size=2, record=[3],
+                       integrator=pdw.Integrator(check_step="off"))
     np.testing.assert_array_equal(a.x_final, c.x_final)
     assert c.recorded[3].ground == g
     np.testing.assert_array_equal(c.recorded[3].x_final, c.x_final[3])

@@ -43,7 +43,8 @@ def test_hierarchy():
 def test_diverged_error_carries_time_state_reason_and_partial_result():
     """Explicit normal damping d_n = 1e7 at dt = 1e-3: the contact runs away."""
     with pytest.raises(DivergedError) as ei:
-        pdw.simulate(dt=1e-3, params=pdw.Params(d_n=1e7), check_step="off")
+        pdw.simulate(dt=1e-3, params=pdw.Params(d_n=1e7),
+                     integrator=pdw.Integrator(check_step="off"))
     e = ei.value
     assert 0 <= e.t < 3.5 and e.x.shape == (8,) and np.isfinite(e.x).all()
     assert "max_speed" in e.reason and "%.6g" % e.t in str(e)
@@ -100,7 +101,8 @@ def test_singular_system_error_carries_time_state_reason(monkeypatch):
         return captured["raw"]
 
     monkeypatch.setattr(sim._core, "run", capture)
-    r = pdw.simulate(t_end=0.01, record_every=1, check_step="off")
+    r = pdw.simulate(t_end=0.01, integrator=pdw.Integrator(check_step="off"),
+                     record=pdw.Record(every=1))
     raw = dict(captured["raw"], status=pdw.core._layout.STATUS.index("singular"),
                failure={"t": 0.005, "x": r.x[50], "reason": 5, "leg": -1})
     with pytest.raises(SingularSystemError) as ei:
@@ -130,7 +132,7 @@ def test_fell_error_of_the_hybrid_model_carries_a_state():
 
 
 def test_fell_is_a_status_with_time_state_reason():
-    r = pdw.simulate(t_end=8.0, params=pdw.Params.paper(), record_every=0)
+    r = pdw.simulate(t_end=8.0, params=pdw.Params.paper(), record=pdw.Record(every=0))
     assert r.status == "fell"
     f = r.failure
     assert 3.0 < f["t"] < 8.0 and f["x"].shape == (8,) and np.isfinite(f["x"]).all()
@@ -184,12 +186,13 @@ def test_check_step_error_refuses_and_off_is_silent():
     P = pdw.Params(d_n=1e7)
     lim = SL.step_limit(P, "rk4")
     with pytest.raises(StepSizeError, match="%.2g" % lim.dt_max) as ei:
-        pdw.simulate(dt=3 * lim.dt_max, params=P, method="rk4", check_step="error")
+        pdw.simulate(dt=3 * lim.dt_max, params=P, method="rk4",
+                     integrator=pdw.Integrator(check_step="error"))
     assert ei.value.limit == lim.dt_max and ei.value.force == lim.force == "d_n"
     _no_warning(dt=3 * lim.dt_max, params=P, method="rk4", check_step="off", on_failure="return",
                 record_every=0)
     with pytest.raises(InvalidInputError, match="check_step"):
-        pdw.simulate(check_step="yes")
+        pdw.simulate(integrator=pdw.Integrator(check_step="yes"))
 
 
 def test_adaptive_methods_are_not_checked():
@@ -290,8 +293,8 @@ def test_ten_thousand_steps_stay_on_the_limit_cycle():
     """Params.paper_steady(), 5,800 s (about 10,000 walking steps), rodas4 at rtol 1e-6 (~7 s):
     every descriptor after the first 100 steps equals the last 100 steps' mean to 2e-5
     (relative), and the mean does not drift (first vs last 100 steps: 1e-6)."""
-    r = pdw.simulate(params=pdw.Params.paper_steady(), t_end=5800.0, method="rodas4", rtol=1e-6,
-                     atol=1e-8, record_every=0)
+    r = pdw.simulate(params=pdw.Params.paper_steady(), t_end=5800.0, method="rodas4",
+                     integrator=pdw.Integrator(rtol=1e-6, atol=1e-8), record=pdw.Record(every=0))
     assert r.status == "walked"
     _finite_result(r)
     n, out = _steady(r)
@@ -307,7 +310,7 @@ def test_ten_thousand_steps_with_the_papers_method():
     shift the cycle (L by 0.1 %), but it stays on it: L, P, v within 2e-3 (relative) of the
     last 100 steps' mean, no drift above 2e-4; the double support, quantized by dt, within
     2 dt and no drift above 1 dt."""
-    r = pdw.simulate(params=pdw.Params.paper_steady(), t_end=5800.0, record_every=0)
+    r = pdw.simulate(params=pdw.Params.paper_steady(), t_end=5800.0, record=pdw.Record(every=0))
     assert r.status == "walked"
     n, out = _steady(r)
     assert n >= 9950
@@ -324,8 +327,9 @@ def test_ten_thousand_steps_with_the_papers_method():
 @pytest.fixture(scope="module")
 def balance_runs():
     P = pdw.Params.paper_steady()
-    return {rtol: pdw.simulate(params=P, method="rodas4", rtol=rtol, atol=rtol * 1e-2, h_max=1e-3,
-                               record_every=1)
+    return {rtol: pdw.simulate(params=P, method="rodas4",
+                               integrator=pdw.Integrator(rtol=rtol, atol=rtol * 1e-2, h_max=1e-3),
+                               record=pdw.Record(every=1))
             for rtol in (1e-5, 1e-8)}
 
 
@@ -352,7 +356,8 @@ def test_energy_residual_shrinks_with_the_tolerance(balance_runs):
 
 def test_energy_balance_consistent_variant():
     r = pdw.simulate(params=pdw.Params.paper_steady(), variant="consistent", method="rodas4",
-                     rtol=1e-8, atol=1e-10, h_max=1e-3, record_every=1, t_end=1.5)
+                     t_end=1.5, integrator=pdw.Integrator(rtol=1e-8, atol=1e-10, h_max=1e-3),
+                     record=pdw.Record(every=1))
     b = S.energy_balance(r)
     assert np.max(np.abs(b["residual"])) < 1e-6
 

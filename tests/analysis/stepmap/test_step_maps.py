@@ -116,14 +116,14 @@ def test_stop_touch_down_ends_at_the_event(method):
     """simulate(stop_touch_down=k) stops at leg k's first touch-down with the event's state:
     the sample a full recorded run has at that event; the batch says the same."""
     x0 = pdw.X0_PAPER
-    full = pdw.simulate(x0, t_end=1.0, method=method, record_events=True)
+    full = pdw.simulate(x0, t_end=1.0, method=method, record=pdw.Record(events=True))
     td = next(e for e in full.events if e.kind == "touch_down" and e.leg == 1)
-    r = pdw.simulate(x0, t_end=1.0, method=method, stop_touch_down=1)
+    r = pdw.simulate(x0, t_end=1.0, method=method, stop=pdw.Stop(touch_down=1))
     assert r.stop_reason == "touch_down" and r.status == "walked"
     i = int(np.argmin(np.abs(full.t - td.t)))
     assert r.t_final == pytest.approx(td.t, abs=0) or method == "cdm"
     np.testing.assert_array_equal(r.x_final, full.x[i])
-    b = pdw.simulate_batch(np.array([x0]), t_end=1.0, method=method, stop_touch_down=1)
+    b = pdw.simulate_batch(np.array([x0]), t_end=1.0, method=method, stop=pdw.Stop(touch_down=1))
     assert b.stop_reason[0] == "touch_down"
     np.testing.assert_array_equal(b.x_final[0], r.x_final)
 
