@@ -11,6 +11,7 @@ and docs/figures/continuation_*.png.
     python benchmarks/continuation.py simplest_limit  # simplest walker's doubling, m_l/m_h -> 0
     python benchmarks/continuation.py kelvin_voigt    # Kelvin-Voigt's d_n branch (docs/contact_laws.md)
     python benchmarks/continuation.py codim2    # compass doubling curve in (slope, c): CPU time
+    python benchmarks/continuation.py goswami   # compass regions in (slope, b/a), (slope, m_H/m)
     python benchmarks/continuation.py chaos     # orbit diagram, Lyapunov exponents, Feigenbaum
     python benchmarks/continuation.py monodromy # exact (variational) vs finite-difference M
 """
@@ -318,6 +319,74 @@ def part_codim2(rounds=3):
     say("wrote docs/figures/continuation_codim2.png")
 
 
+def part_goswami():
+    """Goswami, Thuilot & Espiau's regions of the compass gait in the issue's axes: where the
+    period-1 gait exists (below the end curve, the trailing foot leaves the ground), where it is
+    stable (below its first doubling PD1), and where the period-2 gait is (PD1 to PD2)."""
+    from pdw.analysis.codim2 import continue_bifurcation
+    say("== compass gait: regions in (slope, b/a) and (slope, m_H/m) (hybrid, exact M) ==")
+    say("load average before: %s" % (os.getloadavg(),))
+    C = H.compass_gait_params()
+    axes = {"b/a": (lambda P, r: P.replace(c=r / (1 + r) * P.l), 1.0, (0.25, 3.0)),
+            "m_H/m": (lambda P, r: P.replace(m_h=r * P.m_l), 2.0, (0.1, 10.0))}
+    t0 = time.process_time()
+    b = continue_gait(C, "gamma", 15 * DEG, model="hybrid", max_points=400)
+    pd1, ep = b.of_kind("period_doubling")[0], b.of_kind("end")[0]
+    g2 = b.switch(pd1)
+    b2 = continue_gait(g2.params, "gamma", 6 * DEG, model="hybrid", period=2, start=g2)
+    pd2 = b2.of_kind("period_doubling")[0]
+    curves = {}
+    for name, (of, v0, stops) in axes.items():
+        for lab, bif in (("PD1", pd1), ("PD2", pd2), ("end", ep)):
+            parts = []
+            for s in stops:
+                c0 = time.process_time()
+                cv = continue_bifurcation(bif, name, s, params_of=of, value=v0, max_points=300)
+                say("%-5s %-3s %s %.2f -> %.4g: %d points, %d maps, %.2f s CPU; gamma %.4f -> "
+                    "%.4f deg; stop: %s" % (name, lab, name, v0, cv.values[-1, 1], len(cv),
+                                            cv.n_maps, time.process_time() - c0,
+                                            cv.values[0, 0] / DEG, cv.values[-1, 0] / DEG,
+                                            cv.stop_reason))
+                parts.append(cv.values[::-1] if s < v0 else cv.values)
+            v = np.vstack([parts[0], parts[1][1:]])
+            curves[name, lab] = v
+            for r in (0.5, 1.0, 2.0) if name == "b/a" else (0.5, 2.0, 5.0):
+                if v[:, 1].min() <= r <= v[:, 1].max():
+                    say("      at %s = %.2f: gamma = %.4f deg" % (name, r, np.interp(
+                        r, v[:, 1], v[:, 0]) / DEG))
+    say("all curves: %.1f s CPU" % (time.process_time() - t0))
+    say("load average after: %s" % (os.getloadavg(),))
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axs = plt.subplots(1, 2, figsize=(10, 4.2), layout="constrained")
+    for ax, name in zip(axs, axes):
+        c1, c2 = curves[name, "PD1"] / [DEG, 1], curves[name, "PD2"] / [DEG, 1]
+        # polygons: slope 0 to PD1 (period 1 stable), PD1 to PD2 (period 2 stable); both
+        # doubling curves end on the end curve, which closes them there
+        e = curves[name, "end"] / [DEG, 1]
+        e = e[e[:, 1] < c1[0, 1]]              # the end curve below the corner (PD1 meets it)
+        ax.fill(np.r_[e[:, 0], c1[:, 0], 0, 0], np.r_[e[:, 1], c1[:, 1], c1[-1, 1], e[0, 1]],
+                color="C2", alpha=0.25, lw=0, label="period-1 gait stable")
+        ax.fill(np.r_[c1[:, 0], c2[::-1, 0]], np.r_[c1[:, 1], c2[::-1, 1]], color="C1",
+                alpha=0.25, lw=0, label="period-2 gait stable")
+        for k, st in (("PD1", "C2-"), ("PD2", "C1-"), ("end", "k--")):
+            c = curves[name, k]
+            ax.plot(c[:, 0] / DEG, c[:, 1], st, lw=1.5,
+                    label={"PD1": "PD of the period-1 gait", "PD2": "PD of the period-2 gait",
+                           "end": "end: trailing foot stays down"}[k])
+        ax.set_xlabel("slope gamma [deg]")
+        ax.set_ylabel({"b/a": "b/a [-] (hip-to-leg-mass / leg-mass-to-foot)",
+                       "m_H/m": "m_H/m [-] (hip mass / leg mass)"}[name])
+        ax.set_xlim(0, 13)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="upper right" if name == "b/a" else "lower right")
+    axs[0].set_title("compass gait, m_H/m = 2", fontsize=9)
+    axs[1].set_title("compass gait, b/a = 1", fontsize=9)
+    fig.savefig(FIGS / "continuation_goswami.png", dpi=150)
+    say("wrote docs/figures/continuation_goswami.png")
+
+
 def part_chaos():
     from pdw.analysis import chaos
     C = H.compass_gait_params()
@@ -393,7 +462,7 @@ if __name__ == "__main__":
          "dhip": part_dhip, "rigid": part_rigid,
          "rigid_paper": part_rigid_paper, "fig11": part_fig11,
          "simplest_limit": part_simplest_limit, "kelvin_voigt": part_kelvin_voigt,
-         "codim2": part_codim2, "chaos": part_chaos, "monodromy": part_monodromy}[part]()
+         "codim2": part_codim2, "goswami": part_goswami, "chaos": part_chaos, "monodromy": part_monodromy}[part]()
         say("(%s: %.1f s wall; python benchmarks/continuation.py %s)"
             % (part, time.perf_counter() - t0, part))
         RESULTS.mkdir(exist_ok=True)

@@ -1,4 +1,4 @@
-"""Two-parameter continuation of folds and period doublings of gaits (docs/continuation.md).
+"""Two-parameter continuation of folds, period doublings and ends of gaits (docs/continuation.md).
 
 A fold (a multiplier at +1) or a period doubling (a multiplier at -1) of the period-n map P is
 one equation more than a gait: it is followed in a second parameter lambda2 as the solution
@@ -19,6 +19,11 @@ derivatives are d sigma / dx_k = -w^T (dA/dx_k) v, with w from the transposed sy
 dA/dx_k = dM/dx_k is a central difference of the model's exact (hybrid) or finite-difference
 (continuous) M.
 
+An ``end`` (an admissibility function g of the problem through 0, the edge of the family as
+modelled) is followed the same way with sigma replaced by g(z, mu1, mu2) itself (its
+derivatives by central differences of maps, no monodromy). The second parameter may be a
+derived one (``params_of``), e.g. Goswami's b/a or m_H/m.
+
 `AugmentedProblem` presents F as a step map, P~(x) = x + F(x), with M~ = I + dF/dx and
 dP~/dmu2 = dF/dmu2, so the *unchanged* one-parameter engine (`run_continuation`) follows it.
 `continue_bifurcation` returns a `BifurcationCurve` whose ``values`` are (N, 2): the first
@@ -38,8 +43,9 @@ from ..core.params import Params
 from .branch import Bifurcation
 from .gait_maps import Evaluation
 
-#: the bifurcation kinds a curve can follow, and the sign s of A = M + s I
-SIGNS = {"period_doubling": 1.0, "fold": -1.0}
+#: the bifurcation kinds a curve can follow, and the sign s of A = M + s I ("end": the
+#: admissibility function g(z, mu1, mu2) = 0 itself is the extra equation, no A)
+SIGNS = {"period_doubling": 1.0, "fold": -1.0, "end": 0.0}
 
 
 def _null_vectors(A):
@@ -55,13 +61,26 @@ class AugmentedProblem:
     ADMISSIBLE: dict = {}
     lam_rel = 1e-6
 
-    def __init__(self, prob, kind, parameter2, z, mu1, h=1e-6):
+    def __init__(self, prob, kind, parameter2, z, mu1, h=1e-6, params_of=None, value=None,
+                 admissible=None):
         if kind not in SIGNS:
             raise InvalidInputError("continue_bifurcation follows %s, got a %r"
-                                    % (" and ".join(SIGNS), kind))
-        if parameter2 not in Params.__dataclass_fields__:
-            raise InvalidInputError("parameter must be a Params field (%s), got %r"
+                                    % (", ".join(SIGNS), kind))
+        if kind == "end" and admissible not in getattr(prob, "ADMISSIBLE", {}):
+            raise InvalidInputError("an end is followed through its admissibility function "
+                                    "(one of %s), got %r"
+                                    % (", ".join(getattr(prob, "ADMISSIBLE", {})), admissible))
+        self.admissible = admissible
+        if params_of is None and parameter2 not in Params.__dataclass_fields__:
+            raise InvalidInputError("parameter must be a Params field (%s) or come with "
+                                    "params_of, got %r"
                                     % (", ".join(Params.__dataclass_fields__), parameter2))
+        if params_of is not None and not callable(params_of):
+            raise InvalidInputError("params_of must be a callable (params, value) -> Params, "
+                                    "got %s" % type(params_of).__name__)
+        if params_of is not None and value is None:
+            raise InvalidInputError("value= (the start's %s) is needed with params_of"
+                                    % parameter2)
         if parameter2 == prob.parameter:
             raise InvalidInputError("parameter must differ from the bifurcation's own "
                                     "parameter %r" % parameter2)
@@ -82,10 +101,62 @@ class AugmentedProblem:
         self.n_maps = 0
         self.lam_step = 1e-6
         self.opts = dict(getattr(prob, "opts", {}))
-        ev = self._base_eval(np.asarray(z, dtype=float), mu1, getattr(prob.base, parameter2))
+        self._of = params_of
+        self.start2 = float(value) if value is not None else float(getattr(prob.base,
+                                                                           parameter2))
+        ev = self._base_eval(np.asarray(z, dtype=float), mu1, self.start2)
         if not ev.ok:
             raise InvalidInputError("the bifurcation's gait does not evaluate: %s" % ev.status)
         self.a, self.b = _null_vectors(ev.M + self.s * np.eye(prob.dim))
+
+    def _g(self, z, mu1, mu2):
+        """The followed admissibility function at (z, mu1, mu2) (an "end" curve)."""
+        ev = self._base_eval(z, mu1, mu2, False)
+        if not ev.ok:
+            return None, ev.status
+        return float(ev.admissible[self.admissible]), "ok"
+
+    def _evaluate_end(self, x, mu2, jac) -> Evaluation:
+        """F = (P^n(z) - z, g(z, mu1, mu2)) with dg/dx, dg/dmu2 by central differences of g
+        (maps only, no monodromy)."""
+        z, mu1 = np.asarray(x[:-1], dtype=float), float(x[-1])
+        ev = self._base_eval(z, mu1, mu2, jac)
+        if not ev.ok:
+            return Evaluation(False, ev.status)
+        n = len(z)
+        g = float(ev.admissible[self.admissible])
+        F = np.concatenate([ev.Pz - z, [g]])
+        Mt = Pt = None
+        if jac:
+            h2 = self.lam_step
+            e_hi = self._base_eval(z, mu1, mu2 + h2, False)
+            e_lo = self._base_eval(z, mu1, mu2 - h2, False)
+            if not (e_hi.ok and e_lo.ok):
+                return Evaluation(False, "parameter derivative: %s"
+                                  % (e_hi.status if not e_hi.ok else e_lo.status))
+            dg = np.zeros(n + 1)
+            for k in range(n + 1):
+                d = np.zeros(n + 1)
+                d[k] = self.h
+                hi, st_hi = self._g(z + d[:n], mu1 + d[n], mu2)
+                lo, st_lo = self._g(z - d[:n], mu1 - d[n], mu2)
+                if hi is None or lo is None:
+                    return Evaluation(False, "admissibility derivative: %s"
+                                      % (st_hi if hi is None else st_lo))
+                dg[k] = (hi - lo) / (2 * self.h)
+            J = np.zeros((n + 1, n + 1))
+            J[:n, :n] = ev.M - np.eye(n)
+            J[:n, n] = ev.P_lam
+            J[n, :] = dg
+            Mt = np.eye(n + 1) + J
+            Pt = np.concatenate([(e_hi.Pz - e_lo.Pz) / (2 * h2),
+                                 [(e_hi.admissible[self.admissible]
+                                   - e_lo.admissible[self.admissible]) / (2 * h2)]])
+        m = np.linalg.eigvals(ev.M)
+        info = dict(ev.info, base_multipliers=m[np.argsort(-np.abs(m))], sigma=g,
+                    value1=self.p1.value(mu1), M=ev.M)
+        adm = {k: v for k, v in ev.admissible.items() if k != self.admissible}
+        return Evaluation(True, "ok", x + F, Mt, Pt, info, adm)
 
     # the parameter coordinate of lambda2 (linear)
     def value(self, mu):
@@ -94,13 +165,24 @@ class AugmentedProblem:
     def coord(self, value):
         return float(value)
 
+    def _with2(self, mu2):
+        """The base parameters at ``mu2`` of the second parameter (a field, or ``params_of``)."""
+        if self._of is None:
+            return self.base.replace(**{self.parameter: float(mu2)})
+        P = self._of(self.base, float(mu2))
+        if not isinstance(P, Params):
+            raise InvalidInputError("params_of must return a pdw.Params, got %s"
+                                    % type(P).__name__)
+        return P
+
     def params_at(self, mu2, mu1):
-        return self.p1.params_at(mu1).replace(**{self.parameter: float(mu2)})
+        self.p1.base = self._with2(mu2)
+        return self.p1.params_at(mu1)
 
     def _base_eval(self, z, mu1, mu2, jac=True) -> Evaluation:
         try:
-            self.p1.base = self.base.replace(**{self.parameter: float(mu2)})
-        except ValueError as e:
+            self.p1.base = self._with2(mu2)
+        except (ValueError, InvalidInputError) as e:
             return Evaluation(False, "invalid parameter: %s = %r: %s" % (self.parameter, mu2, e))
         n0 = self.p1.n_maps
         ev = self.p1.evaluate(z, mu1, jac)
@@ -119,6 +201,8 @@ class AugmentedProblem:
         return vs[-1], vs[:n], ws[:n]
 
     def evaluate(self, x, mu2, jac=True) -> Evaluation:
+        if self.kind == "end":
+            return self._evaluate_end(x, mu2, jac)
         z, mu1 = np.asarray(x[:-1], dtype=float), float(x[-1])
         ev = self._base_eval(z, mu1, mu2, True)
         if not ev.ok:
@@ -166,7 +250,7 @@ class AugmentedProblem:
         """Refresh the border vectors a, b at an accepted point (BifurcationKit's
         ``update_minaug_every_step``), called by the engine."""
         M = pt.ev.info.get("M")
-        if M is not None:
+        if M is not None and self.kind != "end":
             self.a, self.b = _null_vectors(M + self.s * np.eye(len(M)))
 
     def gait(self, x, mu2, ev, multipliers):
@@ -177,12 +261,12 @@ class AugmentedProblem:
 
 @dataclass(eq=False)
 class BifurcationCurve:
-    """A fold or period-doubling curve in two parameters (`continue_bifurcation`).
+    """A fold, period-doubling or end curve in two parameters (`continue_bifurcation`).
 
     Attributes
     ----------
     kind : str
-        "fold" or "period_doubling".
+        "fold", "period_doubling" or "end".
     parameters : tuple of str
         (the bifurcation's own parameter, the second parameter).
     values : ndarray (N, 2)
@@ -235,16 +319,19 @@ class BifurcationCurve:
 def continue_bifurcation(bifurcation: Bifurcation, parameter: str, stop: float, *,
                          step: float | None = None, max_points: int = 200,
                          tol: float = 1e-9, max_newton: int = 10, fd_step: float = 1e-6,
+                         params_of: Any = None, value: float | None = None,
                          **kw: Any) -> BifurcationCurve:
-    """Follow a located fold or period doubling of a branch in a second parameter.
+    """Follow a located fold, period doubling or end of a branch in a second parameter.
 
     Parameters
     ----------
     bifurcation : Bifurcation
-        A located ``fold`` or ``period_doubling`` of a `pdw.continue_gait` branch (it carries
-        its problem: model, period, options).
+        A located ``fold``, ``period_doubling`` or ``end`` of a `pdw.continue_gait` branch (it
+        carries its problem: model, period, options). An end is followed as the curve where
+        its admissibility function is 0 (the edge of the gait's existence as modelled).
     parameter : str
-        The second parameter (a `pdw.Params` field other than the branch's).
+        The second parameter (a `pdw.Params` field other than the branch's, or any name with
+        ``params_of``).
     stop : float
         Continue until ``parameter`` reaches ``stop`` (or ``max_points``, or the curve ends).
     step : float, optional
@@ -254,6 +341,12 @@ def continue_bifurcation(bifurcation: Bifurcation, parameter: str, stop: float, 
     fd_step : float
         Difference step of the second derivatives dM/dx (default 1e-6: M is exact for the
         hybrid model; use about 1e-4 with the continuous model's finite-difference M).
+    params_of : callable (Params, float) -> Params, optional
+        A derived second parameter: the branch's base parameters at ``parameter`` = value,
+        e.g. Goswami's b/a, ``lambda P, r: P.replace(c=r / (1 + r))``. The bifurcation's own
+        parameter is applied on top of it.
+    value : float, optional
+        The start's ``parameter`` (needed with ``params_of``; default: the base's field).
     **kw
         `run_continuation`'s other options (``max_newton``, ``step_max``, ``at``, ...).
 
@@ -274,10 +367,13 @@ def continue_bifurcation(bifurcation: Bifurcation, parameter: str, stop: float, 
     if not bifurcation.located:
         raise InvalidInputError("the %s was only detected, not located (%s): locate it "
                                 "first" % (bifurcation.kind, bifurcation.location_note))
+    adm = None
+    if bifurcation.kind == "end":
+        adm = str(bifurcation.details.get("test", ""))[len("end:"):]
     aug = AugmentedProblem(prob, bifurcation.kind, parameter, bifurcation.z, bifurcation.mu,
-                           h=fd_step)
+                           h=fd_step, params_of=params_of, value=value, admissible=adm)
     x0 = np.append(np.asarray(bifurcation.z, dtype=float), bifurcation.mu)
-    b = run_continuation(aug, x0, getattr(prob.base, parameter), stop, step=step,
+    b = run_continuation(aug, x0, aug.start2, stop, step=step,
                          max_points=max_points, tol=tol, max_newton=max_newton,
                          detect=("end",), **kw)
     vals = np.column_stack([[prob.value(m) for m in b.z[:, -1]], b.values])
