@@ -12,6 +12,7 @@ and docs/figures/continuation_*.png.
     python benchmarks/continuation.py kelvin_voigt    # Kelvin-Voigt's d_n branch (docs/contact_laws.md)
     python benchmarks/continuation.py codim2    # compass doubling curve in (slope, c): CPU time
     python benchmarks/continuation.py goswami   # compass regions in (slope, b/a), (slope, m_H/m)
+    python benchmarks/continuation.py region_hip  # paper walker (hybrid): region in (k_hip, d_hip)
     python benchmarks/continuation.py chaos     # orbit diagram, Lyapunov exponents, Feigenbaum
     python benchmarks/continuation.py monodromy # exact (variational) vs finite-difference M
 """
@@ -387,6 +388,103 @@ def part_goswami():
     say("wrote docs/figures/continuation_goswami.png")
 
 
+def _walks(y, P, n=400):
+    """Walk n steps of the hybrid map from y: 0 falls, 1 settles (the last step moves the
+    state by < 1e-8), 2 walks on without settling."""
+    y_prev = y
+    for _ in range(n):
+        try:
+            y_prev, y = y, H.step_map(y, P)
+        except pdw.FellError:
+            return 0
+    return 1 if np.max(np.abs(y - y_prev)) < 1e-8 else 2
+
+
+def part_region_hip():
+    """The paper walker on rigid ground (hybrid model): where its gait exists and is stable in
+    (k_hip, d_hip), the d_hip fold followed in k_hip, against a brute-force grid of find_gait."""
+    from pdw.analysis.codim2 import continue_bifurcation
+    say("== paper_steady (hybrid): the existence and stability region in (k_hip, d_hip) ==")
+    say("load average before: %s" % (os.getloadavg(),))
+    P = pdw.Params.paper_steady()
+    t0 = time.process_time()
+    b = continue_gait(P, "d_hip", 0.1, model="hybrid", max_points=150)
+    fold = b.of_kind("fold")[0]
+    parts = []
+    for stop in (0.0, 6.0):
+        c0 = time.process_time()
+        cv = continue_bifurcation(fold, "k_hip", stop, max_points=300)
+        say("fold d_hip = %.7f at k_hip = 0.95 followed to k_hip %.4g: %d points, %d maps, "
+            "%.2f s CPU; d_hip %.6f -> %.6f; stop: %s"
+            % (fold.value, cv.values[-1, 1], len(cv), cv.n_maps, time.process_time() - c0,
+               cv.values[0, 0], cv.values[-1, 0], cv.stop_reason))
+        parts.append(cv.values[::-1] if stop < 0.95 else cv.values[1:])
+    curve = np.vstack(parts)
+    for k in (0.0, 0.5, 0.95, 2.0, 3.9838, 5.0):
+        say("  k_hip = %.4f: fold at d_hip = %.6f" % (k, np.interp(k, curve[:, 1], curve[:, 0])))
+    say("fold curve: %.2f s CPU" % (time.process_time() - t0))
+    c0 = time.process_time()
+    bk = continue_gait(P, "k_hip", 0.0, model="hybrid")
+    b0 = continue_gait(P.replace(k_hip=0.0), "d_hip", 0.0, model="hybrid", start=bk.state[-1])
+    pd = b0.of_kind("period_doubling")[0]
+    pdc = continue_bifurcation(pd, "k_hip", 1.0)
+    lobe = pdc.values
+    say("period doubling at k_hip = 0, d_hip = %.7f (paper_steady's family continued to "
+        "k_hip = 0, then in d_hip) followed in k_hip: %d points, %.2f s CPU, to k_hip = %.5f, "
+        "d_hip = %.3g; stop: %s" % (pd.value, len(pdc), time.process_time() - c0,
+                                    lobe[-1, 1], lobe[-1, 0], pdc.stop_reason))
+    # brute force: long walks on a grid, each row from the gait of paper_steady's family at
+    # d_hip = 0.005 (continued in k_hip: at small k_hip find_gait alone finds another, unstable
+    # gait, multiplier 3.7 at k_hip = 0)
+    t0 = time.process_time()
+    ks, ds = np.linspace(0.0, 6.0, 25), np.linspace(0.0005, 0.024, 24)
+    P5 = P.replace(d_hip=0.005)
+    rows = [continue_gait(P5, "k_hip", s, model="hybrid", at=list(ks)) for s in (0.0, 6.0)]
+    grid = np.zeros((len(ks), len(ds)), dtype=int)  # 0 falls, 1 settles on a gait, 2 walks on
+    for i, k in enumerate(ks):
+        r = rows[0] if k <= 0.95 else rows[1]
+        y0 = r.state[int(np.argmin(np.abs(r.values - k)))]
+        for j, d in enumerate(ds):
+            grid[i, j] = _walks(y0, P.replace(k_hip=k, d_hip=d))
+    say("grid %d x %d of 400-step walks: %d settle on a gait, %d walk on unsettled, %d fall; "
+        "%.1f s CPU" % (len(ks), len(ds), (grid == 1).sum(), (grid == 2).sum(),
+                        (grid == 0).sum(), time.process_time() - t0))
+    d_at = np.interp(ks, curve[:, 1], curve[:, 0])
+    wrong = [(k, d, grid[i, j]) for i, k in enumerate(ks) for j, d in enumerate(ds)
+             if (grid[i, j] != 0) != (d < d_at[i])]
+    say("grid points on the wrong side of the fold curve (walks above / falls below): %d %s"
+        % (len(wrong), wrong[:6]))
+    l_at = np.interp(ks, lobe[:, 1], lobe[:, 0], right=-1.0)
+    wrong = [(k, d, grid[i, j]) for i, k in enumerate(ks) for j, d in enumerate(ds)
+             if grid[i, j] != 0 and (grid[i, j] == 2) != (d < l_at[i])]
+    say("walking grid points on the wrong side of the doubling curve (unsettled above / "
+        "settled below): %d %s" % (len(wrong), wrong[:6]))
+    say("load average after: %s" % (os.getloadavg(),))
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.2, 4.4), layout="constrained")
+    ax.fill_between(curve[:, 1], 0, curve[:, 0], color="C2", alpha=0.2,
+                    label="period-1 gait exists")
+    ax.plot(curve[:, 1], curve[:, 0], "C2-", lw=1.8, label="fold (continue_bifurcation)")
+    ax.fill(np.r_[lobe[:, 1], 0], np.r_[lobe[:, 0], 0], color="C1", alpha=0.35, lw=0,
+            label="period-1 gait unstable (past a doubling)")
+    ax.plot(lobe[:, 1], lobe[:, 0], "C1-", lw=1.5, label="period doubling")
+    kk, dd = np.meshgrid(ks, ds, indexing="ij")
+    for v, mk, lab in ((1, "C2o", "400-step walk settles"), (2, "C0^", "walks, unsettled"),
+                       (0, "kx", "the walker falls")):
+        m = grid == v
+        ax.plot(kk[m], dd[m], mk, ms=2.5, label=lab)
+    ax.plot([0.95], [0.010], "k*", ms=9, label="paper_steady")
+    ax.set_xlabel("k_hip [N m/rad]")
+    ax.set_ylabel("d_hip [N m s/rad]")
+    ax.set_title("paper walker on rigid ground (hybrid), slope 0.02 rad", fontsize=9)
+    ax.legend(fontsize=7, loc="upper right")
+    ax.grid(alpha=0.3)
+    fig.savefig(FIGS / "continuation_region_hip.png", dpi=150)
+    say("wrote docs/figures/continuation_region_hip.png")
+
+
 def part_chaos():
     from pdw.analysis import chaos
     C = H.compass_gait_params()
@@ -462,7 +560,7 @@ if __name__ == "__main__":
          "dhip": part_dhip, "rigid": part_rigid,
          "rigid_paper": part_rigid_paper, "fig11": part_fig11,
          "simplest_limit": part_simplest_limit, "kelvin_voigt": part_kelvin_voigt,
-         "codim2": part_codim2, "goswami": part_goswami, "chaos": part_chaos, "monodromy": part_monodromy}[part]()
+         "codim2": part_codim2, "goswami": part_goswami, "region_hip": part_region_hip, "chaos": part_chaos, "monodromy": part_monodromy}[part]()
         say("(%s: %.1f s wall; python benchmarks/continuation.py %s)"
             % (part, time.perf_counter() - t0, part))
         RESULTS.mkdir(exist_ok=True)

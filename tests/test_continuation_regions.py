@@ -101,3 +101,54 @@ def test_params_of_needs_a_start_value_and_a_params(branch):
         continue_bifurcation(pd, "b/a", 0.5, params_of=3, value=1.0)
     with pytest.raises(pdw.InvalidInputError, match="params_of must return"):
         continue_bifurcation(pd, "b/a", 0.5, params_of=lambda P, r: r, value=1.0)
+
+
+# --- the paper walker on rigid ground (hybrid): its region in (k_hip, d_hip) ----------------
+
+def _walk(y, P, n=400):
+    """400 steps of the hybrid map from y: 'falls', 'settles' (last step moves < 1e-8) or
+    'walks' (on, unsettled)."""
+    prev = y
+    for _ in range(n):
+        try:
+            prev, y = y, H.step_map(y, P)
+        except pdw.FellError:
+            return "falls"
+    return "settles" if np.max(np.abs(y - prev)) < 1e-8 else "walks"
+
+
+def test_paper_walker_fold_curve_in_k_hip_against_long_walks():
+    """The d_hip fold of paper_steady on rigid ground followed in k_hip: at k_hip = 0.5 and
+    2.5, a walker started on the family's gait 1 % below the fold's d_hip settles on a gait
+    in 400 steps, and 1 % above it falls (independent: the step map only)."""
+    P = pdw.Params.paper_steady()
+    b = continue_gait(P, "d_hip", 0.1, model="hybrid")
+    (fold,) = b.of_kind("fold")
+    cv = continue_bifurcation(fold, "k_hip", 3.0, at=[2.5])
+    lo = continue_bifurcation(fold, "k_hip", 0.0, at=[0.5])
+    for c, k in ((lo, 0.5), (cv, 2.5)):
+        i = int(np.argmin(np.abs(c.values[:, 1] - k)))
+        d_fold = c.values[i, 0]
+        Q = P.replace(k_hip=k, d_hip=0.005)
+        y0 = H.find_gait(Q).state
+        assert _walk(y0, Q.replace(d_hip=0.99 * d_fold)) == "settles"
+        assert _walk(y0, Q.replace(d_hip=1.01 * d_fold)) == "falls"
+
+
+def test_paper_walker_doubling_at_no_hip_spring_against_long_walks():
+    """At k_hip = 0 the family (continued from paper_steady) doubles at d_hip = 0.0067; the
+    doubling curve starts there at k_hip = 0 (one-sided difference at the field's edge) and
+    closes at d_hip -> 0 near k_hip = 0.12. Long walks: at k_hip = 0.05 the walker settles on
+    the period-1 gait above the curve and walks on unsettled (period 2) below it."""
+    P = pdw.Params.paper_steady()
+    bk = continue_gait(P, "k_hip", 0.0, model="hybrid")
+    b0 = continue_gait(P.replace(k_hip=0.0), "d_hip", 0.0, model="hybrid", start=bk.state[-1])
+    (pd,) = b0.of_kind("period_doubling")
+    cv = continue_bifurcation(pd, "k_hip", 1.0, at=[0.05])
+    assert cv.values[0, 1] == 0.0 and 0.10 < cv.values[-1, 1] < 0.13
+    i = int(np.argmin(np.abs(cv.values[:, 1] - 0.05)))
+    d_pd = cv.values[i, 0]
+    y0 = bk.state[int(np.argmin(np.abs(bk.values - 0.05)))]
+    Q = P.replace(k_hip=0.05)
+    assert _walk(y0, Q.replace(d_hip=d_pd + 5e-4), n=2000) == "settles"
+    assert _walk(y0, Q.replace(d_hip=d_pd - 5e-4), n=2000) == "walks"

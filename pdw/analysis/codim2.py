@@ -128,9 +128,10 @@ class AugmentedProblem:
         F = np.concatenate([ev.Pz - z, [g]])
         Mt = Pt = None
         if jac:
-            h2 = self.lam_step
-            e_hi = self._base_eval(z, mu1, mu2 + h2, False)
-            e_lo = self._base_eval(z, mu1, mu2 - h2, False)
+            up, down = self._mu2_offsets(mu2)
+            h2 = 0.5 * (up - down)
+            e_hi = self._base_eval(z, mu1, mu2 + up, False) if up else ev
+            e_lo = self._base_eval(z, mu1, mu2 + down, False) if down else ev
             if not (e_hi.ok and e_lo.ok):
                 return Evaluation(False, "parameter derivative: %s"
                                   % (e_hi.status if not e_hi.ok else e_lo.status))
@@ -175,6 +176,18 @@ class AugmentedProblem:
                                     % type(P).__name__)
         return P
 
+    def _mu2_offsets(self, mu2):
+        """(up, down) of the difference in mu2: central, or one-sided at the edge of its
+        allowed range (e.g. k_hip -> 0)."""
+        h, out = self.lam_step, []
+        for s in (h, -h):
+            try:
+                self._with2(mu2 + s)
+                out.append(s)
+            except (ValueError, InvalidInputError):
+                out.append(0.0)
+        return out[0], out[1]
+
     def params_at(self, mu2, mu1):
         self.p1.base = self._with2(mu2)
         return self.p1.params_at(mu1)
@@ -216,14 +229,15 @@ class AugmentedProblem:
         Mt = Pt = None
         if jac:
             # P_mu2 by a central difference in lambda2
-            h2 = self.lam_step
-            e_hi = self._base_eval(z, mu1, mu2 + h2, True)
-            e_lo = self._base_eval(z, mu1, mu2 - h2, True)
+            up, down = self._mu2_offsets(mu2)
+            h2 = up - down
+            e_hi = self._base_eval(z, mu1, mu2 + up, True) if up else ev
+            e_lo = self._base_eval(z, mu1, mu2 + down, True) if down else ev
             if not (e_hi.ok and e_lo.ok):
                 return Evaluation(False, "parameter derivative: %s"
                                   % (e_hi.status if not e_hi.ok else e_lo.status))
-            P_mu2 = (e_hi.Pz - e_lo.Pz) / (2 * h2)
-            dM_mu2 = (e_hi.M - e_lo.M) / (2 * h2)
+            P_mu2 = (e_hi.Pz - e_lo.Pz) / h2
+            dM_mu2 = (e_hi.M - e_lo.M) / h2
             # d sigma / dz_k and d sigma / d mu1 from central differences of M
             ds = np.zeros(n + 1)
             for k in range(n + 1):
