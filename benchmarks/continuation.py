@@ -13,6 +13,7 @@ and docs/figures/continuation_*.png.
     python benchmarks/continuation.py codim2    # compass doubling curve in (slope, c): CPU time
     python benchmarks/continuation.py goswami   # compass regions in (slope, b/a), (slope, m_H/m)
     python benchmarks/continuation.py region_hip  # paper walker (hybrid): region in (k_hip, d_hip)
+    python benchmarks/continuation.py fold_kn   # continuous: paper walker's d_n fold in (k_n, d_n)
     python benchmarks/continuation.py chaos     # orbit diagram, Lyapunov exponents, Feigenbaum
     python benchmarks/continuation.py monodromy # exact (variational) vs finite-difference M
 """
@@ -485,6 +486,84 @@ def part_region_hip():
     say("wrote docs/figures/continuation_region_hip.png")
 
 
+def part_fold_kn():
+    """The continuous model's (paper_steady, paper variant) low-d_n fold followed in k_n: the
+    edge of the paper walker's existence and stability region in (k_n, d_n), with CPU and wall
+    time (the issue's budget: 10 minutes on 2 cores), against long walks of the step map."""
+    from pdw.analysis import poincare
+    from pdw.analysis.codim2 import continue_bifurcation
+    say("== paper_steady (continuous, paper variant): its d_n fold followed in k_n ==")
+    say("load average before: %s" % (os.getloadavg(),))
+    P = pdw.Params.paper_steady()
+    w0, c0 = time.perf_counter(), time.process_time()
+    b = continue_gait(P, "d_n", 1e3, log=True, max_points=25, workers=2)
+    fold = b.of_kind("fold")[0]
+    say("one parameter, d_n 1e6 -> down: %d points, %d maps, %.1f s wall, %.1f s CPU; first "
+        "fold at d_n = %.7g (k_n = 1e5)" % (len(b), b.n_maps, time.perf_counter() - w0,
+                                             time.process_time() - c0, fold.value))
+    curves = []
+    for stop in (3e5, 3e4):
+        w0, c0 = time.perf_counter(), time.process_time()
+        cv = continue_bifurcation(fold, "k_n", stop, fd_step=1e-4, max_points=60)
+        say("fold curve k_n 1e5 -> %.3g: %d points, %d maps, %.1f s wall, %.1f s CPU (2 "
+            "threads); d_n %.6g -> %.6g; max |mu - 1| of the nearest multiplier %.2g; stop: %s"
+            % (stop, len(cv), cv.n_maps, time.perf_counter() - w0, time.process_time() - c0,
+               cv.values[0, 0], cv.values[-1, 0],
+               np.max(np.min(np.abs(cv.multipliers - 1.0), axis=1)), cv.stop_reason))
+        curves.append(cv)
+    for cv in curves:
+        for v in cv.values[::4]:
+            say("  k_n = %.6g  d_n = %.6g" % (v[1], v[0]))
+    # brute force: 120-step walks on a grid, each column from the gait at d_n = 1e6
+    w0, c0 = time.perf_counter(), time.process_time()
+    kns = np.array([4e4, 6e4, 1e5, 1.5e5, 2e5, 3e5])
+    dns = np.geomspace(1.5e4, 2e5, 9)
+    rows = [continue_gait(P, "k_n", s, log=True, at=[k for k in kns if (k < 1e5) == (s < 1e5)],
+                          max_points=30, workers=2) for s in (3e4, 3.5e5)]
+    grid = np.zeros((len(kns), len(dns)), dtype=int)
+    for i, k in enumerate(kns):
+        r = rows[0] if k < 1e5 else rows[1]
+        z0 = r.z[int(np.argmin(np.abs(r.values - k)))]
+        for j, d in enumerate(dns):
+            z, zp, ok = z0, z0, True
+            for _ in range(120):
+                out = poincare.step(z, P.replace(k_n=k, d_n=d))
+                if out["status"] != "ok":
+                    ok = False
+                    break
+                zp, z = z, out["z"]
+            grid[i, j] = 0 if not ok else (1 if np.max(np.abs(z - zp)) < 1e-6 else 2)
+    say("grid %d x %d of 120-step walks: %d settle, %d walk unsettled, %d fall; %.1f s wall, "
+        "%.1f s CPU" % (len(kns), len(dns), (grid == 1).sum(), (grid == 2).sum(),
+                        (grid == 0).sum(), time.perf_counter() - w0, time.process_time() - c0))
+    allv = np.vstack([curves[1].values[::-1], curves[0].values[1:]])
+    d_at = np.interp(kns, allv[:, 1], allv[:, 0])
+    for i, k in enumerate(kns):
+        say("  k_n = %.3g: fold d_n = %.5g; walks: %s" % (k, d_at[i], " ".join(
+            "%.3g:%s" % (d, "FSU"[grid[i, j]]) for j, d in enumerate(dns))))
+    say("load average after: %s" % (os.getloadavg(),))
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.2, 4.4), layout="constrained")
+    ax.plot(allv[:, 1], allv[:, 0], "C3-", lw=1.8, label="fold (continue_bifurcation)")
+    kk, dd = np.meshgrid(kns, dns, indexing="ij")
+    for v, mk, lab in ((1, "C2o", "120-step walk settles"), (2, "C0^", "walks, unsettled"),
+                       (0, "kx", "the walker falls")):
+        m = grid == v
+        ax.plot(kk[m], dd[m], mk, ms=4, label=lab)
+    ax.plot([1e5], [1e6], "k*", ms=9, label="paper_steady")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("k_n [N/m^1.5]")
+    ax.set_ylabel("d_n [N s/m^2.5]")
+    ax.set_title("paper walker on compliant ground (continuous, paper variant)", fontsize=9)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3, which="both")
+    fig.savefig(FIGS / "continuation_fold_kn.png", dpi=150)
+    say("wrote docs/figures/continuation_fold_kn.png")
+
+
 def part_chaos():
     from pdw.analysis import chaos
     C = H.compass_gait_params()
@@ -560,7 +639,7 @@ if __name__ == "__main__":
          "dhip": part_dhip, "rigid": part_rigid,
          "rigid_paper": part_rigid_paper, "fig11": part_fig11,
          "simplest_limit": part_simplest_limit, "kelvin_voigt": part_kelvin_voigt,
-         "codim2": part_codim2, "goswami": part_goswami, "region_hip": part_region_hip, "chaos": part_chaos, "monodromy": part_monodromy}[part]()
+         "codim2": part_codim2, "goswami": part_goswami, "region_hip": part_region_hip, "fold_kn": part_fold_kn, "chaos": part_chaos, "monodromy": part_monodromy}[part]()
         say("(%s: %.1f s wall; python benchmarks/continuation.py %s)"
             % (part, time.perf_counter() - t0, part))
         RESULTS.mkdir(exist_ok=True)

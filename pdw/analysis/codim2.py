@@ -53,6 +53,10 @@ def _null_vectors(A):
     return U[:, -1].copy(), Vt[-1].copy()
 
 
+class _Fail(Exception):
+    """A failed evaluation inside the augmented problem (becomes a not-ok Evaluation)."""
+
+
 class AugmentedProblem:
     """The minimally augmented system of a fold / period doubling of ``prob`` (a one-parameter
     problem of `pdw.analysis.gait_maps`, whose parameter is the bifurcation's) in the second
@@ -62,7 +66,7 @@ class AugmentedProblem:
     lam_rel = 1e-6
 
     def __init__(self, prob, kind, parameter2, z, mu1, h=1e-6, params_of=None, value=None,
-                 admissible=None):
+                 admissible=None, second="auto"):
         if kind not in SIGNS:
             raise InvalidInputError("continue_bifurcation follows %s, got a %r"
                                     % (", ".join(SIGNS), kind))
@@ -71,6 +75,18 @@ class AugmentedProblem:
                                     "(one of %s), got %r"
                                     % (", ".join(getattr(prob, "ADMISSIBLE", {})), admissible))
         self.admissible = admissible
+        if second not in ("auto", "monodromy", "directional"):
+            raise InvalidInputError("second must be 'auto', 'monodromy' or 'directional', got "
+                                    "%r" % (second,))
+        #: how d sigma / dx is differenced: "monodromy" (central differences of M, 2 (n + 1)
+        #: + 2 monodromies: the hybrid model's exact M is cheap) or "directional" (of
+        #: w^T M v = w^T (P(z + e v) - P(z - e v)) / 2e, 4 (n + 1) + 6 maps in one batch)
+        self.second = (("monodromy" if prob.model == "hybrid" else "directional")
+                       if second == "auto" else second)
+        self.lam_rel = getattr(prob, "lam_rel", 1e-6)
+        #: weight of sigma in the residual (`continue_bifurcation`'s ``sigma_tol``): Newton's
+        #: max |F| < tol then means |sigma| < sigma_tol
+        self.kappa = 1.0
         if params_of is None and parameter2 not in Params.__dataclass_fields__:
             raise InvalidInputError("parameter must be a Params field (%s) or come with "
                                     "params_of, got %r"
@@ -213,9 +229,55 @@ class AugmentedProblem:
         ws = np.linalg.solve(K.T, rhs)
         return vs[-1], vs[:n], ws[:n]
 
+    def _at(self, mu1, mu2):
+        self.p1.base = self._with2(mu2)
+        return self.p1.params_at(mu1)
+
+    def _directional(self, z, mu1, mu2, v, w):
+        """d sigma / d(z, mu1) (n + 1,), d sigma / d mu2 and dP / d mu2 from central
+        differences of S(x) = w^T (P(z + e v^) - P(z - e v^)) / 2e |v| = w^T M v, all maps of
+        one batch (`images`): no monodromy but the base point's."""
+        n = len(z)
+        nv = float(np.linalg.norm(v))
+        vh, e = v / nv, self.h
+        h1 = self.p1.lam_step if self.p1.lam_step > 0 else self.h
+        steps = [self.h] * n + [h1]
+        up, down = self._mu2_offsets(mu2)
+        pts = []
+        for k in range(n + 1):
+            for sgn in (1.0, -1.0):
+                d = np.zeros(n + 1)
+                d[k] = sgn * steps[k]
+                try:
+                    P = self._at(mu1 + d[n], mu2)
+                except (ValueError, InvalidInputError) as err:
+                    raise _Fail("second derivative: %s" % err) from None
+                zk = z + d[:n]
+                pts += [(zk + e * vh, P), (zk - e * vh, P)]
+        for off in (up, down):
+            P = self._at(mu1, mu2 + off)
+            pts += [(z + e * vh, P), (z - e * vh, P), (z, P)]
+        self.p1.base = self._with2(mu2)
+        ims = self.p1.images(pts)
+        self.n_maps += len(pts) * self.period
+        if any(im is None for im in ims):
+            raise _Fail("second derivative: the step map fails within %g of the point" % e)
+
+        def S(i):
+            return float(w @ (ims[i] - ims[i + 1])) / (2 * e) * nv
+
+        ds = np.array([-(S(4 * k) - S(4 * k + 2)) / (2 * steps[k]) for k in range(n + 1)])
+        b0 = 4 * (n + 1)
+        h2 = up - down
+        dsig2 = -(S(b0) - S(b0 + 3)) / h2
+        P_mu2 = (ims[b0 + 2] - ims[b0 + 5]) / h2
+        return ds, dsig2, P_mu2
+
     def evaluate(self, x, mu2, jac=True) -> Evaluation:
         if self.kind == "end":
             return self._evaluate_end(x, mu2, jac)
+        if self.second == "directional":
+            return self._evaluate_directional(x, mu2, jac)
         z, mu1 = np.asarray(x[:-1], dtype=float), float(x[-1])
         ev = self._base_eval(z, mu1, mu2, True)
         if not ev.ok:
@@ -225,7 +287,7 @@ class AugmentedProblem:
         except np.linalg.LinAlgError:
             return Evaluation(False, "singular bordered matrix")
         n = len(z)
-        F = np.concatenate([ev.Pz - z, [sigma]])
+        F = np.concatenate([ev.Pz - z, [self.kappa * sigma]])
         Mt = Pt = None
         if jac:
             # P_mu2 by a central difference in lambda2
@@ -252,9 +314,37 @@ class AugmentedProblem:
             J = np.zeros((n + 1, n + 1))
             J[:n, :n] = ev.M - np.eye(n)
             J[:n, n] = ev.P_lam
-            J[n, :] = ds
+            J[n, :] = self.kappa * ds
             Mt = np.eye(n + 1) + J
-            Pt = np.concatenate([P_mu2, [-w @ dM_mu2 @ v]])
+            Pt = np.concatenate([P_mu2, [-self.kappa * (w @ dM_mu2 @ v)]])
+        m = np.linalg.eigvals(ev.M)
+        info = dict(ev.info, base_multipliers=m[np.argsort(-np.abs(m))], sigma=sigma,
+                    value1=self.p1.value(mu1), M=ev.M)
+        return Evaluation(True, "ok", x + F, Mt, Pt, info, dict(ev.admissible))
+
+    def _evaluate_directional(self, x, mu2, jac) -> Evaluation:
+        z, mu1 = np.asarray(x[:-1], dtype=float), float(x[-1])
+        ev = self._base_eval(z, mu1, mu2, True)
+        if not ev.ok:
+            return Evaluation(False, ev.status)
+        try:
+            sigma, v, w = self._sigma(ev.M)
+        except np.linalg.LinAlgError:
+            return Evaluation(False, "singular bordered matrix")
+        n = len(z)
+        F = np.concatenate([ev.Pz - z, [self.kappa * sigma]])
+        Mt = Pt = None
+        if jac:
+            try:
+                ds, dsig2, P_mu2 = self._directional(z, mu1, mu2, v, w)
+            except _Fail as err:
+                return Evaluation(False, str(err))
+            J = np.zeros((n + 1, n + 1))
+            J[:n, :n] = ev.M - np.eye(n)
+            J[:n, n] = ev.P_lam
+            J[n, :] = self.kappa * ds
+            Mt = np.eye(n + 1) + J
+            Pt = np.concatenate([P_mu2, [self.kappa * dsig2]])
         m = np.linalg.eigvals(ev.M)
         info = dict(ev.info, base_multipliers=m[np.argsort(-np.abs(m))], sigma=sigma,
                     value1=self.p1.value(mu1), M=ev.M)
@@ -334,6 +424,7 @@ def continue_bifurcation(bifurcation: Bifurcation, parameter: str, stop: float, 
                          step: float | None = None, max_points: int = 200,
                          tol: float = 1e-9, max_newton: int = 10, fd_step: float = 1e-6,
                          params_of: Any = None, value: float | None = None,
+                         second: str = "auto", sigma_tol: float | None = None,
                          **kw: Any) -> BifurcationCurve:
     """Follow a located fold, period doubling or end of a branch in a second parameter.
 
@@ -355,6 +446,17 @@ def continue_bifurcation(bifurcation: Bifurcation, parameter: str, stop: float, 
     fd_step : float
         Difference step of the second derivatives dM/dx (default 1e-6: M is exact for the
         hybrid model; use about 1e-4 with the continuous model's finite-difference M).
+    second : {"auto", "monodromy", "directional"}
+        How the fold / doubling condition's derivatives are differenced: of the monodromy M
+        (2 (n + 1) + 2 extra monodromies per Newton iteration; "auto" for the hybrid model,
+        whose M is exact and cheap) or of w^T M v along the null vector (4 (n + 1) + 6 maps in
+        one parallel batch; "auto" for the continuous model, whose M costs 2n + 3 maps).
+    sigma_tol : float, optional
+        Newton's tolerance on the fold / doubling condition sigma (default ``tol`` for the
+        hybrid model, whose M is exact; 3e-6 for the continuous model: sigma from its
+        finite-difference M moves by ~4e-6 between difference steps 1e-6 and 1e-4, so
+        ``tol`` = 1e-9 cannot be met and Newton stalls). The curve is then located to about
+        sigma_tol / |d sigma / d parameter| in the first parameter.
     params_of : callable (Params, float) -> Params, optional
         A derived second parameter: the branch's base parameters at ``parameter`` = value,
         e.g. Goswami's b/a, ``lambda P, r: P.replace(c=r / (1 + r))``. The bifurcation's own
@@ -385,7 +487,13 @@ def continue_bifurcation(bifurcation: Bifurcation, parameter: str, stop: float, 
     if bifurcation.kind == "end":
         adm = str(bifurcation.details.get("test", ""))[len("end:"):]
     aug = AugmentedProblem(prob, bifurcation.kind, parameter, bifurcation.z, bifurcation.mu,
-                           h=fd_step, params_of=params_of, value=value, admissible=adm)
+                           h=fd_step, params_of=params_of, value=value, admissible=adm,
+                           second=second)
+    if sigma_tol is None:
+        sigma_tol = tol if prob.model == "hybrid" else max(tol, 3e-6)
+    if not (isinstance(sigma_tol, (int, float)) and 0 < sigma_tol < 1):
+        raise InvalidInputError("sigma_tol must be in (0, 1), got %r" % (sigma_tol,))
+    aug.kappa = float(tol) / float(sigma_tol)
     x0 = np.append(np.asarray(bifurcation.z, dtype=float), bifurcation.mu)
     b = run_continuation(aug, x0, aug.start2, stop, step=step,
                          max_points=max_points, tol=tol, max_newton=max_newton,
