@@ -14,6 +14,7 @@ and docs/figures/continuation_*.png.
     python benchmarks/continuation.py goswami   # compass regions in (slope, b/a), (slope, m_H/m)
     python benchmarks/continuation.py region_hip  # paper walker (hybrid): region in (k_hip, d_hip)
     python benchmarks/continuation.py fold_kn   # continuous: paper walker's d_n fold in (k_n, d_n)
+    python benchmarks/continuation.py ns_search # complex multiplier pairs: any Neimark-Sacker?
     python benchmarks/continuation.py chaos     # orbit diagram, Lyapunov exponents, Feigenbaum
     python benchmarks/continuation.py monodromy # exact (variational) vs finite-difference M
 """
@@ -564,6 +565,41 @@ def part_fold_kn():
     say("wrote docs/figures/continuation_fold_kn.png")
 
 
+def part_ns_search():
+    """Where could a Neimark-Sacker point be? The largest modulus of a complex pair of
+    multipliers along one-parameter families of the hybrid paper walker (d_hip from 0 to its
+    fold, at 25 k_hip in [0, 6]; the slope from 0.02 to 0.2) and of the compass gait (slope)."""
+    say("== Neimark-Sacker search: complex multiplier pairs along families (hybrid) ==")
+    P = pdw.Params.paper_steady()
+    t0 = time.process_time()
+    best, n_pts, n_ns = (0.0, None), 0, 0
+    P5 = P.replace(d_hip=0.005)
+    ks = np.linspace(0.0, 6.0, 25)
+    rows = [continue_gait(P5, "k_hip", s, model="hybrid", at=list(ks)) for s in (0.0, 6.0)]
+    for k in ks:
+        r = rows[0] if k <= 0.95 else rows[1]
+        y0 = r.state[int(np.argmin(np.abs(r.values - k)))]
+        for stop in (0.0, 0.1):
+            b = continue_gait(P.replace(k_hip=k, d_hip=0.005), "d_hip", stop, model="hybrid",
+                              start=y0, max_points=100)
+            n_pts += len(b)
+            n_ns += len(b.of_kind("neimark_sacker"))
+            for v, m in zip(b.values, b.multipliers):
+                cx = [abs(x) for x in m if abs(x.imag) > 1e-8]
+                if cx and max(cx) > best[0]:
+                    best = (max(cx), (k, v))
+    say("paper walker, d_hip families at 25 k_hip: %d points, %d NS located; largest complex "
+        "|mu| = %.4f at (k_hip, d_hip) = (%.3g, %.4g); %.1f s CPU"
+        % (n_pts, n_ns, best[0], best[1][0], best[1][1], time.process_time() - t0))
+    for name, Q, stop in (("paper walker, slope", P, 0.2),
+                          ("compass gait, slope", H.compass_gait_params(), 12 * DEG)):
+        b = continue_gait(Q, "gamma", stop, model="hybrid", max_points=300)
+        cx = [abs(x) for m in b.multipliers for x in m if abs(x.imag) > 1e-8]
+        say("%s to %.3g: %d points, %d NS located, largest complex |mu| = %s"
+            % (name, stop, len(b), len(b.of_kind("neimark_sacker")),
+               "%.4f" % max(cx) if cx else "none (all real)"))
+
+
 def part_chaos():
     from pdw.analysis import chaos
     C = H.compass_gait_params()
@@ -639,7 +675,7 @@ if __name__ == "__main__":
          "dhip": part_dhip, "rigid": part_rigid,
          "rigid_paper": part_rigid_paper, "fig11": part_fig11,
          "simplest_limit": part_simplest_limit, "kelvin_voigt": part_kelvin_voigt,
-         "codim2": part_codim2, "goswami": part_goswami, "region_hip": part_region_hip, "fold_kn": part_fold_kn, "chaos": part_chaos, "monodromy": part_monodromy}[part]()
+         "codim2": part_codim2, "goswami": part_goswami, "region_hip": part_region_hip, "fold_kn": part_fold_kn, "ns_search": part_ns_search, "chaos": part_chaos, "monodromy": part_monodromy}[part]()
         say("(%s: %.1f s wall; python benchmarks/continuation.py %s)"
             % (part, time.perf_counter() - t0, part))
         RESULTS.mkdir(exist_ok=True)

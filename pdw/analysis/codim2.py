@@ -45,7 +45,22 @@ from .gait_maps import Evaluation
 
 #: the bifurcation kinds a curve can follow, and the sign s of A = M + s I ("end": the
 #: admissibility function g(z, mu1, mu2) = 0 itself is the extra equation, no A)
-SIGNS = {"period_doubling": 1.0, "fold": -1.0, "end": 0.0}
+SIGNS = {"period_doubling": 1.0, "fold": -1.0, "end": 0.0, "neimark_sacker": 0.0}
+
+
+def compound2(M):
+    """The second compound matrix C2(M) (m x m, m = n (n - 1) / 2; its entries are M's 2 x 2
+    minors, rows and columns the index pairs p > q): its eigenvalues are the products
+    mu_i mu_j (i < j) of M's, so C2(M) - I is singular at a Neimark-Sacker point
+    (mu mu-bar = 1), and at a neutral saddle (real mu_i mu_j = 1) too."""
+    M = np.asarray(M, dtype=float)
+    n = len(M)
+    pairs = [(p, q) for p in range(1, n) for q in range(p)]
+    C = np.empty((len(pairs), len(pairs)))
+    for i, (p, q) in enumerate(pairs):
+        for j, (r, s) in enumerate(pairs):
+            C[i, j] = M[p, r] * M[q, s] - M[p, s] * M[q, r]
+    return C
 
 
 def _null_vectors(A):
@@ -123,7 +138,9 @@ class AugmentedProblem:
         ev = self._base_eval(np.asarray(z, dtype=float), mu1, self.start2)
         if not ev.ok:
             raise InvalidInputError("the bifurcation's gait does not evaluate: %s" % ev.status)
-        self.a, self.b = _null_vectors(ev.M + self.s * np.eye(prob.dim))
+        if kind == "neimark_sacker":
+            self.second = "monodromy"          # C2(M) is quadratic in M: no directional form
+        self.a, self.b = _null_vectors(self._A(ev.M))
 
     def _g(self, z, mu1, mu2):
         """The followed admissibility function at (z, mu1, mu2) (an "end" curve)."""
@@ -218,9 +235,16 @@ class AugmentedProblem:
         self.n_maps += self.p1.n_maps - n0
         return ev
 
+    def _A(self, M):
+        """The matrix singular at the bifurcation: M + s I, or C2(M) - I (Neimark-Sacker)."""
+        if self.kind == "neimark_sacker":
+            C = compound2(M)
+            return C - np.eye(len(C))
+        return M + self.s * np.eye(len(M))
+
     def _sigma(self, M):
-        n = len(M)
-        A = M + self.s * np.eye(n)
+        A = self._A(M)
+        n = len(A)
         K = np.zeros((n + 1, n + 1))
         K[:n, :n], K[:n, n], K[n, :n] = A, self.a, self.b
         rhs = np.zeros(n + 1)
@@ -299,7 +323,7 @@ class AugmentedProblem:
                 return Evaluation(False, "parameter derivative: %s"
                                   % (e_hi.status if not e_hi.ok else e_lo.status))
             P_mu2 = (e_hi.Pz - e_lo.Pz) / h2
-            dM_mu2 = (e_hi.M - e_lo.M) / h2
+            dA_mu2 = (self._A(e_hi.M) - self._A(e_lo.M)) / h2
             # d sigma / dz_k and d sigma / d mu1 from central differences of M
             ds = np.zeros(n + 1)
             for k in range(n + 1):
@@ -310,13 +334,13 @@ class AugmentedProblem:
                 if not (lo.ok and hi.ok):
                     return Evaluation(False, "second derivative: %s"
                                       % (hi.status if not hi.ok else lo.status))
-                ds[k] = -w @ ((hi.M - lo.M) / (2 * self.h)) @ v
+                ds[k] = -w @ ((self._A(hi.M) - self._A(lo.M)) / (2 * self.h)) @ v
             J = np.zeros((n + 1, n + 1))
             J[:n, :n] = ev.M - np.eye(n)
             J[:n, n] = ev.P_lam
             J[n, :] = self.kappa * ds
             Mt = np.eye(n + 1) + J
-            Pt = np.concatenate([P_mu2, [-self.kappa * (w @ dM_mu2 @ v)]])
+            Pt = np.concatenate([P_mu2, [-self.kappa * (w @ dA_mu2 @ v)]])
         m = np.linalg.eigvals(ev.M)
         info = dict(ev.info, base_multipliers=m[np.argsort(-np.abs(m))], sigma=sigma,
                     value1=self.p1.value(mu1), M=ev.M)
@@ -355,7 +379,7 @@ class AugmentedProblem:
         ``update_minaug_every_step``), called by the engine."""
         M = pt.ev.info.get("M")
         if M is not None and self.kind != "end":
-            self.a, self.b = _null_vectors(M + self.s * np.eye(len(M)))
+            self.a, self.b = _null_vectors(self._A(M))
 
     def gait(self, x, mu2, ev, multipliers):
         g = self.p1.gait(np.asarray(x[:-1]), float(x[-1]), ev,
