@@ -344,7 +344,10 @@ def part_goswami():
             parts = []
             for s in stops:
                 c0 = time.process_time()
-                cv = continue_bifurcation(bif, name, s, params_of=of, value=v0, max_points=300)
+                marks = [r for r in ((0.5, 1.0, 2.0) if name == "b/a" else (0.5, 2.0, 5.0))
+                         if min(v0, s) < r < max(v0, s)]
+                cv = continue_bifurcation(bif, name, s, params_of=of, value=v0, max_points=300,
+                                          at=marks)
                 say("%-5s %-3s %s %.2f -> %.4g: %d points, %d maps, %.2f s CPU; gamma %.4f -> "
                     "%.4f deg; stop: %s" % (name, lab, name, v0, cv.values[-1, 1], len(cv),
                                             cv.n_maps, time.process_time() - c0,
@@ -415,7 +418,8 @@ def part_region_hip():
     parts = []
     for stop in (0.0, 6.0):
         c0 = time.process_time()
-        cv = continue_bifurcation(fold, "k_hip", stop, max_points=300)
+        cv = continue_bifurcation(fold, "k_hip", stop, max_points=300,
+                                  at=[0.5] if stop < 0.95 else [2.0, 3.9838, 5.0])
         say("fold d_hip = %.7f at k_hip = 0.95 followed to k_hip %.4g: %d points, %d maps, "
             "%.2f s CPU; d_hip %.6f -> %.6f; stop: %s"
             % (fold.value, cv.values[-1, 1], len(cv), cv.n_maps, time.process_time() - c0,
@@ -538,15 +542,36 @@ def part_fold_kn():
         "%.1f s CPU" % (len(kns), len(dns), (grid == 1).sum(), (grid == 2).sum(),
                         (grid == 0).sum(), time.perf_counter() - w0, time.process_time() - c0))
     allv = np.vstack([curves[1].values[::-1], curves[0].values[1:]])
-    d_at = np.interp(kns, allv[:, 1], allv[:, 0])
     for i, k in enumerate(kns):
-        say("  k_n = %.3g: fold d_n = %.5g; walks: %s" % (k, d_at[i], " ".join(
+        say("  k_n = %.3g: walks (d_n: F fell, S settled, U unsettled): %s" % (k, " ".join(
             "%.3g:%s" % (d, "FSU"[grid[i, j]]) for j, d in enumerate(dns))))
+    # the 10-minute benchmark of the issue: a longer fold curve, of the d_hip = 0.014 walker
+    P14 = P.replace(d_hip=0.014)
+    w0, c0 = time.perf_counter(), time.process_time()
+    b14 = continue_gait(P14, "d_n", 1e8, log=True, max_points=30, workers=2)
+    f14 = b14.of_kind("fold")[0]
+    cv14 = continue_bifurcation(f14, "k_n", 1e6, fd_step=1e-4, max_points=80)
+    say("d_hip = 0.014: fold at d_n = %.7g (k_n = 1e5) followed in k_n: %d points, %d maps, "
+        "%.1f s wall, %.1f s CPU (2 threads, with the one-parameter run that found it); k_n "
+        "in [%.4g, %.4g], d_n in [%.4g, %.4g]; max |mu - 1| %.2g; stop: %s"
+        % (f14.value, len(cv14), cv14.n_maps, time.perf_counter() - w0,
+           time.process_time() - c0, cv14.values[:, 1].min(), cv14.values[:, 1].max(),
+           cv14.values[:, 0].min(), cv14.values[:, 0].max(),
+           np.max(np.min(np.abs(cv14.multipliers - 1.0), axis=1)), cv14.stop_reason))
     say("load average after: %s" % (os.getloadavg(),))
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6.2, 4.4), layout="constrained")
+    fig, (ax, a2) = plt.subplots(1, 2, figsize=(11, 4.4), layout="constrained")
+    a2.plot(cv14.values[:, 1], cv14.values[:, 0], "C3.-", lw=1.5, ms=3)
+    a2.plot([1e5], [f14.value], "ks", ms=5, label="start: LP of the d_n family")
+    a2.set_xlabel("k_n [N/m^1.5]")
+    a2.set_ylabel("d_n [N s/m^2.5]")
+    a2.set_yscale("log")
+    a2.set_title("d_hip = 0.014: the fold curve (%d points, %.0f s wall)"
+                 % (len(cv14), time.perf_counter() - w0), fontsize=9)
+    a2.legend(fontsize=7)
+    a2.grid(alpha=0.3, which="both")
     ax.plot(allv[:, 1], allv[:, 0], "C3-", lw=1.8, label="fold (continue_bifurcation)")
     kk, dd = np.meshgrid(kns, dns, indexing="ij")
     for v, mk, lab in ((1, "C2o", "120-step walk settles"), (2, "C0^", "walks, unsettled"),
@@ -558,7 +583,8 @@ def part_fold_kn():
     ax.set_yscale("log")
     ax.set_xlabel("k_n [N/m^1.5]")
     ax.set_ylabel("d_n [N s/m^2.5]")
-    ax.set_title("paper walker on compliant ground (continuous, paper variant)", fontsize=9)
+    ax.set_title("paper_steady (d_hip = 0.01): fold of the low-d_n end, and long walks",
+                 fontsize=9)
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3, which="both")
     fig.savefig(FIGS / "continuation_fold_kn.png", dpi=150)
