@@ -1,5 +1,6 @@
-"""Continuation studies (docs/continuation.md): writes benchmarks/results/continuation_<part>.txt
-and docs/figures/continuation_*.png.
+"""Continuation studies (docs/continuation.md): writes continuation_<part>.txt and the figures
+continuation_*.png under out/benchmarks/ (with --update-docs: benchmarks/results/ and
+docs/figures/; `make bench` runs the issue's two codim-2 speed benchmarks, codim2 and fold_kn).
 
     python benchmarks/continuation.py hybrid    # compass cascade + simplest walker (seconds)
     python benchmarks/continuation.py hybrid_paper  # paper_steady on rigid ground, 8 parameters
@@ -31,14 +32,15 @@ import numpy as np
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from _results import FIGURES as FIGS  # noqa: E402  (out/benchmarks/ unless --update-docs)
+from _results import RESULTS  # noqa: E402
+
 import pdw  # noqa: E402
 from pdw import hybrid as H  # noqa: E402
 from pdw.analysis.continuation import continue_gait, follow_cascade  # noqa: E402
 from pdw.present.cli_continue import preset  # noqa: E402
 from pdw.present.plots_continuation import plot_branches, plot_curves  # noqa: E402
 
-RESULTS = ROOT / "benchmarks" / "results"
-FIGS = ROOT / "docs" / "figures"
 DEG = np.pi / 180
 OUT = []
 
@@ -701,8 +703,11 @@ if __name__ == "__main__":
          "dhip": part_dhip, "rigid": part_rigid,
          "rigid_paper": part_rigid_paper, "fig11": part_fig11,
          "simplest_limit": part_simplest_limit, "kelvin_voigt": part_kelvin_voigt,
-         "codim2": part_codim2, "goswami": part_goswami, "region_hip": part_region_hip, "fold_kn": part_fold_kn, "ns_search": part_ns_search, "chaos": part_chaos, "monodromy": part_monodromy}[part]()
+         "codim2": part_codim2, "goswami": part_goswami, "region_hip": part_region_hip,
+         "fold_kn": part_fold_kn, "ns_search": part_ns_search, "chaos": part_chaos,
+         "monodromy": part_monodromy}[part]()
         say("(%s: %.1f s wall; python benchmarks/continuation.py %s)"
             % (part, time.perf_counter() - t0, part))
-        RESULTS.mkdir(exist_ok=True)
+        RESULTS.mkdir(parents=True, exist_ok=True)
+        FIGS.mkdir(parents=True, exist_ok=True)
         (RESULTS / ("continuation_%s.txt" % part)).write_text("\n".join(OUT) + "\n")
