@@ -24,10 +24,19 @@ modelled) is followed the same way with sigma replaced by g(z, mu1, mu2) itself 
 derivatives by central differences of maps, no monodromy). The second parameter may be a
 derived one (``params_of``), e.g. Goswami's b/a or m_H/m.
 
+A Neimark-Sacker point uses A = C2(M) - I instead (`compound2`, the second compound matrix,
+singular where mu mu-bar = 1). dsigma/dx comes from differences of M (``second="monodromy"``,
+the hybrid model's default) or, without extra monodromies, from central differences of
+w^T M v = w^T (P(z + e v) - P(z - e v)) / 2e (``"directional"``, the continuous model's).
+
 `AugmentedProblem` presents F as a step map, P~(x) = x + F(x), with M~ = I + dF/dx and
 dP~/dmu2 = dF/dmu2, so the *unchanged* one-parameter engine (`run_continuation`) follows it.
 `continue_bifurcation` returns a `BifurcationCurve` whose ``values`` are (N, 2): the first
 (the bifurcation's own) and the second parameter.
+
+(Over 500 lines: the augmented problem's three residuals (bordered sigma with monodromy or
+directional derivatives, and the admissibility function of an end) share its border vectors,
+parameter handling and batch of maps, so they stay in one class.)
 """
 from __future__ import annotations
 
