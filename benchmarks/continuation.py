@@ -696,6 +696,8 @@ def part_monodromy(rounds=3):
 
 if __name__ == "__main__":
     parts = sys.argv[1:] or ["hybrid"]
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    FIGS.mkdir(parents=True, exist_ok=True)
     for part in parts:
         OUT.clear()
         t0 = time.perf_counter()
@@ -708,6 +710,4 @@ if __name__ == "__main__":
          "monodromy": part_monodromy}[part]()
         say("(%s: %.1f s wall; python benchmarks/continuation.py %s)"
             % (part, time.perf_counter() - t0, part))
-        RESULTS.mkdir(parents=True, exist_ok=True)
-        FIGS.mkdir(parents=True, exist_ok=True)
         (RESULTS / ("continuation_%s.txt" % part)).write_text("\n".join(OUT) + "\n")
