@@ -15,6 +15,7 @@ docs/figures/; `make bench` runs the issue's two codim-2 speed benchmarks, codim
     python benchmarks/continuation.py goswami   # compass regions in (slope, b/a), (slope, m_H/m)
     python benchmarks/continuation.py region_hip  # paper walker (hybrid): region in (k_hip, d_hip)
     python benchmarks/continuation.py fold_kn   # continuous: paper walker's d_n fold in (k_n, d_n)
+    python benchmarks/continuation.py codim2_schemes  # continuous fold curve: why it stalled
     python benchmarks/continuation.py ns_search # complex multiplier pairs: any Neimark-Sacker?
     python benchmarks/continuation.py chaos     # orbit diagram, Lyapunov exponents, Feigenbaum
     python benchmarks/continuation.py monodromy # exact (variational) vs finite-difference M
@@ -593,6 +594,31 @@ def part_fold_kn():
     say("wrote docs/figures/continuation_fold_kn.png")
 
 
+def part_codim2_schemes():
+    """The continuous fold curve's two derivative schemes interleaved (8 points each, two
+    rounds), and sigma_tol = tol = 1e-9: the stall of the last round."""
+    from pdw.analysis.codim2 import continue_bifurcation
+    say("== d_hip = 0.014 walker's d_n fold in k_n: directional vs monodromy second "
+        "differences ==")
+    say("load average before: %s" % (os.getloadavg(),))
+    P = pdw.Params.paper_steady(d_hip=0.014)
+    b = continue_gait(P, "d_n", 1e8, log=True, max_points=30, workers=2)
+    f = b.of_kind("fold")[0]
+    for r in range(2):
+        for sec in ("directional", "monodromy"):
+            w0, c0 = time.perf_counter(), time.process_time()
+            cv = continue_bifurcation(f, "k_n", 2e5, fd_step=1e-4, max_points=8, second=sec)
+            say("round %d %-11s: %d points, %d maps, %.1f s wall, %.1f s CPU; to k_n = %.6g"
+                % (r, sec, len(cv), cv.n_maps, time.perf_counter() - w0,
+                   time.process_time() - c0, cv.values[-1, 1]))
+    try:
+        continue_bifurcation(f, "k_n", 2e5, fd_step=1e-4, max_points=8, sigma_tol=1e-9)
+        say("sigma_tol = 1e-9: ran")
+    except pdw.GaitNotFoundError as e:
+        say("sigma_tol = 1e-9 (the last round's behaviour): %s" % e)
+    say("load average after: %s" % (os.getloadavg(),))
+
+
 def part_ns_search():
     """Where could a Neimark-Sacker point be? The largest modulus of a complex pair of
     multipliers along one-parameter families of the hybrid paper walker (d_hip from 0 to its
@@ -706,7 +732,8 @@ if __name__ == "__main__":
          "rigid_paper": part_rigid_paper, "fig11": part_fig11,
          "simplest_limit": part_simplest_limit, "kelvin_voigt": part_kelvin_voigt,
          "codim2": part_codim2, "goswami": part_goswami, "region_hip": part_region_hip,
-         "fold_kn": part_fold_kn, "ns_search": part_ns_search, "chaos": part_chaos,
+         "fold_kn": part_fold_kn, "codim2_schemes": part_codim2_schemes,
+         "ns_search": part_ns_search, "chaos": part_chaos,
          "monodromy": part_monodromy}[part]()
         say("(%s: %.1f s wall; python benchmarks/continuation.py %s)"
             % (part, time.perf_counter() - t0, part))
