@@ -81,6 +81,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/work_precision.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_terrain.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_mfpt.py $(UPDATE_DOCS)
+	$(PY) benchmarks/continuation.py codim2 fold_kn $(UPDATE_DOCS)
 
 ## instructions: the instruction-count guard (valgrind's callgrind; benchmarks/instructions.py):
 ## the paper run with and without recording, a first call, 64-walker batches, find_gait,

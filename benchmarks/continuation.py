@@ -1,5 +1,6 @@
-"""Continuation studies (docs/continuation.md): writes benchmarks/results/continuation_<part>.txt
-and docs/figures/continuation_*.png.
+"""Continuation studies (docs/continuation.md): writes continuation_<part>.txt and the figures
+continuation_*.png under out/benchmarks/ (with --update-docs: benchmarks/results/ and
+docs/figures/; `make bench` runs the issue's two codim-2 speed benchmarks, codim2 and fold_kn).
 
     python benchmarks/continuation.py hybrid    # compass cascade + simplest walker (seconds)
     python benchmarks/continuation.py hybrid_paper  # paper_steady on rigid ground, 8 parameters
@@ -11,6 +12,11 @@ and docs/figures/continuation_*.png.
     python benchmarks/continuation.py simplest_limit  # simplest walker's doubling, m_l/m_h -> 0
     python benchmarks/continuation.py kelvin_voigt    # Kelvin-Voigt's d_n branch (docs/contact_laws.md)
     python benchmarks/continuation.py codim2    # compass doubling curve in (slope, c): CPU time
+    python benchmarks/continuation.py goswami   # compass regions in (slope, b/a), (slope, m_H/m)
+    python benchmarks/continuation.py region_hip  # paper walker (hybrid): region in (k_hip, d_hip)
+    python benchmarks/continuation.py fold_kn   # continuous: paper walker's d_n fold in (k_n, d_n)
+    python benchmarks/continuation.py codim2_schemes  # continuous fold curve: why it stalled
+    python benchmarks/continuation.py ns_search # complex multiplier pairs: any Neimark-Sacker?
     python benchmarks/continuation.py chaos     # orbit diagram, Lyapunov exponents, Feigenbaum
     python benchmarks/continuation.py monodromy # exact (variational) vs finite-difference M
 """
@@ -27,14 +33,15 @@ import numpy as np
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from _results import FIGURES as FIGS  # noqa: E402  (out/benchmarks/ unless --update-docs)
+from _results import RESULTS  # noqa: E402
+
 import pdw  # noqa: E402
 from pdw import hybrid as H  # noqa: E402
 from pdw.analysis.bifurcation.continuation import continue_gait, follow_cascade  # noqa: E402
 from pdw.present.cli_continue import preset  # noqa: E402
 from pdw.present.plots_continuation import plot_branches, plot_curves  # noqa: E402
 
-RESULTS = ROOT / "benchmarks" / "results"
-FIGS = ROOT / "docs" / "figures"
 DEG = np.pi / 180
 OUT = []
 
@@ -318,6 +325,335 @@ def part_codim2(rounds=3):
     say("wrote docs/figures/continuation_codim2.png")
 
 
+def part_goswami():
+    """Goswami, Thuilot & Espiau's regions of the compass gait in the issue's axes: where the
+    period-1 gait exists (below the end curve, the trailing foot leaves the ground), where it is
+    stable (below its first doubling PD1), and where the period-2 gait is (PD1 to PD2)."""
+    from pdw.analysis.bifurcation.codim2 import continue_bifurcation
+    say("== compass gait: regions in (slope, b/a) and (slope, m_H/m) (hybrid, exact M) ==")
+    say("load average before: %s" % (os.getloadavg(),))
+    C = H.compass_gait_params()
+    axes = {"b/a": (lambda P, r: P.replace(c=r / (1 + r) * P.l), 1.0, (0.25, 3.0)),
+            "m_H/m": (lambda P, r: P.replace(m_h=r * P.m_l), 2.0, (0.1, 10.0))}
+    t0 = time.process_time()
+    b = continue_gait(C, "gamma", 15 * DEG, model="hybrid", max_points=400)
+    pd1, ep = b.of_kind("period_doubling")[0], b.of_kind("end")[0]
+    g2 = b.switch(pd1)
+    b2 = continue_gait(g2.params, "gamma", 6 * DEG, model="hybrid", period=2, start=g2)
+    pd2 = b2.of_kind("period_doubling")[0]
+    curves = {}
+    for name, (of, v0, stops) in axes.items():
+        for lab, bif in (("PD1", pd1), ("PD2", pd2), ("end", ep)):
+            parts = []
+            for s in stops:
+                c0 = time.process_time()
+                marks = [r for r in ((0.5, 1.0, 2.0) if name == "b/a" else (0.5, 2.0, 5.0))
+                         if min(v0, s) < r < max(v0, s)]
+                cv = continue_bifurcation(bif, name, s, params_of=of, value=v0, max_points=300,
+                                          at=marks)
+                say("%-5s %-3s %s %.2f -> %.4g: %d points, %d maps, %.2f s CPU; gamma %.4f -> "
+                    "%.4f deg; stop: %s" % (name, lab, name, v0, cv.values[-1, 1], len(cv),
+                                            cv.n_maps, time.process_time() - c0,
+                                            cv.values[0, 0] / DEG, cv.values[-1, 0] / DEG,
+                                            cv.stop_reason))
+                parts.append(cv.values[::-1] if s < v0 else cv.values)
+            v = np.vstack([parts[0], parts[1][1:]])
+            curves[name, lab] = v
+            for r in (0.5, 1.0, 2.0) if name == "b/a" else (0.5, 2.0, 5.0):
+                if v[:, 1].min() <= r <= v[:, 1].max():
+                    say("      at %s = %.2f: gamma = %.4f deg" % (name, r, np.interp(
+                        r, v[:, 1], v[:, 0]) / DEG))
+    say("all curves: %.1f s CPU" % (time.process_time() - t0))
+    say("load average after: %s" % (os.getloadavg(),))
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axs = plt.subplots(1, 2, figsize=(10, 4.2), layout="constrained")
+    for ax, name in zip(axs, axes):
+        c1, c2 = curves[name, "PD1"] / [DEG, 1], curves[name, "PD2"] / [DEG, 1]
+        # polygons: slope 0 to PD1 (period 1 stable), PD1 to PD2 (period 2 stable); both
+        # doubling curves end on the end curve, which closes them there
+        e = curves[name, "end"] / [DEG, 1]
+        e = e[e[:, 1] < c1[0, 1]]              # the end curve below the corner (PD1 meets it)
+        ax.fill(np.r_[e[:, 0], c1[:, 0], 0, 0], np.r_[e[:, 1], c1[:, 1], c1[-1, 1], e[0, 1]],
+                color="C2", alpha=0.25, lw=0, label="period-1 gait stable")
+        ax.fill(np.r_[c1[:, 0], c2[::-1, 0]], np.r_[c1[:, 1], c2[::-1, 1]], color="C1",
+                alpha=0.25, lw=0, label="period-2 gait stable")
+        for k, st in (("PD1", "C2-"), ("PD2", "C1-"), ("end", "k--")):
+            c = curves[name, k]
+            ax.plot(c[:, 0] / DEG, c[:, 1], st, lw=1.5,
+                    label={"PD1": "PD of the period-1 gait", "PD2": "PD of the period-2 gait",
+                           "end": "end: trailing foot stays down"}[k])
+        ax.set_xlabel("slope gamma [deg]")
+        ax.set_ylabel({"b/a": "b/a [-] (hip-to-leg-mass / leg-mass-to-foot)",
+                       "m_H/m": "m_H/m [-] (hip mass / leg mass)"}[name])
+        ax.set_xlim(0, 13)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="upper right" if name == "b/a" else "lower right")
+    axs[0].set_title("compass gait, m_H/m = 2", fontsize=9)
+    axs[1].set_title("compass gait, b/a = 1", fontsize=9)
+    fig.savefig(FIGS / "continuation_goswami.png", dpi=150)
+    say("wrote docs/figures/continuation_goswami.png")
+
+
+def _walks(y, P, n=400):
+    """Walk n steps of the hybrid map from y: 0 falls, 1 settles (the last step moves the
+    state by < 1e-8), 2 walks on without settling."""
+    y_prev = y
+    for _ in range(n):
+        try:
+            y_prev, y = y, H.step_map(y, P)
+        except pdw.FellError:
+            return 0
+    return 1 if np.max(np.abs(y - y_prev)) < 1e-8 else 2
+
+
+def part_region_hip():
+    """The paper walker on rigid ground (hybrid model): where its gait exists and is stable in
+    (k_hip, d_hip), the d_hip fold followed in k_hip, against a brute-force grid of find_gait."""
+    from pdw.analysis.bifurcation.codim2 import continue_bifurcation
+    say("== paper_steady (hybrid): the existence and stability region in (k_hip, d_hip) ==")
+    say("load average before: %s" % (os.getloadavg(),))
+    P = pdw.Params.paper_steady()
+    t0 = time.process_time()
+    b = continue_gait(P, "d_hip", 0.1, model="hybrid", max_points=150)
+    fold = b.of_kind("fold")[0]
+    parts = []
+    for stop in (0.0, 6.0):
+        c0 = time.process_time()
+        cv = continue_bifurcation(fold, "k_hip", stop, max_points=300,
+                                  at=[0.5] if stop < 0.95 else [2.0, 3.9838, 5.0])
+        say("fold d_hip = %.7f at k_hip = 0.95 followed to k_hip %.4g: %d points, %d maps, "
+            "%.2f s CPU; d_hip %.6f -> %.6f; stop: %s"
+            % (fold.value, cv.values[-1, 1], len(cv), cv.n_maps, time.process_time() - c0,
+               cv.values[0, 0], cv.values[-1, 0], cv.stop_reason))
+        parts.append(cv.values[::-1] if stop < 0.95 else cv.values[1:])
+    curve = np.vstack(parts)
+    for k in (0.0, 0.5, 0.95, 2.0, 3.9838, 5.0):
+        say("  k_hip = %.4f: fold at d_hip = %.6f" % (k, np.interp(k, curve[:, 1], curve[:, 0])))
+    say("fold curve: %.2f s CPU" % (time.process_time() - t0))
+    c0 = time.process_time()
+    bk = continue_gait(P, "k_hip", 0.0, model="hybrid")
+    b0 = continue_gait(P.replace(k_hip=0.0), "d_hip", 0.0, model="hybrid", start=bk.state[-1])
+    pd = b0.of_kind("period_doubling")[0]
+    pdc = continue_bifurcation(pd, "k_hip", 1.0)
+    lobe = pdc.values
+    say("period doubling at k_hip = 0, d_hip = %.7f (paper_steady's family continued to "
+        "k_hip = 0, then in d_hip) followed in k_hip: %d points, %.2f s CPU, to k_hip = %.5f, "
+        "d_hip = %.3g; stop: %s" % (pd.value, len(pdc), time.process_time() - c0,
+                                    lobe[-1, 1], lobe[-1, 0], pdc.stop_reason))
+    # brute force: long walks on a grid, each row from the gait of paper_steady's family at
+    # d_hip = 0.005 (continued in k_hip: at small k_hip find_gait alone finds another, unstable
+    # gait, multiplier 3.7 at k_hip = 0)
+    t0 = time.process_time()
+    ks, ds = np.linspace(0.0, 6.0, 25), np.linspace(0.0005, 0.024, 24)
+    P5 = P.replace(d_hip=0.005)
+    rows = [continue_gait(P5, "k_hip", s, model="hybrid", at=list(ks)) for s in (0.0, 6.0)]
+    grid = np.zeros((len(ks), len(ds)), dtype=int)  # 0 falls, 1 settles on a gait, 2 walks on
+    for i, k in enumerate(ks):
+        r = rows[0] if k <= 0.95 else rows[1]
+        y0 = r.state[int(np.argmin(np.abs(r.values - k)))]
+        for j, d in enumerate(ds):
+            grid[i, j] = _walks(y0, P.replace(k_hip=k, d_hip=d))
+    say("grid %d x %d of 400-step walks: %d settle on a gait, %d walk on unsettled, %d fall; "
+        "%.1f s CPU" % (len(ks), len(ds), (grid == 1).sum(), (grid == 2).sum(),
+                        (grid == 0).sum(), time.process_time() - t0))
+    d_at = np.interp(ks, curve[:, 1], curve[:, 0])
+    wrong = [(k, d, grid[i, j]) for i, k in enumerate(ks) for j, d in enumerate(ds)
+             if (grid[i, j] != 0) != (d < d_at[i])]
+    say("grid points on the wrong side of the fold curve (walks above / falls below): %d %s"
+        % (len(wrong), wrong[:6]))
+    l_at = np.interp(ks, lobe[:, 1], lobe[:, 0], right=-1.0)
+    wrong = [(k, d, grid[i, j]) for i, k in enumerate(ks) for j, d in enumerate(ds)
+             if grid[i, j] != 0 and (grid[i, j] == 2) != (d < l_at[i])]
+    say("walking grid points on the wrong side of the doubling curve (unsettled above / "
+        "settled below): %d %s" % (len(wrong), wrong[:6]))
+    say("load average after: %s" % (os.getloadavg(),))
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.2, 4.4), layout="constrained")
+    ax.fill_between(curve[:, 1], 0, curve[:, 0], color="C2", alpha=0.2,
+                    label="period-1 gait exists")
+    ax.plot(curve[:, 1], curve[:, 0], "C2-", lw=1.8, label="fold (continue_bifurcation)")
+    ax.fill(np.r_[lobe[:, 1], 0], np.r_[lobe[:, 0], 0], color="C1", alpha=0.35, lw=0,
+            label="period-1 gait unstable (past a doubling)")
+    ax.plot(lobe[:, 1], lobe[:, 0], "C1-", lw=1.5, label="period doubling")
+    kk, dd = np.meshgrid(ks, ds, indexing="ij")
+    for v, mk, lab in ((1, "C2o", "400-step walk settles"), (2, "C0^", "walks, unsettled"),
+                       (0, "kx", "the walker falls")):
+        m = grid == v
+        ax.plot(kk[m], dd[m], mk, ms=2.5, label=lab)
+    ax.plot([0.95], [0.010], "k*", ms=9, label="paper_steady")
+    ax.set_xlabel("k_hip [N m/rad]")
+    ax.set_ylabel("d_hip [N m s/rad]")
+    ax.set_title("paper walker on rigid ground (hybrid), slope 0.02 rad", fontsize=9)
+    ax.legend(fontsize=7, loc="upper right")
+    ax.grid(alpha=0.3)
+    fig.savefig(FIGS / "continuation_region_hip.png", dpi=150)
+    say("wrote docs/figures/continuation_region_hip.png")
+
+
+def part_fold_kn():
+    """The continuous model's (paper_steady, paper variant) low-d_n fold followed in k_n: the
+    edge of the paper walker's existence and stability region in (k_n, d_n), with CPU and wall
+    time (the issue's budget: 10 minutes on 2 cores), against long walks of the step map."""
+    from pdw.analysis import poincare
+    from pdw.analysis.bifurcation.codim2 import continue_bifurcation
+    say("== paper_steady (continuous, paper variant): its d_n fold followed in k_n ==")
+    say("load average before: %s" % (os.getloadavg(),))
+    P = pdw.Params.paper_steady()
+    w0, c0 = time.perf_counter(), time.process_time()
+    b = continue_gait(P, "d_n", 1e3, log=True, max_points=25, workers=2)
+    fold = b.of_kind("fold")[0]
+    say("one parameter, d_n 1e6 -> down: %d points, %d maps, %.1f s wall, %.1f s CPU; first "
+        "fold at d_n = %.7g (k_n = 1e5)" % (len(b), b.n_maps, time.perf_counter() - w0,
+                                             time.process_time() - c0, fold.value))
+    curves = []
+    for stop in (3e5, 3e4):
+        w0, c0 = time.perf_counter(), time.process_time()
+        cv = continue_bifurcation(fold, "k_n", stop, fd_step=1e-4, max_points=60)
+        say("fold curve k_n 1e5 -> %.3g: %d points, %d maps, %.1f s wall, %.1f s CPU (2 "
+            "threads); d_n %.6g -> %.6g; max |mu - 1| of the nearest multiplier %.2g; stop: %s"
+            % (stop, len(cv), cv.n_maps, time.perf_counter() - w0, time.process_time() - c0,
+               cv.values[0, 0], cv.values[-1, 0],
+               np.max(np.min(np.abs(cv.multipliers - 1.0), axis=1)), cv.stop_reason))
+        curves.append(cv)
+    for cv in curves:
+        for v in cv.values[::4]:
+            say("  k_n = %.6g  d_n = %.6g" % (v[1], v[0]))
+    # brute force: 120-step walks on a grid, each column from the gait at d_n = 1e6
+    w0, c0 = time.perf_counter(), time.process_time()
+    kns = np.array([4e4, 6e4, 1e5, 1.5e5, 2e5, 3e5])
+    dns = np.geomspace(1.5e4, 2e5, 9)
+    rows = [continue_gait(P, "k_n", s, log=True, at=[k for k in kns if (k < 1e5) == (s < 1e5)],
+                          max_points=30, workers=2) for s in (3e4, 3.5e5)]
+    grid = np.zeros((len(kns), len(dns)), dtype=int)
+    for i, k in enumerate(kns):
+        r = rows[0] if k < 1e5 else rows[1]
+        z0 = r.z[int(np.argmin(np.abs(r.values - k)))]
+        for j, d in enumerate(dns):
+            z, zp, ok = z0, z0, True
+            for _ in range(120):
+                out = poincare.step(z, P.replace(k_n=k, d_n=d))
+                if out["status"] != "ok":
+                    ok = False
+                    break
+                zp, z = z, out["z"]
+            grid[i, j] = 0 if not ok else (1 if np.max(np.abs(z - zp)) < 1e-6 else 2)
+    say("grid %d x %d of 120-step walks: %d settle, %d walk unsettled, %d fall; %.1f s wall, "
+        "%.1f s CPU" % (len(kns), len(dns), (grid == 1).sum(), (grid == 2).sum(),
+                        (grid == 0).sum(), time.perf_counter() - w0, time.process_time() - c0))
+    allv = np.vstack([curves[1].values[::-1], curves[0].values[1:]])
+    for i, k in enumerate(kns):
+        say("  k_n = %.3g: walks (d_n: F fell, S settled, U unsettled): %s" % (k, " ".join(
+            "%.3g:%s" % (d, "FSU"[grid[i, j]]) for j, d in enumerate(dns))))
+    # the 10-minute benchmark of the issue: a longer fold curve, of the d_hip = 0.014 walker
+    P14 = P.replace(d_hip=0.014)
+    w0, c0 = time.perf_counter(), time.process_time()
+    b14 = continue_gait(P14, "d_n", 1e8, log=True, max_points=30, workers=2)
+    f14 = b14.of_kind("fold")[0]
+    cv14 = continue_bifurcation(f14, "k_n", 1e6, fd_step=1e-4, max_points=80)
+    say("d_hip = 0.014: fold at d_n = %.7g (k_n = 1e5) followed in k_n: %d points, %d maps, "
+        "%.1f s wall, %.1f s CPU (2 threads, with the one-parameter run that found it); k_n "
+        "in [%.4g, %.4g], d_n in [%.4g, %.4g]; max |mu - 1| %.2g; stop: %s"
+        % (f14.value, len(cv14), cv14.n_maps, time.perf_counter() - w0,
+           time.process_time() - c0, cv14.values[:, 1].min(), cv14.values[:, 1].max(),
+           cv14.values[:, 0].min(), cv14.values[:, 0].max(),
+           np.max(np.min(np.abs(cv14.multipliers - 1.0), axis=1)), cv14.stop_reason))
+    say("load average after: %s" % (os.getloadavg(),))
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, (ax, a2) = plt.subplots(1, 2, figsize=(11, 4.4), layout="constrained")
+    a2.plot(cv14.values[:, 1], cv14.values[:, 0], "C3.-", lw=1.5, ms=3)
+    a2.plot([1e5], [f14.value], "ks", ms=5, label="start: LP of the d_n family")
+    a2.set_xlabel("k_n [N/m^1.5]")
+    a2.set_ylabel("d_n [N s/m^2.5]")
+    a2.set_yscale("log")
+    a2.set_title("d_hip = 0.014: the fold curve (%d points, %.0f s wall)"
+                 % (len(cv14), time.perf_counter() - w0), fontsize=9)
+    a2.legend(fontsize=7)
+    a2.grid(alpha=0.3, which="both")
+    ax.plot(allv[:, 1], allv[:, 0], "C3-", lw=1.8, label="fold (continue_bifurcation)")
+    kk, dd = np.meshgrid(kns, dns, indexing="ij")
+    for v, mk, lab in ((1, "C2o", "120-step walk settles"), (2, "C0^", "walks, unsettled"),
+                       (0, "kx", "the walker falls")):
+        m = grid == v
+        ax.plot(kk[m], dd[m], mk, ms=4, label=lab)
+    ax.plot([1e5], [1e6], "k*", ms=9, label="paper_steady")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("k_n [N/m^1.5]")
+    ax.set_ylabel("d_n [N s/m^2.5]")
+    ax.set_title("paper_steady (d_hip = 0.01): fold of the low-d_n end, and long walks",
+                 fontsize=9)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3, which="both")
+    fig.savefig(FIGS / "continuation_fold_kn.png", dpi=150)
+    say("wrote docs/figures/continuation_fold_kn.png")
+
+
+def part_codim2_schemes():
+    """The continuous fold curve's two derivative schemes interleaved (8 points each, two
+    rounds), and sigma_tol = tol = 1e-9: the stall of the last round."""
+    from pdw.analysis.bifurcation.codim2 import continue_bifurcation
+    say("== d_hip = 0.014 walker's d_n fold in k_n: directional vs monodromy second "
+        "differences ==")
+    say("load average before: %s" % (os.getloadavg(),))
+    P = pdw.Params.paper_steady(d_hip=0.014)
+    b = continue_gait(P, "d_n", 1e8, log=True, max_points=30, workers=2)
+    f = b.of_kind("fold")[0]
+    for r in range(2):
+        for sec in ("directional", "monodromy"):
+            w0, c0 = time.perf_counter(), time.process_time()
+            cv = continue_bifurcation(f, "k_n", 2e5, fd_step=1e-4, max_points=8, second=sec)
+            say("round %d %-11s: %d points, %d maps, %.1f s wall, %.1f s CPU; to k_n = %.6g"
+                % (r, sec, len(cv), cv.n_maps, time.perf_counter() - w0,
+                   time.process_time() - c0, cv.values[-1, 1]))
+    try:
+        continue_bifurcation(f, "k_n", 2e5, fd_step=1e-4, max_points=8, sigma_tol=1e-9)
+        say("sigma_tol = 1e-9: ran")
+    except pdw.GaitNotFoundError as e:
+        say("sigma_tol = 1e-9 (the last round's behaviour): %s" % e)
+    say("load average after: %s" % (os.getloadavg(),))
+
+
+def part_ns_search():
+    """Where could a Neimark-Sacker point be? The largest modulus of a complex pair of
+    multipliers along one-parameter families of the hybrid paper walker (d_hip from 0 to its
+    fold, at 25 k_hip in [0, 6]; the slope from 0.02 to 0.2) and of the compass gait (slope)."""
+    say("== Neimark-Sacker search: complex multiplier pairs along families (hybrid) ==")
+    P = pdw.Params.paper_steady()
+    t0 = time.process_time()
+    best, n_pts, n_ns = (0.0, None), 0, 0
+    P5 = P.replace(d_hip=0.005)
+    ks = np.linspace(0.0, 6.0, 25)
+    rows = [continue_gait(P5, "k_hip", s, model="hybrid", at=list(ks)) for s in (0.0, 6.0)]
+    for k in ks:
+        r = rows[0] if k <= 0.95 else rows[1]
+        y0 = r.state[int(np.argmin(np.abs(r.values - k)))]
+        for stop in (0.0, 0.1):
+            b = continue_gait(P.replace(k_hip=k, d_hip=0.005), "d_hip", stop, model="hybrid",
+                              start=y0, max_points=100)
+            n_pts += len(b)
+            n_ns += len(b.of_kind("neimark_sacker"))
+            for v, m in zip(b.values, b.multipliers):
+                cx = [abs(x) for x in m if abs(x.imag) > 1e-8]
+                if cx and max(cx) > best[0]:
+                    best = (max(cx), (k, v))
+    say("paper walker, d_hip families at 25 k_hip: %d points, %d NS located; largest complex "
+        "|mu| = %.4f at (k_hip, d_hip) = (%.3g, %.4g); %.1f s CPU"
+        % (n_pts, n_ns, best[0], best[1][0], best[1][1], time.process_time() - t0))
+    for name, Q, stop in (("paper walker, slope", P, 0.2),
+                          ("compass gait, slope", H.compass_gait_params(), 12 * DEG)):
+        b = continue_gait(Q, "gamma", stop, model="hybrid", max_points=300)
+        cx = [abs(x) for m in b.multipliers for x in m if abs(x.imag) > 1e-8]
+        say("%s to %.3g: %d points, %d NS located, largest complex |mu| = %s"
+            % (name, stop, len(b), len(b.of_kind("neimark_sacker")),
+               "%.4f" % max(cx) if cx else "none (all real)"))
+
+
 def part_chaos():
     from pdw.analysis.rigid import chaos
     C = H.compass_gait_params()
@@ -386,6 +722,8 @@ def part_monodromy(rounds=3):
 
 if __name__ == "__main__":
     parts = sys.argv[1:] or ["hybrid"]
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    FIGS.mkdir(parents=True, exist_ok=True)
     for part in parts:
         OUT.clear()
         t0 = time.perf_counter()
@@ -393,8 +731,10 @@ if __name__ == "__main__":
          "dhip": part_dhip, "rigid": part_rigid,
          "rigid_paper": part_rigid_paper, "fig11": part_fig11,
          "simplest_limit": part_simplest_limit, "kelvin_voigt": part_kelvin_voigt,
-         "codim2": part_codim2, "chaos": part_chaos, "monodromy": part_monodromy}[part]()
+         "codim2": part_codim2, "goswami": part_goswami, "region_hip": part_region_hip,
+         "fold_kn": part_fold_kn, "codim2_schemes": part_codim2_schemes,
+         "ns_search": part_ns_search, "chaos": part_chaos,
+         "monodromy": part_monodromy}[part]()
         say("(%s: %.1f s wall; python benchmarks/continuation.py %s)"
             % (part, time.perf_counter() - t0, part))
-        RESULTS.mkdir(exist_ok=True)
         (RESULTS / ("continuation_%s.txt" % part)).write_text("\n".join(OUT) + "\n")

@@ -104,6 +104,11 @@ class _Problem:
                     down = 0.0
         return up, down
 
+    def images(self, points):
+        """P^n(z) for every (z, params) of ``points`` (no Jacobians): a list of (dim,) arrays,
+        None where the map fails. The codim-2 problems' second differences use it."""
+        raise NotImplementedError
+
     def params_at(self, mu) -> Params:
         v = self.value(mu)
         try:
@@ -152,6 +157,13 @@ class HybridProblem(_Problem):
             steps.append(res)
             y = np.ascontiguousarray(res["y_plus"])
         return y, DP, steps
+
+    def images(self, points):
+        out = []
+        for z, P in points:
+            o = self._steps(parameter_vector(P), np.asarray(z, dtype=float), False)
+            out.append(None if isinstance(o, str) else o[0][list(H._SECTION)])
+        return out
 
     def evaluate(self, z, mu, jac=True) -> Evaluation:
         try:
@@ -246,6 +258,21 @@ class ContinuousProblem(_Problem):
         return _maps.compose_points([t[0] for t in tasks], self.period,
                                  [self.params_at(mu) for _, mu in tasks], self.variant,
                                  self.method, {**self.opts, "t_hint": self.t_hint}, self.workers)
+
+    def images(self, points):
+        if not points:
+            return []
+        zs = [np.asarray(z, dtype=float) for z, _ in points]
+        ps = [P for _, P in points]
+        if self.executor is not None:
+            outs = list(self.executor.map(
+                lambda zp: LC._compose(zp[0], self.period, zp[1], self.variant, self.method,
+                                       {**self.opts, "t_hint": self.t_hint}), zip(zs, ps)))
+        else:
+            outs = LC.compose_points(zs, self.period, ps, self.variant, self.method,
+                                     {**self.opts, "t_hint": self.t_hint}, self.workers)
+        self.n_maps += self.period * len(points)
+        return [o[0] for o in outs]
 
     def evaluate(self, z, mu, jac=True) -> Evaluation:
         z = np.asarray(z, dtype=float)

@@ -4,9 +4,12 @@ matrices (issue #24 item 2; a Python/SciPy version over the compiled rhs and Jac
 One step of the touch-down map (`pdw.analysis.stepmap.poincare.step`) from section point z:
 
     x0 = E(z)          (`section.embed`: leg 2's contact point at the origin, flags (1, 1))
-    x' = f(x; flags)   between support-flag switches (lift-off: a support foot's height
-                       g_i = y_o - r - (l - r) cos(theta_i) through 0 upwards; touch-down: a swing
-                       foot's through 0 downwards while ahead of the other foot), and
+    x' = f(x; flags)   between support-flag switches (lift-off, Eq. 18a: a support foot's height
+                       g_i = y_o - r - (l - r) cos(theta_i) > 0 AND its normal rate v_i (the
+                       paper's Eq. 5) > 0: where g_i passes 0 first, the foot stays support,
+                       without penetration force, until v_i passes 0 (or g_i returns below 0);
+                       touch-down: a swing foot's height through 0 downwards while ahead of
+                       the other foot), and
     z' = R x(T)        at leg 1's touch-down (`section_coordinates(x, leg=1)`: relabelled).
 
 Its Jacobian is M = R S_T Phi(T) E with Phi' = A(x(t)) Phi (A = df/dx, `pdw.ode_function`'s
@@ -50,6 +53,18 @@ def _foot(x, leg, p):
     grad[1] = 1.0
     grad[2 + leg] = (p.l - p.r) * math.sin(th)
     return g, grad, x[0] + (p.l - p.r) * math.sin(th)
+
+
+def _rate(x, leg, p):
+    """(v, grad v (8,)): leg's normal rate in the paper variant (docs/model.md section 6),
+    v = ydot_o + (l - r) sin(theta) thetadot + r thetadot, which Eq. 18's flag rules read."""
+    th, w = x[2 + leg], x[6 + leg]
+    v = x[5] + (p.l - p.r) * math.sin(th) * w + p.r * w
+    grad = np.zeros(N)
+    grad[5] = 1.0
+    grad[2 + leg] = (p.l - p.r) * math.cos(th) * w
+    grad[6 + leg] = (p.l - p.r) * math.sin(th) + p.r
+    return v, grad
 
 
 def _event(fn, direction):
@@ -113,11 +128,16 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
 
     armed = [False, True]       # a swing foot touches down only ahead of the other one
     gate_dir = [0.0, 0.0]       # after a gate crossing only the opposite one (not t0 again)
+    # a support foot above the ground whose normal rate is not yet > 0: Eq. 18a lifts it off
+    # only when v > 0 too, so until then it stays support (flag 1) with no penetration force
+    pending = [False, False]
 
     for _ in range(max_events):
         evs = []
         for leg in (0, 1):
-            if flags[leg] or armed[leg]:
+            if flags[leg] and pending[leg]:     # Eq. 18a's second condition, v through 0
+                evs.append(_event(lambda t, xx, leg=leg: _rate(xx, leg, p)[0], 1.0))
+            elif flags[leg] or armed[leg]:
                 evs.append(_event(lambda t, xx, leg=leg: _foot(xx, leg, p)[0],
                                   1.0 if flags[leg] else -1.0))
             else:                   # arming: the swing foot passes the other foot
@@ -126,6 +146,9 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
         for leg in (0, 1):          # Eq. 11's gate: the tangential damper acts while xi <= 0
             evs.append(_event(lambda t, xx, leg=leg, on=flags[leg]: xx[2 + leg] if on else 1.0,
                               gate_dir[leg]))
+        for leg in (0, 1):          # a pending foot back into the ground: contact again
+            evs.append(_event(lambda t, xx, leg=leg, on=pending[leg]:
+                              _foot(xx, leg, p)[0] if on else 1.0, -1.0))
         x_start = x.copy()
         sol = solve_ivp(f, (t0, t_max), x, method="Radau", rtol=rtol, atol=atol, jac=f.jac,
                         events=evs, dense_output=True)
@@ -146,6 +169,27 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
             raise InvalidInputError("variational step_jacobian: variational equations "
                                     "failed: %s" % ph.message)
         Phi = ph.y[N:, -1].reshape(N, N)
+        if k_ev >= 4 or (k_ev < 2 and flags[leg] and pending[leg]):
+            # a pending foot's normal rate through 0 (the lift-off, Eq. 18a: the flag-gated
+            # forces stop) or its height back through 0 (the penetration force returns)
+            fx = f(t_ev, x)
+            tau = 1e-9
+            f_minus = f(t_ev, x - tau * fx)
+            if k_ev < 2:
+                _, grad = _rate(x, leg, p)
+                flags[leg] = 0
+                armed[leg] = False
+                f.set_discrete(flags[0], flags[1], 0.0, 0.0)
+                events.append((t_ev, "lift_off", leg + 1))
+            else:
+                _, grad, _ = _foot(x, leg, p)
+            pending[leg] = False
+            f_plus = f(t_ev, x + tau * fx)
+            S = np.eye(N) + np.outer(f_plus - f_minus, grad) / (grad @ f_minus)
+            Phi = S @ Phi
+            salts.append(S)
+            t0 = t_ev
+            continue
         if k_ev >= 2:               # a gate of the force law: f jumps, the flags stay
             grad = np.zeros(N)
             grad[2 + leg] = 1.0
@@ -179,6 +223,16 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
             M = R @ S @ Phi @ _embed_jac(z, p)
             return {"z": R @ x, "M": M, "T": t_ev, "events": events, "saltations": salts,
                     "x": x, "dx_dz": S @ Phi @ _embed_jac(z, p), "Phi": Phi}
+        if flags[leg] and _rate(x, leg, p)[0] <= 0.0:
+            # above the ground but not yet rising (Eq. 18a): the penetration force ends, the
+            # flag stays 1 until v > 0
+            pending[leg] = True
+            f_plus = f(t_ev, x + tau * fx)
+            S = np.eye(N) + np.outer(f_plus - f_minus, grad) / (grad @ f_minus)
+            Phi = S @ Phi
+            salts.append(S)
+            t0 = t_ev
+            continue
         flags[leg] = 0 if flags[leg] else 1
         armed[leg] = False
         f.set_discrete(flags[0], flags[1], 0.0, 0.0)
