@@ -34,7 +34,7 @@ dP~/dmu2 = dF/dmu2, so the *unchanged* one-parameter engine (`run_continuation`)
 `continue_bifurcation` returns a `BifurcationCurve` whose ``values`` are (N, 2): the first
 (the bifurcation's own) and the second parameter.
 
-(Over 500 lines: the augmented problem's three residuals (bordered sigma with monodromy or
+(Why this module is long: the augmented problem's three residuals (bordered sigma with monodromy or
 directional derivatives, and the admissibility function of an end) share its border vectors,
 parameter handling and batch of maps, so they stay in one class.)
 """
