@@ -40,17 +40,20 @@ CASES = [
     ("_hybrid.walk(P, Y0, 0.0, 2 ** 64, {}, 0)", "n_steps", "InvalidInputError"),
     ("_hybrid.walk(P, Y0, 0.0, 3, {}, BIG)", "rec_cap", "InvalidInputError"),
     ("_hybrid.step(P, Y0, {}, 0.0, 0.0, BIG)", "rec_cap", "InvalidInputError"),
-    ("_core.run(0, 0, X0, P, 0, 1, 1e-4, BIG, 0, False, 0.2, 0.1, 1e3)", "n_steps",
+    ("_core.run(0, 0, X0, P, 0, 1, dict(dt=1e-4, n_steps=BIG, max_speed=1e3))", "n_steps",
      "InvalidInputError"),
-    ("_core.run(0, 0, X0, P, 0, 1, 1e-4, 10, 1, False, 0.2, 0.1, 1e3, max_records=BIG)",
+    ("_core.run(0, 0, X0, P, 0, 1, dict(dt=1e-4, n_steps=10, record_every=1, max_speed=1e3), "
+     "max_records=BIG)",
      "max_records", "InvalidInputError"),
-    ("_core.run(0, 0, X0, P, 0, 1, 1e-4, 10, 1, False, 0.2, 0.1, 1e3, event_capacity=BIG)",
+    ("_core.run(0, 0, X0, P, 0, 1, dict(dt=1e-4, n_steps=10, record_every=1, record_events=1, "
+     "max_speed=1e3), event_capacity=BIG)",
      "event_capacity", "InvalidInputError"),
-    ("_core.run(0, 0, X0, P, 0, 1, 1e-4, 2 ** 64, 0, False, 0.2, 0.1, 1e3)", "n_steps",
+    ("_core.run(0, 0, X0, P, 0, 1, dict(dt=1e-4, n_steps=2 ** 64, max_speed=1e3))", "n_steps",
      "InvalidInputError"),
     ("_core.bench(0, 'rhs', X0, P, 0, 1, 0.0, 0.0, BIG)", "n", "InvalidInputError"),
     # found by the round-three fuzz run: a poll before every step, so never a step (a hang)
-    ("_core.run(0, 0, X0, P, 0, 1, 1e-4, 20, 1, True, 0.25, 0.125, 1e3, poll_every=1)",
+    ("_core.run(0, 0, X0, P, 0, 1, dict(dt=1e-4, n_steps=20, record_every=1, max_speed=1e3), "
+     "poll_every=1)",
      "poll_every", "InvalidInputError"),
 ]
 
@@ -92,7 +95,7 @@ x = np.tile(X0, (n, 1))
 outd = B._outputs(n)
 try:
     _batch.run_range(0, x, P[None], np.tile(np.array([0, 1], np.intc), (n, 1)),
-                     np.full(n, 0.2), np.full(n, 0.1), 1e-4, BIG, 1e3, 0, 0, 0.0,
+                     np.full(n, 0.2), np.full(n, 0.1), dict(dt=1e-4, n_steps=BIG, max_speed=1e3),
                      outd, 0, n, 1, False)
 except Exception as e:
     print("RAISED", type(e).__name__, "|", e)
@@ -116,7 +119,9 @@ def test_counts_within_range_still_run():
     res, t, y, k = _hybrid.walk(p, np.array([0.2, -0.2, -1.0, -0.3]), 0.0, 2, {}, 100)
     assert len(res) >= 1
     raw = _core.run(0, 0, np.array(pdw.X0_PAPER), parameter_vector(pdw.Params.paper()), 0, 1,
-                    1e-4, 10, 1, False, 0.2, 0.1, 1e3, max_records=16, event_capacity=8)
+                    dict(dt=1e-4, n_steps=10, record_every=1, record_events=1, fall_hip_height=0.2,
+                         fall_depth=0.1, max_speed=1e3), record_contact=False, max_records=16,
+                    event_capacity=8)
     assert len(raw["t"]) == 11
     g = pdw.hybrid.find_gait(pdw.Params.paper_steady(), settle_steps=5)
     assert g.period > 0

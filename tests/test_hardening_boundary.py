@@ -49,7 +49,7 @@ CASES = [
      "contact"),
     ("_core.precompute(np.ones(3), np.empty(NP))", "params"),
     ("_core.precompute(pdw.Params().as_array(), np.empty(3))", "p"),
-    ("_core.run(0, 0, np.zeros(3), P, 0, 1, 1e-4, 10, 1, True, 0.2, 0.1, 1e3)", "x0"),
+    ("_core.run(0, 0, np.zeros(3), P, 0, 1, dict(dt=1e-4, n_steps=10, max_speed=1e3))", "x0"),
     ("_core.bench(0, 'rhs', np.zeros(3), P, 0, 1, 0.0, 0.0, 10)", "x"),
     ("_hybrid.step_batch(P, np.zeros((4, 4)), {}, np.empty((1, 4)), np.empty(4, np.intc))",
      "y_plus"),
@@ -114,7 +114,8 @@ def _array_args(fn):
     parts = [p.split("=")[0].split() for p in raw]
     # the required arguments (no default), with a valid scalar for the non-array ones
     scalar = {"int": 0, "long": 0, "double": 0.0, "bint": False, "str": "rhs", "dict": {}}
-    names = [(p[-1], scalar.get(p[0], None)) for p, r in zip(parts, raw) if "=" not in r]
+    names = [(p[-1], scalar.get(p[0], None)) for p, r in zip(parts, raw)
+             if "=" not in r and p != ["*"]]      # keyword-only ones after "*" have defaults
     arrays = []
     for p in parts:
         m = re.fullmatch(r"(const )?(double|int|long)\[([:, 0-9]*)\] (\w+)", " ".join(p))
@@ -198,7 +199,7 @@ def test_batch_outputs_of_the_wrong_dtype_are_named():
     finally:
         mp.undo()
     args, kw = calls[0]
-    i_out = next(i for i, v in enumerate(args) if isinstance(v, dict))
+    i_out = next(i for i, v in enumerate(args) if isinstance(v, dict) and "status" in v)
     for key in ("n_steps", "x_final", "gait"):
         out = dict(args[i_out])
         out[key] = out[key].astype(np.float32 if out[key].dtype != np.float32 else np.float64)

@@ -30,8 +30,12 @@ P = parameter_vector(pdw.Params.paper())
 X = np.tile(np.array(pdw.X0_PAPER), (2, 1))
 F = np.tile(np.array([0, 1], dtype=np.intc), (2, 1))
 H, D = np.full(2, 0.5), np.full(2, 0.1)
+O = dict(dt=1e-4, n_steps=50, record_every=1, record_events=1, fall_hip_height=0.2,
+         fall_depth=0.1, max_speed=1e3)
 def rr(x=X, p=P[None], f=F, dt=1e-4, n=50, stop=0, pk=0, out=None):
-    return _batch.run_range(0, x, p, f, H, D, dt, n, 1e3, stop, pk, 1e-3,
+    return _batch.run_range(0, x, p, f, H, D, dict(dt=dt, n_steps=n, max_speed=1e3,
+                                                   stop_steps=stop, periodic_k=pk,
+                                                   periodic_tol=1e-3),
                             _outputs(len(x)) if out is None else out, 0, len(x), 4, False)
 def tampered(**arrays):
     b = RecordBuffer(100)
@@ -49,9 +53,9 @@ CRASH_CASES = [
     ("pdw.simulate(t_end=0.005, out=tampered(x=np.zeros((1, NX))))", "out.x"),
     ("pdw.simulate(t_end=0.05, out=tampered(t=np.zeros(5000)))", "out.x"),
     ("pdw.simulate(t_end=0.005, out=tampered(flags=np.zeros((100, 2))))", "out.flags"),
-    ("_core.run(0, 0, X[0], P, 0, 1, 1e-4, 50, 1, True, 0.2, 0.1, 1e3, buffers=bufs(nc=1))",
+    ("_core.run(0, 0, X[0], P, 0, 1, O, buffers=bufs(nc=1))",
      "contact"),
-    ("_core.run(0, 0, X[0], P, 0, 1, 1e-4, 50, 1, True, 0.2, 0.1, 1e3, "
+    ("_core.run(0, 0, X[0], P, 0, 1, O, "
      "buffers=bufs()[:1] + (np.zeros((3, NX)),) + bufs()[2:])", "x"),
     ("rr(f=np.array([[7, 1], [0, 1]], np.intc))", "flags0"),
     ("rr(dt=float('nan'))", "dt"),

@@ -483,14 +483,12 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
         if _integrators.get(method).adaptive:     # unknown step count: what the buffer has
             rows = max(min(rows, 4096), out.capacity)
         buffers = out.arrays(rows, contact.nx)
-    raw = _core.run(k, METHODS.index(method), x, p, f0[0], f0[1], dt, n_steps, int(record_every),
-                    bool(record_forces), hip, depth, max_speed, rtol, atol, h_max,
-                    event_tol=event_tol, record_events=bool(record_events), stop_steps=stop_steps,
-                    periodic_k=periodic_steps, periodic_tol=periodic_tol, t_end=t_end,
-                    max_steps=budget, buffers=buffers, approach_speeds0=v_in0,
-                    stop_touch_down=stop_touch_down,
-                    ground=None if ground.is_flat else _core.CGround(ground.table()),
-                    opts=_opt.c_options(it, rec, st, lim, skip=_opt.RUN_ARGS))
+    opts = _opt.c_options(it, rec, st, lim, dt=dt, n_steps=n_steps, t_end=t_end, h_max=h_max,
+                          max_steps=budget, periodic_k=periodic_steps, fall_hip_height=hip,
+                          fall_depth=depth)
+    raw = _core.run(k, METHODS.index(method), x, p, f0[0], f0[1], opts,
+                    record_contact=bool(record_forces), buffers=buffers, approach_speeds0=v_in0,
+                    ground=None if ground.is_flat else _core.CGround(ground.table()))
     wall = time.perf_counter() - start
     energies = None
     if record_energies and raw["interrupted"] is None:
