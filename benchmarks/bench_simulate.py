@@ -101,11 +101,12 @@ def first_call(lines):
 def python_overhead(lines, n=2000):
     P = pdw.Params.paper()
     x, p = np.asarray(pdw.X0_PAPER, dtype=float), parameter_vector(P)
+    R0 = pdw.Record(every=0)
     opts = dict(dt=1e-4, n_steps=2, record_events=1, fall_hip_height=0.25, fall_depth=0.125,
                 max_speed=1e3, rtol=1e-6, atol=1e-8, event_tol=1e-9)
     jobs = {
-        "simulate, 2 steps, params given": lambda: pdw.simulate(params=P, t_end=2e-4, record_every=0),
-        "simulate, 2 steps, defaults": lambda: pdw.simulate(t_end=2e-4, record_every=0),
+        "simulate, 2 steps, params given": lambda: pdw.simulate(params=P, t_end=2e-4, record=R0),
+        "simulate, 2 steps, defaults": lambda: pdw.simulate(t_end=2e-4, record=R0),
         "_core.run, 2 steps": lambda: _core.run(0, 0, x, p, 0, 1, opts),
     }
     times = {k: [] for k in jobs}

@@ -431,6 +431,18 @@ cdef tuple _records(long n, int nx, bint contact):
     return t, x, flags, c
 
 
+cdef dict _EMPTY_RECORDS = {}
+
+
+cdef tuple _no_records(int nx):
+    """The record arrays of a run that records nothing: empty (no element to write), made once
+    per state size nx (a Result's t, x, flags of no samples are views of them)."""
+    out = _EMPTY_RECORDS.get(nx)
+    if out is None:
+        out = _EMPTY_RECORDS[nx] = _records(0, nx, True)
+    return out
+
+
 cdef tuple _records_copy(tuple old, long n, long n_copy, int nx, bint contact):
     """Fresh record arrays for n samples (`_records`) holding the first n_copy of old's."""
     new = _records(n, nx, contact)
@@ -557,17 +569,23 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         if record_contact:
             _rows("buffers[3] (contact)", rec_contact.shape[0],
                   rec_contact.shape[1] if rec_contact.ndim == 2 else -1, n_rec_cap, PDW_NREC)
+    elif record_every == 0:     # nothing recorded: empty arrays, one set per state size
+        rec_t, rec_x, rec_flags, rec_contact = _no_records(nx)
     else:
         rec_t, rec_x, rec_flags, rec_contact = _records(n_rec_cap, nx, record_contact)
     cdef bint owned = buffers is None or record_every == 0  # the record arrays are ours
     events = _zeros("the event buffer (event_capacity)",
                     (max(event_capacity, 4) if record_events else 1, PDW_NEVENT))
-    cdef double[::1] v_t = rec_t
-    cdef double[:, ::1] v_x = rec_x
-    cdef int[:, ::1] v_f = rec_flags
-    cdef double[:, ::1] v_c = rec_contact
+    cdef double[::1] v_t
+    cdef double[:, ::1] v_x
+    cdef int[:, ::1] v_f
+    cdef double[:, ::1] v_c
     cdef double[:, ::1] v_e = events
     if n_rec_cap > 0:
+        v_t = rec_t
+        v_x = rec_x
+        v_f = rec_flags
+        v_c = rec_contact
         s.rec_t = &v_t[0]
         s.rec_x = &v_x[0, 0]
         s.rec_flags = &v_f[0, 0]
@@ -630,12 +648,13 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     cdef double *ring = &s.gait.ring[0][0]
     # fixed size (a view of the first n_keep rows is returned): the same memory however long
     # the run
-    gait = np.full((PDW_STEP_RING, PDW_NSTEP), np.nan)
+    gait = np.empty((PDW_STEP_RING, PDW_NSTEP))
+    cdef double[:, ::1] gv = gait
     cdef long r, c, slot
     for r in range(n_keep):
         slot = (n_gait - n_keep + r) % PDW_STEP_RING
         for c in range(PDW_NSTEP):
-            gait[r, c] = ring[slot * PDW_NSTEP + c]
+            gv[r, c] = ring[slot * PDW_NSTEP + c]
     return {
         "gait": gait[:n_keep],
         "n_gait_steps": n_gait,
