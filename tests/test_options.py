@@ -1,5 +1,6 @@
 """The option objects of a run (pdw/sim/options.py): validation, one name per option, the
 Scene holding the same objects, outcomes, and simulate_batch's progress and repr."""
+import dataclasses
 import io
 import warnings
 
@@ -201,9 +202,12 @@ def test_c_options_names_the_fields_of_pdw_run_opts():
     run derives; every name is a field of pdw_run_opts."""
     from pdw.core import _core
     from pdw.sim.options import c_options
-    names = c_options(Integrator(h_max=1.0, max_steps=5), Record(), Stop(), Limits())
-    assert set(names) == {"rtol", "atol", "event_tol", "record_every", "record_events",
-                          "stop_steps", "periodic_tol", "stop_touch_down", "max_speed"}
+    objs = (Integrator(h_max=1.0, max_steps=5), Record(), Stop(), Limits())
+    names = c_options(*objs)
+    named = {f.metadata["c"] for o in objs for f in dataclasses.fields(o) if f.metadata["c"]}
+    assert set(names) == named >= {"rtol", "atol", "event_tol", "record_every",
+                                   "record_events", "stop_steps", "periodic_tol",
+                                   "stop_touch_down", "max_speed"}
     assert set(names) <= set(_core.OPT_FIELDS)
     assert c_options(Stop(touch_down=1)) == {"stop_steps": 0, "periodic_tol": 1e-3,
                                              "stop_touch_down": 1}
