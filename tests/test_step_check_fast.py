@@ -47,3 +47,13 @@ def test_simulate_still_warns_above_the_limit_with_new_parameters():
         warnings.simplefilter("error", pdw.StepSizeWarning)
         pdw.simulate(params=P, t_end=0.01, record=pdw.Record(every=0))
     assert math.isfinite(dt)
+
+
+@pytest.mark.parametrize("variant", ["paper", "consistent"])
+def test_state_jacobians_together_are_state_jacobian_bit_for_bit(variant):
+    P = P0.replace(k_t=700.0)
+    X, flags = S.stance_states(P, variant)
+    for features in (S._NO_FRICTION, None):
+        together = S._state_jacobians(X, P, flags, variant, features)
+        alone = [S.state_jacobian(x, P, f, variant, features) for x, f in zip(X, flags)]
+        assert all(np.array_equal(a, b) for a, b in zip(together, alone))

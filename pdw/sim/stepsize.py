@@ -509,11 +509,23 @@ def state_jacobian(x, params: Params, flags, variant: str = "paper", features=_N
     return jacobian(x, params, flags=flags, anchors=anchors, variant=variant, features=features)
 
 
+def _state_jacobians(X, params: Params, flags, variant: str, features=_NO_FRICTION) -> list:
+    """[`state_jacobian` of each state of X (n, 8) with its flags], bit for bit, in two
+    compiled calls (rows are evaluated independently) without the per-call argument checks."""
+    X = np.array(X, dtype=float, ndmin=2)
+    F = np.array(flags, dtype=np.intc).reshape(len(X), 2)
+    anchors = np.where(F > 0, _contact(X, params, F, variant).s, 0.0)
+    J = np.empty((len(X), NX * NX))
+    folded = params if features is None else params.without(features)
+    _core.jacobian_batch(kernel_index(variant, features), X, parameter_vector(folded), F,
+                         anchors, J, np.empty((len(X), _core.NWORK)))
+    return list(J.reshape(len(X), NX, NX))
+
+
 def _limits(params: Params, method: str, variant: str, features=_NO_FRICTION):
     """Linear limits of ``method`` at each of `stance_states`."""
     X, flags = stance_states(params, variant)
-    return linear_limits(method, [state_jacobian(x, params, fl, variant, features)
-                                  for x, fl in zip(X, flags)])
+    return linear_limits(method, _state_jacobians(X, params, flags, variant, features))
 
 
 @functools.lru_cache(maxsize=1024)
@@ -575,13 +587,12 @@ def _safe(params: Params, method: str, variant: str, dt: float, f: float) -> boo
     if bound is None:
         c = CALIBRATION[variant][method]
         X, flags = stance_states(params, variant)
-        hs = linear_limits(method, [state_jacobian(x, params, fl, variant) for x, fl in
-                                    zip(X, flags)], enough=lambda h: not dt > f * (c * h))
+        hs = linear_limits(method, _state_jacobians(X, params, flags, variant),
+                           enough=lambda h: not dt > f * (c * h))
         bound = c * min(hs)
         if _friction_load(params, variant) >= FRICTION_LOAD:
             n = len(STANCE_STATES)
-            hc = linear_limits(method, [state_jacobian(x, params, fl, variant, None) for x, fl
-                                        in zip(X[:n], flags[:n])],
+            hc = linear_limits(method, _state_jacobians(X[:n], params, flags[:n], variant, None),
                                enough=lambda h: not dt > f * (CHATTER_CALIBRATION * h))
             bound = min(bound, CHATTER_CALIBRATION * min(hc))
         if len(_BOUNDS) >= 1024:
