@@ -38,10 +38,16 @@ CASES = [
     ("full recording (state, flags, forces every step)", dict(record_every=1, record_forces=True)),
     ("state every 10th step", dict(record_every=10, record_forces=False)),
 ]
+# the first and second call of a fresh process: the preset parameters (whose step limits are
+# precomputed, pdw.sim.stepsize_presets) and parameters of no preset (k_n 10 % up: the check
+# computes the limits, cut short, pdw.sim.stepsize._safe)
 FIRST_CALL = """
-import time, pdw
-t = time.process_time(); pdw.simulate(record_every=0); t1 = time.process_time()
-pdw.simulate(record_every=0); t2 = time.process_time()
+import sys, time, pdw
+P = pdw.Params.paper()
+P = P if sys.argv[1] == "preset" else P.replace(k_n=1.1 * P.k_n)
+R = pdw.Record(every=0)
+t = time.process_time(); pdw.simulate(params=P, record=R); t1 = time.process_time()
+pdw.simulate(params=P, record=R); t2 = time.process_time()
 print(t1 - t, t2 - t1)
 """
 
@@ -84,27 +90,34 @@ def recording(lines):
 
 
 def first_call(lines):
-    firsts, seconds = [], []
+    lines += ["", "first call of a fresh process (simulate(params=P, record=Record(every=0)), the "
+              "default step check), %d processes of each kind, interleaved; %s" % (FRESH, load())]
+    runs: dict = {"preset": ([], []), "other": ([], [])}
     for _ in range(FRESH):
-        out = subprocess.run([sys.executable, "-c", FIRST_CALL], capture_output=True, text=True,
-                             check=True).stdout.split()
-        firsts.append(float(out[0]))
-        seconds.append(float(out[1]))
-    a, b = statistics.median(firsts), statistics.median(seconds)
-    lines += ["", "first call of a fresh process (simulate(record_every=0), default step check), "
-              "%d processes; %s" % (FRESH, load()),
-              "  first %.2f ms, second %.2f ms: first / second = %.2fx (per process: %s)"
-              % (1e3 * a, 1e3 * b, a / b,
-                 ", ".join("%.2f" % (f / s) for f, s in zip(firsts, seconds)))]
+        for kind, (firsts, seconds) in runs.items():
+            out = subprocess.run([sys.executable, "-c", FIRST_CALL, kind], capture_output=True,
+                                 text=True, check=True).stdout.split()
+            firsts.append(float(out[0]))
+            seconds.append(float(out[1]))
+    for kind, (firsts, seconds) in runs.items():
+        a, b = statistics.median(firsts), statistics.median(seconds)
+        lines.append("  %-44s first %.2f ms, second %.2f ms: first / second = %.2fx (per "
+                     "process: %s)" % ("Params.paper() (preset)" if kind == "preset" else
+                                       "Params.paper() with k_n x 1.1 (no preset)", 1e3 * a,
+                                       1e3 * b, a / b, ", ".join("%.2f" % (f / s) for f, s
+                                                                 in zip(firsts, seconds))))
 
 
 def python_overhead(lines, n=2000):
     P = pdw.Params.paper()
     x, p = np.asarray(pdw.X0_PAPER, dtype=float), parameter_vector(P)
+    R0 = pdw.Record(every=0)
+    opts = dict(dt=1e-4, n_steps=2, record_events=1, fall_hip_height=0.25, fall_depth=0.125,
+                max_speed=1e3, rtol=1e-6, atol=1e-8, event_tol=1e-9)
     jobs = {
-        "simulate, 2 steps, params given": lambda: pdw.simulate(params=P, t_end=2e-4, record_every=0),
-        "simulate, 2 steps, defaults": lambda: pdw.simulate(t_end=2e-4, record_every=0),
-        "_core.run, 2 steps": lambda: _core.run(0, 0, x, p, 0, 1, 1e-4, 2, 0, True, 0.25, 0.125, 1e3),
+        "simulate, 2 steps, params given": lambda: pdw.simulate(params=P, t_end=2e-4, record=R0),
+        "simulate, 2 steps, defaults": lambda: pdw.simulate(t_end=2e-4, record=R0),
+        "_core.run, 2 steps": lambda: _core.run(0, 0, x, p, 0, 1, opts),
     }
     times = {k: [] for k in jobs}
     for f in jobs.values():

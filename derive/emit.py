@@ -368,6 +368,14 @@ def header(h):
         _enum("EVKIND", layout.EVENT_KIND), _enum("STOP", layout.STOP),
         "/* why a loop failed (pdw_failure.reason); the messages: _layout.REASON_TEXT */",
         _enum("REASON", [name for name, _ in layout.REASON]), "",
+        "/* returns of a loop that never reach a Result: the caller acts and resumes it",
+        " * (_layout.RESUME_TEXT) */",
+        "enum {\n%s\n};" % ",\n".join(
+            "    /* %s */\n    PDW_STATUS_%s = %d" % (text, name.upper(), layout.RESUME_BASE + i)
+            for i, (name, text) in enumerate(layout.RESUME)),
+        "/* the record buffers and the poll of one run (_core.pyx run) */",
+        "enum { PDW_RECORD_CHUNK = %d, PDW_RECORD_EXACT_MAX = %d, PDW_POLL_EVERY = %d };\n"
+        % (layout.RECORD_CHUNK, layout.RECORD_EXACT_MAX, layout.POLL_EVERY),
         "/* online gait analysis: one step's descriptors; the last PDW_STEP_RING steps are kept */",
         _enum("STEP", layout.STEP), "enum { PDW_STEP_RING = %d };" % layout.STEP_RING,
         "/* the descriptors compared by the periodic stop */",
@@ -487,7 +495,12 @@ def python_layout(h, ops):
         tup("EVENT", layout.EVENT), tup("RECORD_CONTACT", layout.RECORD_CONTACT),
         tup("STATUS", layout.STATUS), tup("EVENT_KIND", layout.EVENT_KIND),
         tup("STOP", layout.STOP), tup("REASON", [name for name, _ in layout.REASON]),
-        tup("REASON_TEXT", [text for _, text in layout.REASON]), tup("STEP", layout.STEP), "STEP_RING = %d\n" % layout.STEP_RING,
+        tup("REASON_TEXT", [text for _, text in layout.REASON]),
+        "RESUME_BASE = %d\n" % layout.RESUME_BASE, tup("RESUME", [name for name, _ in layout.RESUME]),
+        tup("RESUME_TEXT", [text for _, text in layout.RESUME]),
+        "RECORD_CHUNK = %d\n" % layout.RECORD_CHUNK,
+        "RECORD_EXACT_MAX = %d\n" % layout.RECORD_EXACT_MAX, "POLL_EVERY = %d\n" % layout.POLL_EVERY,
+        tup("STEP", layout.STEP), "STEP_RING = %d\n" % layout.STEP_RING,
         tup("PERIODIC_FIELDS", layout.PERIODIC_FIELDS),
         "WORK = %r\n" % work, "NWORK = %d\n" % pos,
         "# kernels in the order of the C table pdw_kernels[]: (name, variant, features)\n",

@@ -122,6 +122,21 @@ REASON = (
     ("off_ground", "the walker left the ground's defined extent (the hip came within a leg length "
                    "of Ground.s_range's ends; docs/terrain.md)"),
 )
+# Returns of a time loop that never reach a Result (PDW_STATUS_<NAME> = RESUME_BASE + i, apart
+# from STATUS): the loop stops where it resumes exactly, its caller (pdw/core/_core.pyx run) does
+# what the message says and calls it again.
+RESUME_BASE = 64
+RESUME = (
+    ("records_full", "the record buffer is full: the caller doubles it, copying the samples, and "
+                     "resumes (only adaptive methods and fixed-step runs of more than "
+                     "RECORD_EXACT_MAX samples, whose buffers are not sized exactly, return it)"),
+    ("poll", "poll_every loop iterations have passed: the caller checks for signals (Ctrl-C) and "
+             "a cancelled pool's token, then resumes"),
+)
+# The record buffers and the poll of one run (pdw/core/_core.pyx run).
+RECORD_CHUNK = 1 << 16          # first size of an adaptive run's record buffers [samples]
+RECORD_EXACT_MAX = 1 << 24      # a fixed-step run's buffers hold its samples exactly up to this
+POLL_EVERY = 2000               # loop iterations between two polls (0 in a run: never)
 # Which stop condition of a scene ended a run before t_end (pdw_sim.stop_reason).
 STOP = (
     "none",         # none did: the run reached t_end, or failed

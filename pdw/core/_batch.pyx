@@ -6,9 +6,7 @@ Private: the public API is `pdw.sim.batch.simulate_batch`. Every array is caller
 C-contiguous (typed memoryviews). `run_range` releases the GIL for the whole range.
 """
 from cpython.exc cimport PyErr_CheckSignals
-from libc.math cimport INFINITY
 from libc.stdlib cimport malloc, free
-from libc.string cimport memset
 
 import threading
 
@@ -141,22 +139,18 @@ _OUT_KEYS = tuple(_OUT_SPECS)
 
 @_named_buffers
 def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[:, ::1] flags0,
-              const double[::1] hip, const double[::1] depth, double dt, long n_steps,
-              double max_speed, long stop_steps, int periodic_k, double periodic_tol,
-              dict out, long i0, long i1, int lanes, bint vector, int method=0,
-              double t_end=0.0, double rtol=1e-6, double atol=1e-8, double h_max=0.0,
-              double event_tol=1e-9, long max_steps=0, int isa=0, int stop_touch_down=0,
-              long[::1] next_walker=None, dict opts=None, grounds=None):
+              const double[::1] hip, const double[::1] depth, dict opts, dict out, long i0,
+              long i1, int lanes, bint vector, *, int method=0, int isa=0,
+              long[::1] next_walker=None, grounds=None):
     """Advance walkers [i0, i1) with `lanes` lanes (GIL released), writing rows of `out`.
 
+    opts: the options of every walker, one record: pdw_run_opts's fields by name
+    (`pdw.sim.options.c_options`), filled into the job's one embedded struct by _opts.pxi's
+    `_fill_opts` (the filler `pdw.core._core.run` uses: the same fields, checks and derived
+    values); the fall limits are each walker's (hip, depth), not the record's.
     method: index into the compiled method table (pdw.core.integrators.METHODS); 0 (cdm) takes
     the lockstep cdm loop (pdw_batch_cdm, `vector` applies; to rodas4's lanes too), any other
-    the per-lane rounds of
-    pdw_batch_method with t_end (0: n_steps dt), rtol, atol, h_max (0: t_end), event_tol and
-    max_steps (0: no budget) as `pdw.core._core.run` takes them; dt is then the first step.
-    stop_touch_down: 1 or 2, stop each walker at that leg's first touch-down; 0: off.
-    opts: further fields of pdw_run_opts by name (`pdw.sim.options.c_options`), set after the
-    arguments (as `pdw.core._core.run`'s); the fall limits are each walker's (hip, depth).
+    the per-lane rounds of pdw_batch_method (dt is then the first step).
     next_walker: a shared (1,) counter (start it at i0): the threads that call this on the same
     range [i0, i1) take their walkers from it one by one (atomically), so every lane of every
     thread keeps busy until the batch runs out; None: the range is this call's alone.
@@ -186,18 +180,13 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
         raise ValueError("x0 must be (N, %d) and p (N or 1, %d)" % (PDW_NX, PDW_NP))
     if not (0 <= i0 <= i1 <= n):
         raise ValueError("range [%d, %d) not within [0, %d]" % (i0, i1, n))
-    if not (dt > 0 and dt < INFINITY) or n_steps < 0 or stop_steps < 0 or not (max_speed > 0):
-        raise ValueError("dt must be finite and > 0, n_steps and stop_steps >= 0, max_speed > 0; "
-                         "got dt = %r, n_steps = %d, stop_steps = %d, max_speed = %r"
-                         % (dt, n_steps, stop_steps, max_speed))
-    _count("n_steps", n_steps, 0)          # a loop bound: beyond MAX_COUNT no run finishes
-    _count("stop_steps", stop_steps, 0)
-    _count("max_steps", max_steps, 0)
-    if stop_touch_down < 0 or stop_touch_down > 2:
-        raise ValueError("stop_touch_down must be 0 (off), 1 or 2, got %d" % stop_touch_down)
-    if periodic_k < 0 or periodic_k == 1 or periodic_k > PDW_STEP_RING or not (periodic_tol >= 0):
-        raise ValueError("periodic_k must be 0 (off) or in [2, %d] and periodic_tol >= 0, got %d, %r"
-                         % (PDW_STEP_RING, periodic_k, periodic_tol))
+    if method < 0 or method >= pdw_nmethods:
+        raise ValueError("method id %d out of range [0, %d)" % (method, pdw_nmethods))
+    cdef pdw_batch_job job
+    _fill_opts(&job.opt, opts, pdw_methods[method].adaptive, PDW_STEP_RING)   # the one filler
+    if job.opt.record_every or job.opt.record_events:
+        raise ValueError("opts: the ensemble records no samples and stores no events "
+                         "(record_every and record_events must be 0)")
     missing = [key for key in _OUT_KEYS if key not in out]
     if missing:
         raise ValueError("out lacks the array(s) %s" % ", ".join(missing))
@@ -246,10 +235,6 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
             ("out['fail_x']", (fail_x.shape[0], fail_x.shape[1]), (n, PDW_NX))):
         if got != want:
             raise ValueError("%s must have shape %s, got %s" % (name, want, got))
-    if method < 0 or method >= pdw_nmethods:
-        raise ValueError("method id %d out of range [0, %d)" % (method, pdw_nmethods))
-    if max_steps < 0 or not (event_tol > 0) or not (rtol > 0) or not (atol > 0):
-        raise ValueError("max_steps must be >= 0 and rtol, atol, event_tol > 0")
     if grounds is not None:
         if len(grounds) != n:
             raise ValueError("grounds must have N = %d entries, got %d" % (n, len(grounds)))
@@ -261,7 +246,6 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
                 raise ValueError("grounds[%d] must be a CGround or None" % r)
     if n == 0 or i0 == i1:
         return 0
-    cdef pdw_batch_job job
     job.grounds = NULL
     job.kernel = &pdw_kernels[k]
     job.n = n
@@ -271,22 +255,7 @@ def run_range(int k, const double[:, ::1] x0, const double[:, ::1] p, const int[
     job.flags0 = &flags0[0, 0]
     job.fall_hip_height = &hip[0]
     job.fall_depth = &depth[0]
-    memset(&job.opt, 0, sizeof(pdw_run_opts))   # nothing recorded; fall limits per walker
-    job.opt.dt = dt
-    job.opt.n_steps = n_steps
-    job.opt.max_speed = max_speed
-    job.opt.stop_steps = stop_steps
-    job.opt.periodic_k = periodic_k
-    job.opt.stop_touch_down = stop_touch_down
-    job.opt.periodic_tol = periodic_tol
     job.method = method
-    job.opt.t_end = t_end if t_end > 0 else n_steps * dt
-    job.opt.rtol = rtol
-    job.opt.atol = atol
-    job.opt.h_max = h_max
-    job.opt.event_tol = event_tol
-    job.opt.max_steps = max_steps
-    _set_opts(&job.opt, opts)
     job.status = &status[0]
     job.stop_reason = &stop_reason[0]
     job.flags_final = &flags_final[0, 0]

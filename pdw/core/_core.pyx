@@ -26,6 +26,8 @@ cdef extern from "pdw_model.h":
         PDW_STATUS_RUNNING, PDW_STATUS_EVENTS_FULL
         PDW_NSTEP, PDW_STEP_RING, PDW_NANCHOR, PDW_ANCHOR_V_IN1, PDW_ANCHOR_V_IN2
         PDW_NX_MAX
+        PDW_STATUS_RECORDS_FULL, PDW_STATUS_POLL  # derive/layout.py RESUME
+        PDW_RECORD_CHUNK, PDW_RECORD_EXACT_MAX, PDW_POLL_EVERY
     ctypedef struct pdw_kernel:
         const char *name
         int variant
@@ -119,8 +121,6 @@ cdef extern from "pdw_sim.h":
     void pdw_terrain_jacobian(const pdw_kernel *k, const pdw_ground *g, const double *x,
                               const double *p, const int *flags, const double *anchors,
                               double *J, double *work) noexcept nogil
-    enum:
-        PDW_STATUS_RECORDS_FULL, PDW_STATUS_POLL
 
 
 cdef extern from "pdw_tableaus.h":
@@ -399,14 +399,15 @@ def ros_tableau(str name="rodas4"):
             "e": np.array([T.e[i] for i in range(n)])}
 
 
-#: Loop iterations between two polls for signals (Ctrl-C) and the step budget.
-POLL_EVERY = 2000
+# generated from derive/layout.py (pdw_model.h; the same in pdw.core._layout):
+#: Loop iterations between two polls for signals (Ctrl-C) and a cancelled pool.
+POLL_EVERY = PDW_POLL_EVERY
 #: First size of the record buffers of an adaptive run [samples] (its step count is not known
 #: in advance); they double as the run needs more and are trimmed to the samples recorded at its
 #: end. A fixed-step run's buffers hold exactly its n_steps // record_every + 2 samples when
 #: that is at most RECORD_EXACT_MAX, else they grow from RECORD_CHUNK as an adaptive run's.
-RECORD_CHUNK = 1 << 16
-RECORD_EXACT_MAX = 1 << 24
+RECORD_CHUNK = PDW_RECORD_CHUNK
+RECORD_EXACT_MAX = PDW_RECORD_EXACT_MAX
 _SAMPLE_BYTES = 8 * (1 + PDW_NX + 1 + PDW_NREC)
 
 
@@ -428,6 +429,18 @@ cdef tuple _records(long n, int nx, bint contact):
     flags = block[n * (1 + nx):n * (2 + nx)].view(np.intc).reshape(n, 2)
     c = block[n * (2 + nx):].reshape(nc, PDW_NREC)
     return t, x, flags, c
+
+
+cdef dict _EMPTY_RECORDS = {}
+
+
+cdef tuple _no_records(int nx):
+    """The record arrays of a run that records nothing: empty (no element to write), made once
+    per state size nx (a Result's t, x, flags of no samples are views of them)."""
+    out = _EMPTY_RECORDS.get(nx)
+    if out is None:
+        out = _EMPTY_RECORDS[nx] = _records(0, nx, True)
+    return out
 
 
 cdef tuple _records_copy(tuple old, long n, long n_copy, int nx, bint contact):
@@ -467,30 +480,31 @@ def first_runaway(const double[:, ::1] x, double hip_max, double angle_max):
 
 @_named_buffers
 def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, int f2,
-        double dt, long n_steps, long record_every, bint record_contact,
-        double fall_hip_height, double fall_depth, double max_speed,
-        double rtol=1e-6, double atol=1e-8, double h_max=0.0, long max_records=0,
-        long event_capacity=256, double event_tol=1e-9, bint record_events=True,
-        long stop_steps=0, int periodic_k=0, double periodic_tol=0.0, double t_end=0.0,
-        long max_steps=0, long poll_every=POLL_EVERY, buffers=None, approach_speeds0=None,
-        int stop_touch_down=0, dict opts=None, CGround ground=None):
+        dict opts, *, bint record_contact=True, long max_records=0, long event_capacity=256,
+        long poll_every=POLL_EVERY, buffers=None, approach_speeds0=None, CGround ground=None):
     """Run one simulation in compiled code (GIL released). Returns a dict of arrays and status.
 
-    The online gait analysis runs for every method: the result's "gait" holds the last
+    opts: the run's options, one record: pdw_run_opts's fields by name
+    (`pdw.sim.options.c_options` makes it from the option objects), filled into the struct by
+    _opts.pxi's `_fill_opts` (the one filler, shared with `pdw.core._batch.run_range`; a field
+    not given is 0: off or derived). Fixed-step methods take n_steps steps of dt; adaptive
+    ones integrate to t_end (0: n_steps*dt) with first step dt, locating flag switches to
+    within event_tol [s], and fail (reason PDW_REASON_BUDGET) once max_steps (> 0) steps were
+    tried. record_every k > 0 records every k-th step; record_events 0 stores no event (only
+    counts). stop_steps > 0 stops at that many complete steps, periodic_k > 0 when the last
+    periodic_k steps agree within periodic_tol (relative), stop_touch_down = 1 or 2 at that
+    leg's first touch-down (the final state is the event's); "stop_reason" says which (layout
+    STOP). The online gait analysis runs for every method: the result's "gait" holds the last
     min(n_gait_steps, PDW_STEP_RING) complete steps (rows of layout STEP, oldest first), with
-    the step and event counts. record_events=False stores no event (only counts). stop_steps > 0
-    stops at that many complete steps, periodic_k > 0 when the last periodic_k steps agree within
-    periodic_tol (relative), stop_touch_down = 1 or 2 at that leg's first touch-down (the final
-    state is the event's); "stop_reason" says which (layout STOP).
+    the step and event counts.
 
-    Fixed-step methods take n_steps steps of dt; adaptive ones integrate to t_end (default
-    n_steps*dt) with first step dt, locating flag switches to within event_tol [s], and fail
-    (reason PDW_REASON_BUDGET) once max_steps (> 0) steps were tried. The record buffer first
-    holds n_steps/record_every + 2 samples (or max_records; an adaptive run's, or one of more
-    than RECORD_EXACT_MAX samples, at most RECORD_CHUNK); when a loop fills the event or the
-    record buffer it returns PDW_STATUS_EVENTS_FULL / PDW_STATUS_RECORDS_FULL; this function
-    then doubles that buffer and calls the loop again, which resumes where it stopped: no sample
-    is dropped. Record arrays of its own that hold more than the samples recorded (an adaptive
+    The other arguments are this call's buffers, not options of the loop. record_contact:
+    record the contact forces with the states. The record buffer first holds
+    n_steps/record_every + 2 samples (or max_records; an adaptive run's, or one of more than
+    RECORD_EXACT_MAX samples, at most RECORD_CHUNK); when a loop fills the event or the record
+    buffer it returns PDW_STATUS_EVENTS_FULL / PDW_STATUS_RECORDS_FULL; this function then
+    doubles that buffer and calls the loop again, which resumes where it stopped: no sample is
+    dropped. Record arrays of its own that hold more than the samples recorded (an adaptive
     run, an early stop) are trimmed to them at the end (one copy). Every poll_every loop
     iterations the loop returns PDW_STATUS_POLL: signals are checked here (GIL held); on Ctrl-C
     the run stops and the result (so far) is returned with "interrupted" set to the
@@ -498,10 +512,6 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
 
     approach_speeds0: (v1, v2) [m/s] replaces the approach speeds of the feet that start in
     support (default: pdw_discrete_init's max(-v_y, 0)).
-
-    opts: fields of pdw_run_opts by name (`pdw.sim.options.c_options`), set after the
-    arguments: an option of the loops that has no argument here (a new stop condition) is a
-    field of the struct, a line of _opts.pxi and an entry of this dict.
     ground: a `CGround` (a shaped or patched ground, docs/terrain.md): the run takes the
     shaped-ground kernel of pdw_terrain.c; None: flat, today's kernel.
 
@@ -514,27 +524,21 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     _len("p", p.shape[0], PDW_NP)
     if (f1 != 0 and f1 != 1) or (f2 != 0 and f2 != 1):
         raise ValueError("flags must be 0 or 1, got (%d, %d)" % (f1, f2))
+    if method < 0 or method >= pdw_nmethods:
+        raise ValueError("method id %d out of range [0, %d)" % (method, pdw_nmethods))
+    memset(&s, 0, sizeof(pdw_sim))
+    cdef bint adaptive = pdw_methods[method].adaptive
+    _fill_opts(&s.opt, opts, adaptive, PDW_STEP_RING)
     # every count in [0, MAX_COUNT] before a size or a loop bound is made of it
-    _count("n_steps", n_steps, 0)
-    _count("record_every", record_every, 0)
     _count("max_records", max_records, 0)
     _count("event_capacity", event_capacity, 0)
-    _count("stop_steps", stop_steps, 0)
-    _count("max_steps", max_steps, 0)
     _count("poll_every", poll_every, 0)
     if poll_every == 1:     # the loop would poll before every step and never take one
         raise _InvalidInputError("poll_every = 1 is out of range; allowed: 0 (never) or "
                                  "integers in [2, %d]" % _MAX_COUNT)
-    if not (dt > 0):
-        raise ValueError("dt must be > 0, got %r" % dt)
-    if method < 0 or method >= pdw_nmethods:
-        raise ValueError("method id %d out of range [0, %d)" % (method, pdw_nmethods))
-    if stop_touch_down < 0 or stop_touch_down > 2:
-        raise ValueError("stop_touch_down must be 0 (off), 1 or 2, got %d" % stop_touch_down)
-    if periodic_k < 0 or periodic_k == 1 or periodic_k > PDW_STEP_RING:
-        raise ValueError("periodic_k must be 0 (off) or in [2, %d], got %d" % (PDW_STEP_RING, periodic_k))
+    cdef long n_steps = s.opt.n_steps, record_every = s.opt.record_every
+    cdef bint record_events = s.opt.record_events != 0
     cdef long n_rec_cap = 0
-    cdef bint adaptive = pdw_methods[method].adaptive
     if record_every > 0:
         n_rec_cap = n_steps // record_every + 2        # a fixed-step run's samples, exactly
         if max_records > 0:
@@ -543,25 +547,12 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
             n_rec_cap = min(n_rec_cap, <long>RECORD_CHUNK)
         n_rec_cap = max(n_rec_cap, 3)
     cdef pdw_advance_fn advance = pdw_methods[method].advance
-    memset(&s, 0, sizeof(pdw_sim))
     s.kernel = _kernel(k)
     if ground is not None:
         s.ground = &ground.g
     s.nx = nx
-    s.opt.t_end = t_end if t_end > 0 else n_steps * dt   # adaptive methods end exactly at t_end
-    s.opt.rtol = rtol
-    s.opt.atol = atol
-    s.opt.h_max = h_max if h_max > 0 else s.opt.t_end
-    s.h = dt
-    s.opt.event_tol = event_tol if event_tol > 0 else 1e-9
+    s.h = s.opt.dt
     memcpy(s.p, &p[0], PDW_NP * sizeof(double))
-    s.opt.dt = dt
-    s.opt.n_steps = n_steps
-    s.opt.record_every = record_every
-    s.opt.fall_hip_height = fall_hip_height
-    s.opt.fall_depth = fall_depth
-    s.opt.max_speed = max_speed
-    s.opt.max_steps = max_steps if pdw_methods[method].adaptive else 0
     s.poll_every = poll_every
     if buffers is not None and record_every > 0:
         # caller-owned record arrays (reused between runs: no fresh pages to fault in);
@@ -578,31 +569,31 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
         if record_contact:
             _rows("buffers[3] (contact)", rec_contact.shape[0],
                   rec_contact.shape[1] if rec_contact.ndim == 2 else -1, n_rec_cap, PDW_NREC)
+    elif record_every == 0:     # nothing recorded: empty arrays, one set per state size
+        rec_t, rec_x, rec_flags, rec_contact = _no_records(nx)
     else:
         rec_t, rec_x, rec_flags, rec_contact = _records(n_rec_cap, nx, record_contact)
     cdef bint owned = buffers is None or record_every == 0  # the record arrays are ours
     events = _zeros("the event buffer (event_capacity)",
                     (max(event_capacity, 4) if record_events else 1, PDW_NEVENT))
-    cdef double[::1] v_t = rec_t
-    cdef double[:, ::1] v_x = rec_x
-    cdef int[:, ::1] v_f = rec_flags
-    cdef double[:, ::1] v_c = rec_contact
+    cdef double[::1] v_t
+    cdef double[:, ::1] v_x
+    cdef int[:, ::1] v_f
+    cdef double[:, ::1] v_c
     cdef double[:, ::1] v_e = events
     if n_rec_cap > 0:
+        v_t = rec_t
+        v_x = rec_x
+        v_f = rec_flags
+        v_c = rec_contact
         s.rec_t = &v_t[0]
         s.rec_x = &v_x[0, 0]
         s.rec_flags = &v_f[0, 0]
         if record_contact:
             s.rec_contact = &v_c[0, 0]
     s.rec_capacity = n_rec_cap
-    s.opt.record_events = record_events
     s.events = &v_e[0, 0] if record_events else NULL
     s.ev_capacity = events.shape[0] if record_events else 0
-    s.opt.stop_steps = stop_steps
-    s.opt.stop_touch_down = stop_touch_down
-    s.opt.periodic_k = periodic_k
-    s.opt.periodic_tol = periodic_tol
-    _set_opts(&s.opt, opts)
     pdw_gait_init(&s.gait)
     memcpy(s.x, &x0[0], nx * sizeof(double))
     flags0[0] = f1; flags0[1] = f2
@@ -657,12 +648,13 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     cdef double *ring = &s.gait.ring[0][0]
     # fixed size (a view of the first n_keep rows is returned): the same memory however long
     # the run
-    gait = np.full((PDW_STEP_RING, PDW_NSTEP), np.nan)
+    gait = np.empty((PDW_STEP_RING, PDW_NSTEP))
+    cdef double[:, ::1] gv = gait
     cdef long r, c, slot
     for r in range(n_keep):
         slot = (n_gait - n_keep + r) % PDW_STEP_RING
         for c in range(PDW_NSTEP):
-            gait[r, c] = ring[slot * PDW_NSTEP + c]
+            gv[r, c] = ring[slot * PDW_NSTEP + c]
     return {
         "gait": gait[:n_keep],
         "n_gait_steps": n_gait,

@@ -431,15 +431,13 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
         raise InvalidInputError("t_end/dt = %d steps exceeds max_steps = %d: raise max_steps "
                                 "or take a larger dt" % (n_steps, budget))
     t_stop = t_end if adaptive else n_steps * dt
-    opts = dict(method=METHODS.index(method), t_end=t_stop, rtol=rtol, atol=atol, h_max=h_max,
-                event_tol=event_tol, max_steps=budget, isa=_batch.ISAS[batch_isa()],
-                stop_touch_down=stop_touch_down,
-                opts=_opt.c_options(it, st, lim, skip=_opt.RUN_ARGS))
+    copts = _opt.c_options(it, st, lim, dt=dt, n_steps=n_steps, t_end=t_stop, h_max=h_max,
+                           max_steps=budget, periodic_k=periodic_steps)
+    opts = dict(method=METHODS.index(method), isa=_batch.ISAS[batch_isa()])
     if cground is not None:         # the per-lane scalar stages: bitwise the scalar runs
         opts.update(isa=-1, grounds=cground)
     if n:
-        args = (k, x, pvec, f0, hip, depth, dt, n_steps, max_speed, stop_steps, periodic_steps,
-                periodic_tol, out, 0, n, lanes, bool(vector))
+        args = (k, x, pvec, f0, hip, depth, copts, out, 0, n, lanes, bool(vector))
         # the threads share the batch: each lane of each takes the next walker from one
         # counter, so no lane idles while a walker waits (pdw_batch_take)
         shared = np.zeros(1, dtype=np.int_) if threads > 1 else None

@@ -617,31 +617,27 @@ def check_type(name: str, value, cls):
                             % (name, cls.__name__, type(value).__name__))
 
 
-#: The fields of pdw_run_opts that `pdw.core._core.run` and `pdw.core._batch.run_range` take
-#: as arguments of their own: `c_options(..., skip=RUN_ARGS)` leaves them out (no work twice).
-RUN_ARGS = frozenset(("dt", "n_steps", "t_end", "rtol", "atol", "h_max", "event_tol",
-                      "max_steps", "record_every", "record_events", "stop_steps",
-                      "stop_touch_down", "periodic_k", "periodic_tol", "fall_hip_height",
-                      "fall_depth", "max_speed"))
-
-
-def c_options(*objects, skip: frozenset = frozenset()) -> dict:
-    """The fields of the compiled loops' pdw_run_opts (pdw/core/csrc/pdw_sim.h) that the given
-    option objects set as they are: each field with a C name (``_f(..., c=NAME)``), by that
-    name, unset (None) ones left out. What a run derives (dt, n_steps, t_end, the periodic
-    window, the fall limits of l, the step budget) it passes itself; `pdw.core._core.run` and
-    `pdw.core._batch.run_range` set these last (``opts=``)."""
+def c_options(*objects, **derived) -> dict:
+    """A run's options as the compiled loops read them: one record of the fields of
+    pdw_run_opts (pdw/core/csrc/pdw_sim.h) by name, which `pdw.core._core.run` and
+    `pdw.core._batch.run_range` take whole and fill into the struct with one filler
+    (pdw/core/_opts.pxi). Each field of the option objects with a C name
+    (``_f(..., c=NAME)``) under that name, unset (None) ones left out; then ``derived``: what
+    a run derives itself (dt, n_steps, t_end, h_max, the step budget max_steps, the periodic
+    window periodic_k, the fall limits of l), by field name. A field given by neither is 0 in
+    the struct (off)."""
     out: dict = {}
     for obj in objects:
-        cache: dict = obj.__dict__.setdefault("_c", {})     # made once per (frozen) object
-        own: dict | None = cache.get(skip)
+        own = obj.__dict__.get("_c")            # made once per (frozen) object
         if own is None:
-            own = cache[skip] = {}
+            own = {}
             for f in dataclasses.fields(obj):
                 name, value = f.metadata.get("c"), getattr(obj, f.name)
-                if name is not None and value is not None and name not in skip:
+                if name is not None and value is not None:
                     own[name] = int(value) if isinstance(value, bool) else value
+            obj.__dict__["_c"] = own
         out.update(own)
+    out.update(derived)
     return out
 
 

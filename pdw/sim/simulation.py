@@ -65,6 +65,9 @@ RUNAWAY_ANGLE = 2 * math.pi
 #: periods 2 pi sqrt(l/g) did not walk: status "no_steps".
 NO_STEP_PERIODS = 2.0
 _Y_O, _THETA1, _THETA2 = (STATE.index(n) for n in ("y_o", "theta1", "theta2"))
+#: The flat ground (`Ground()`, frozen): what a run without ``ground`` walks on.
+_FLAT = Ground()
+_X0_PAPER = np.array(X0_PAPER, dtype=float)
 
 
 def _feet(a: str, b: str) -> slice:
@@ -264,7 +267,14 @@ def _check_positive(name, value):
 
 
 def check_state(x0, name="x0"):
-    """x0: the mechanical state (`pdw.STATE`) or a friction law's (`Contact.run_state`)."""
+    """x0: the mechanical state (`pdw.STATE`) or a friction law's (`Contact.run_state`): a
+    fresh C-contiguous float64 array."""
+    if x0 is X0_PAPER:                  # the default: a copy of the checked array
+        return _X0_PAPER.copy()
+    if type(x0) is np.ndarray and x0.dtype == np.float64 and x0.shape == (_core.NX,):
+        x = x0.copy()                   # the common case: one copy, one finiteness test
+        if math.isfinite(x.sum()):      # (a sum overflowing to inf: the full check below)
+            return x
     n = np.shape(x0)[0] if np.ndim(x0) == 1 else _core.NX
     shape = (n,) if n in {len(v) for v in _layout.STATE_LAYOUTS.values()} else (_core.NX,)
     return checks.real_array(name, x0, [shape], labels=STATE if shape == (_core.NX,) else None)
@@ -391,15 +401,12 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
     params = plain.get("params", params)
     variant = plain.get("variant", variant)
     flags0 = plain.get("flags0", flags0)
-    record_every, record_forces, record_events, record_energies = (
-        rec.every, rec.forces, rec.events, rec.energies)
-    t_eval, dense_output, out = rec.t_eval, rec.dense_output, rec.out
-    rtol, atol, h_max, event_tol, max_steps, check_step = (
-        it.rtol, it.atol, it.h_max, it.event_tol, it.max_steps, it.check_step)
-    stop_steps, periodic_steps, periodic_tol, stop_touch_down = (
-        st.steps, st.periodic_k, st.periodic_tol, st.touch_down)
-    fall_hip_height, fall_depth, max_speed, on_failure = (
-        lim.fall_hip_height, lim.fall_depth, lim.max_speed, lim.on_failure)
+    # The option objects checked every field when they were made (`pdw.sim.options`): what is
+    # checked here is what they cannot know (the plain arguments, the limits derived from l, the
+    # step count t_end/dt, the budget of a fixed-step method, t_eval against t_end).
+    h_max, max_steps, check_step = it.h_max, it.max_steps, it.check_step
+    periodic_steps = st.periodic_k
+    fall_hip_height, fall_depth, on_failure = lim.fall_hip_height, lim.fall_depth, lim.on_failure
     params = Params.paper() if params is None else params
     if not isinstance(params, Params):
         raise InvalidInputError("params must be a pdw.Params, got %s" % type(params).__name__)
@@ -408,55 +415,35 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
     dt = checks.number("dt", dt, lo=DT_MIN)
     if dt > t_end:
         raise InvalidInputError("dt = %g must not exceed t_end = %g" % (dt, t_end))
-    try:
-        check_variant(variant)
-    except ValueError as e:
-        raise InvalidInputError(str(e)) from None
-    checks.choice("method", method, METHODS)
-    checks.choice("on_failure", on_failure, ("raise", "return"))
-    f0 = checks.flags("flags0", flags0)
-    record_every = checks.count("record_every", record_every)
+    if type(variant) is not str or variant not in _layout.VARIANTS:
+        try:
+            check_variant(variant)
+        except ValueError as e:
+            raise InvalidInputError(str(e)) from None
+    if type(method) is not str or method not in METHODS:
+        checks.choice("method", method, METHODS)
+    f0 = (0, 1) if type(flags0) is tuple and flags0 == (0, 1) else checks.flags("flags0", flags0)
     if not t_end / dt <= checks.MAX_COUNT:           # also inf (t_end near the largest float)
         raise InvalidInputError("t_end/dt = %g steps is too many (at most %d)"
                                 % (t_end / dt, checks.MAX_COUNT))
     n_steps = int(round(t_end / dt))
-    adaptive = _core.method_table()[METHODS.index(method)][2]
+    adaptive = _integrators.get(method).adaptive
     if max_steps is None:
         budget = 10 ** 6 + int(2e6 * t_end) if adaptive else 0
     else:
-        budget = checks.count("max_steps", max_steps, lo=1)
+        budget = max_steps
         if not adaptive and n_steps > budget:
             raise InvalidInputError("t_end/dt = %d steps exceeds max_steps = %d: raise max_steps "
                                     "or take a larger dt" % (n_steps, budget))
     hip = 0.5 * params.l if fall_hip_height is None else checks.number("fall_hip_height",
                                                                         fall_hip_height)
-    depth = 0.25 * params.l if fall_depth is None else _check_positive("fall_depth", fall_depth)
-    max_speed = _check_positive("max_speed", max_speed)
-    rtol = _check_positive("rtol", rtol)
-    atol = _check_positive("atol", atol)
-    h_max = 0.0 if h_max is None else _check_positive("h_max", h_max)
-    event_tol = _check_positive("event_tol", event_tol)
+    depth = 0.25 * params.l if fall_depth is None else fall_depth
+    h_max = 0.0 if h_max is None else h_max
     feats = checks.features(features, _layout.FEATURES)
-    for name, flag in (("record_forces", record_forces), ("record_events", record_events),
-                       ("record_energies", record_energies)):
-        if not isinstance(flag, (bool, np.bool_)):
-            raise InvalidInputError("%s must be True or False, got %r" % (name, flag))
-    if record_energies and not record_every:
-        raise InvalidInputError("record_energies needs recorded states (record_every > 0)")
-    stop_steps = _check_count("stop_steps", stop_steps)
-    stop_touch_down = checks.leg_or_off("stop_touch_down", stop_touch_down)
-    periodic_steps = _check_count("periodic_steps", periodic_steps)
-    if periodic_steps == 1 or periodic_steps > _layout.STEP_RING:
-        raise InvalidInputError("periodic_steps must be 0 (off) or in [2, %d], got %d"
-                                % (_layout.STEP_RING, periodic_steps))
-    periodic_tol = _check_positive("periodic_tol", periodic_tol)
-    if not isinstance(dense_output, (bool, np.bool_)):
-        raise InvalidInputError("dense_output must be True or False, got %r" % (dense_output,))
+    record_every, record_forces, record_energies = rec.every, rec.forces, rec.energies
+    t_eval, dense_output, out = rec.t_eval, rec.dense_output, rec.out
     if t_eval is not None:
         t_eval = _dense.check_t_eval(t_eval, t_end)
-    if (t_eval is not None or dense_output) and record_every != 1:
-        raise InvalidInputError("t_eval and dense_output interpolate between the accepted steps: "
-                                "record_every must be 1, got %r" % (record_every,))
 
     contact = _contact.Contact.coerce(contact)
     x = contact.run_state(x, feats)
@@ -466,9 +453,9 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
     if feats != _layout.FEATURES:
         params = params.without(feats)
     p = contact.vector(parameter_vector(params), feats, params)     # validates the law's values
-    ground = Ground.coerce(ground)
+    ground = _FLAT if ground is None else Ground.coerce(ground)
     try:        # every contact law: the law's factor on the default estimate (stepsize.py)
-        for ps in ground.patched_params(params):    # and every patch's properties
+        for ps in ground.patched_params(params) if ground.patches else (params,):  # and patches
             _stepsize.check_step(dt, ps, method, variant, check_step, contact)
     except (np.linalg.LinAlgError, FloatingPointError, OverflowError) as e:
         _stepsize.step_unknown(dt, method, check_step, e)
@@ -483,14 +470,12 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
         if _integrators.get(method).adaptive:     # unknown step count: what the buffer has
             rows = max(min(rows, 4096), out.capacity)
         buffers = out.arrays(rows, contact.nx)
-    raw = _core.run(k, METHODS.index(method), x, p, f0[0], f0[1], dt, n_steps, int(record_every),
-                    bool(record_forces), hip, depth, max_speed, rtol, atol, h_max,
-                    event_tol=event_tol, record_events=bool(record_events), stop_steps=stop_steps,
-                    periodic_k=periodic_steps, periodic_tol=periodic_tol, t_end=t_end,
-                    max_steps=budget, buffers=buffers, approach_speeds0=v_in0,
-                    stop_touch_down=stop_touch_down,
-                    ground=None if ground.is_flat else _core.CGround(ground.table()),
-                    opts=_opt.c_options(it, rec, st, lim, skip=_opt.RUN_ARGS))
+    opts = _opt.c_options(it, rec, st, lim, dt=dt, n_steps=n_steps, t_end=t_end, h_max=h_max,
+                          max_steps=budget, periodic_k=periodic_steps, fall_hip_height=hip,
+                          fall_depth=depth)
+    raw = _core.run(k, METHODS.index(method), x, p, f0[0], f0[1], opts,
+                    record_contact=bool(record_forces), buffers=buffers, approach_speeds0=v_in0,
+                    ground=None if ground.is_flat else _core.CGround(ground.table()))
     wall = time.perf_counter() - start
     energies = None
     if record_energies and raw["interrupted"] is None:
@@ -500,7 +485,7 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
         energies = {name: en[:, i] for i, name in enumerate(_layout.ENERGY)}
         energies["E"] = en.sum(axis=1)
     res = _result(raw, params, variant, method, dt, t_end, wall, on_failure, feats,
-                  bool(record_events), energies, x)
+                  rec.events, energies, x)
     res.contact = contact
     res.integrator, res.stop = settled.ran((method, dt, t_end))
     res.record, res.limits = rec, lim
@@ -511,6 +496,10 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
     return res
 
 
+def _check_count(name, value):
+    return checks.count(name, value)
+
+
 def _same(a, b):
     """Is an argument its default? (for simulate(scene))"""
     if a is None or b is None:
@@ -519,10 +508,6 @@ def _same(a, b):
         return bool(np.array_equal(np.asarray(a, dtype=object), np.asarray(b, dtype=object)))
     except (TypeError, ValueError):
         return False
-
-
-def _check_count(name, value):
-    return checks.count(name, value)
 
 
 def _honest(raw, status, params, x0, energies):

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import functools
 import math
+import types
 import warnings
 from dataclasses import dataclass, field, replace
 
@@ -32,7 +33,7 @@ import numpy as np
 from ..core import _core, _layout
 from ..core.errors import InvalidInputError, StepSizeError, StepSizeWarning
 from ..core.integrators import METHODS
-from ..core.model import check_variant, contact_forces, jacobian
+from ..core.model import check_variant, jacobian, kernel_index, parameter_vector
 from ..core.params import X0_PAPER, Params
 from .stepsize_laws import LAW_CALIBRATION, LUGRE_SIGMA1, law_factor, law_message, law_of, law_params  # noqa: F401
 from .stepsize_presets import PRESET_DT_MAX, preset_limits
@@ -143,43 +144,95 @@ def linear_limit(method: str, J, h_lo: float = 1e-10, h_hi: float = 1.0, rel: fl
     until unstable, then 12 bisections in log h (0.03 % resolution). Returns h_lo if unstable
     there, h_hi if stable everywhere up to it. rodas4 (L-stable) has no limit: inf.
     """
-    if method == "rodas4":
-        return math.inf
-    J = np.asarray(J, dtype=float)
-    ev = np.linalg.eigvals(J)
-    lp = max(0.0, float(np.max(ev.real)))
-    scale = float(np.max(np.abs(ev)))
+    return linear_limits(method, [J], h_lo, h_hi, rel)[0]
 
-    def unstable(h):
-        rho = _growth(method, J, h)
+
+def linear_limits(method: str, Js, h_lo: float = 1e-10, h_hi: float = 1.0,
+                  rel: float = 1e-3, enough=None) -> list:
+    """`linear_limit` of each Jacobian of ``Js`` (each (8, 8)), bit for bit, with the searches
+    run side by side: each round takes the eigenvalues of every pending step map in one
+    stacked call (LAPACK's geev per matrix, as alone), a quarter of the calls for the
+    check's four states (issue 23: the first call of a process).
+
+    ``enough``: a predicate of a step; a search stops as soon as a step it has found stable,
+    and that its limit therefore is at least, satisfies it, and gives that step (a lower bound
+    of its limit, not the limit)."""
+    if method == "rodas4":
+        return [math.inf] * len(Js)
+    Js = [np.asarray(J, dtype=float) for J in Js]
+    searches = []
+    for J in Js:
+        ev = np.linalg.eigvals(J)
+        searches.append(_search(max(0.0, float(np.max(ev.real))), float(np.max(np.abs(ev))),
+                                h_lo, h_hi, rel, enough))
+    out: list = [None] * len(Js)
+    pending = {i: next(g) for i, g in enumerate(searches)}
+    while pending:
+        idx = list(pending)
+        maps = np.stack([step_matrix(method, Js[i], pending[i]) for i in idx])
+        rhos = np.max(np.abs(np.linalg.eigvals(maps)), axis=1)
+        for i, rho in zip(idx, rhos):
+            try:
+                pending[i] = searches[i].send(float(rho))
+            except StopIteration as done:
+                out[i] = done.value
+                del pending[i]
+    return out
+
+
+class _Enough(Exception):
+    """A cut-short search found a stable step that is enough (`linear_limits`' ``enough``)."""
+
+
+def _search(lp: float, scale: float, h_lo: float, h_hi: float, rel: float, enough=None):
+    """`linear_limit`'s search for one Jacobian (largest Re lambda lp, largest |lambda| scale),
+    as a generator: it yields a step h, is sent the spectral radius of the step map there,
+    and returns the limit -- or, with ``enough``, the first stable step a that satisfies it
+    (every later step the search keeps, and the limit it returns, is >= a)."""
+    def unstable(rho, h):
         return rho > 0 and not (math.log(rho) <= 1.5 * h * lp + rel)
 
+    def stable(h):
+        if enough is not None and enough(h):
+            raise _Enough(h)
+        return h
+
+    try:
+        return (yield from _bracket(unstable, stable, scale, h_lo, h_hi))
+    except _Enough as e:
+        return float(e.args[0])
+
+
+def _bracket(unstable, stable, scale, h_lo, h_hi):
+    """The search of `_search`: half-decade steps from 1/scale, then 12 bisections in log h;
+    ``stable(a)`` is called on every step found stable."""
     h = min(max(1.0 / scale if scale > 0 else h_hi, h_lo), h_hi)
     step = math.sqrt(10.0)
-    if unstable(h):
+    if unstable((yield h), h):
         b = h
         while True:
             if b <= h_lo:
                 return float(h_lo)
             a = max(b / step, h_lo)
-            if not unstable(a):
+            if not unstable((yield a), a):
+                stable(a)
                 break
             b = a
     else:
-        a = h
+        a = stable(h)
         while True:
             if a >= h_hi:
                 return float(h_hi)
             b = min(a * step, h_hi)
-            if unstable(b):
+            if unstable((yield b), b):
                 break
-            a = b
+            a = stable(b)
     for _ in range(12):
         m = math.sqrt(a * b)
-        if unstable(m):
+        if unstable((yield m), m):
             b = m
         else:
-            a = m
+            a = stable(m)
     return float(a)
 
 
@@ -210,24 +263,84 @@ def limiting_force(sens: dict) -> str:
 # representative states
 # --------------------------------------------------------------------------------------------
 
+_KIN0, _NKIN = _layout.WORK["kin"]
+_CON0, _NCON = _layout.WORK["contact"]
+_KI = {n: i for i, n in enumerate(_layout.KIN)}
+_FN, _FT = _layout.CONTACT.index("F_n"), _layout.CONTACT.index("F_t")
+
+
+def _contact(x, params: Params, flags, variant: str, anchors=(0.0, 0.0)):
+    """`pdw.core.model.contact_forces` for the check's own inputs (valid by construction: a
+    float state or (N, 8) states, default features and contact law; flags (2,) or (N, 2)):
+    the same compiled evaluation, bit for bit, without the per-call argument checks, which
+    cost ~20 us of the ~25 us of each of the check's ~30 calls (issue 23, the first call of
+    a process). Returns y_D, v_x, s, F_n, F_t: (2,) for one state, (N, 2) for N."""
+    X = np.array(x, dtype=float, ndmin=2)
+    n = len(X)
+    f = np.empty((n, 2), dtype=np.intc)
+    f[:] = flags
+    a = np.empty((n, 2))
+    a[:] = anchors
+    work = np.empty((n, _core.NWORK))
+    _core.rhs_batch(kernel_index(variant, None), X, parameter_vector(params), f, a,
+                    np.empty_like(X), work)
+    kin = work[:, _KIN0:_KIN0 + _NKIN].reshape(n, 2, len(_layout.KIN))
+    con = work[:, _CON0:_CON0 + _NCON].reshape(n, 2, len(_layout.CONTACT))
+    out = dict(y_D=kin[:, :, _KI["y_D"]], v_x=kin[:, :, _KI["v_x"]], s=kin[:, :, _KI["s"]],
+               F_n=con[:, :, _FN], F_t=con[:, :, _FT])
+    if np.ndim(x) == 1:
+        out = {k: v[0] for k, v in out.items()}
+    return types.SimpleNamespace(**out)
+
+
 def _set_hip_height(x, params, variant, flags=(0, 1), force=None):
     """x with y_o such that the support feet carry ``force`` (default: the weight,
     (m_h + 2 m_l) g cos(gamma)) in total; the normal force grows with the depth. Three batched
     grids (geometric in the lowest foot's depth, 1e-9 m to l/4), then linear interpolation:
     relative accuracy ~1e-6 in the depth."""
+    return _side_by_side([_hip_height(x, params, flags, force)], [flags], params, variant)[0]
+
+
+def _side_by_side(searches, flags, params, variant):
+    """Run generator searches in lockstep: each yields states (m, 8) to evaluate under its
+    support flags and is sent their contact state (`_contact`: y_D, v_x, F_n, ... (m, 2));
+    one compiled call per round for all of them (rows are evaluated independently, so each
+    search gets what it would alone, bit for bit). Returns their results."""
+    out: list = [None] * len(searches)
+    pending = {i: next(g) for i, g in enumerate(searches)}
+    while pending:
+        idx = list(pending)
+        X = np.concatenate([pending[i] for i in idx])
+        F = np.concatenate([np.tile(np.asarray(flags[i], dtype=np.intc), (len(pending[i]), 1))
+                            for i in idx])
+        c = _contact(X, params, F, variant)
+        o = 0
+        for i in idx:
+            m = len(pending[i])
+            part = types.SimpleNamespace(**{k: v[o:o + m] for k, v in vars(c).items()})
+            o += m
+            try:
+                pending[i] = searches[i].send(part)
+            except StopIteration as done:
+                out[i] = done.value
+                del pending[i]
+    return out
+
+
+def _hip_height(x, params, flags, force=None):
+    """`_set_hip_height` as a search of `_side_by_side`."""
     x = np.array(x, dtype=float)
     W = params.weight if force is None else float(force)
-    y0 = x[1] - float(np.min(contact_forces(x, params, flags=flags, variant=variant).y_D
-                             [np.array(flags) > 0]))
+    y0 = x[1] - float(np.min((yield x[None, :]).y_D[0][np.array(flags) > 0]))
 
-    def excess(depths):
+    def grid(depths):
         X = np.repeat(x[None, :], len(depths), axis=0)
         X[:, 1] = y0 - depths
-        return contact_forces(X, params, flags=flags, variant=variant).F_n.sum(axis=1) - W
+        return X
 
     d = np.geomspace(1e-9, 0.25 * params.l, 97)
     for _ in range(3):
-        e = excess(d)
+        e = (yield grid(d)).F_n.sum(axis=1) - W
         k = int(np.argmax(e > 0))
         if e[k] <= 0:                       # not even l/4 deep carries the weight
             x[1] = y0 - d[-1]
@@ -237,11 +350,20 @@ def _set_hip_height(x, params, variant, flags=(0, 1), force=None):
             return x
         lo, hi = d[k - 1], d[k]
         d = np.linspace(lo, hi, 97)
-    e = excess(d)
+    e = (yield grid(d)).F_n.sum(axis=1) - W
     k = int(np.argmax(e > 0))
     a, b, ea, eb = d[k - 1], d[k], e[k - 1], e[k]
     x[1] = y0 - (a - ea * (b - a) / (eb - ea))
     return x
+
+
+def _stance_state(x0, params, flags, foot, force):
+    """One state of `_stance_states` as a search of `_side_by_side`."""
+    x = np.array(x0, dtype=float)
+    x[4] -= float((yield x[None, :]).v_x[0][foot])
+    if foot == 1:       # single stance: the stance foot neither sinks nor rises
+        x[5] = -(params.l - params.r) * math.sin(x[3]) * x[7]
+    return (yield from _hip_height(x, params, flags, force))
 
 
 def typical_start(params: Params | None = None, variant: str = "paper") -> np.ndarray:
@@ -290,15 +412,11 @@ def _stance_states(params: Params, variant: str) -> tuple:
     stance the paper variant's tangential spring-damper acts (xi_2 < 0), early on it does not;
     the landing holds the impact (d_n delta^p delta' at its largest)."""
     params = Params.paper() if params is None else params
-    out, flags = [], []
-    for x0, fl, foot, load in [(x, (0, 1), 1, 1.0) for x in STANCE_STATES] + \
-            [(DOUBLE_SUPPORT_STATE, LANDING_FLAGS, 0, DOUBLE_SUPPORT_LOAD)]:
-        x = np.array(x0, dtype=float)
-        x[4] -= float(contact_forces(x, params, flags=fl, variant=variant).v_x[foot])
-        if foot == 1:       # single stance: the stance foot neither sinks nor rises
-            x[5] = -(params.l - params.r) * math.sin(x[3]) * x[7]
-        out.append(_set_hip_height(x, params, variant, fl, load * params.weight))
-        flags.append(fl)
+    cases = [(x, (0, 1), 1, 1.0) for x in STANCE_STATES] + \
+        [(DOUBLE_SUPPORT_STATE, LANDING_FLAGS, 0, DOUBLE_SUPPORT_LOAD)]
+    flags = [fl for _, fl, _, _ in cases]
+    out = _side_by_side([_stance_state(x0, params, fl, foot, load * params.weight)
+                         for x0, fl, foot, load in cases], flags, params, variant)
     X = np.array(out)
     X.flags.writeable = False
     return X, tuple(flags)
@@ -386,16 +504,28 @@ def _stiffest(J):
 def state_jacobian(x, params: Params, flags, variant: str = "paper", features=_NO_FRICTION):
     """df/dx at a representative state, its support feet anchored where they are (the
     consistent variant's xi = 0: a foot that has not slipped since touch-down)."""
-    s = contact_forces(x, params, flags=flags, variant=variant).s
+    s = _contact(x, params, flags, variant).s
     anchors = tuple(float(s[i]) if flags[i] else 0.0 for i in range(2))
     return jacobian(x, params, flags=flags, anchors=anchors, variant=variant, features=features)
+
+
+def _state_jacobians(X, params: Params, flags, variant: str, features=_NO_FRICTION) -> list:
+    """[`state_jacobian` of each state of X (n, 8) with its flags], bit for bit, in two
+    compiled calls (rows are evaluated independently) without the per-call argument checks."""
+    X = np.array(X, dtype=float, ndmin=2)
+    F = np.array(flags, dtype=np.intc).reshape(len(X), 2)
+    anchors = np.where(F > 0, _contact(X, params, F, variant).s, 0.0)
+    J = np.empty((len(X), NX * NX))
+    folded = params if features is None else params.without(features)
+    _core.jacobian_batch(kernel_index(variant, features), X, parameter_vector(folded), F,
+                         anchors, J, np.empty((len(X), _core.NWORK)))
+    return list(J.reshape(len(X), NX, NX))
 
 
 def _limits(params: Params, method: str, variant: str, features=_NO_FRICTION):
     """Linear limits of ``method`` at each of `stance_states`."""
     X, flags = stance_states(params, variant)
-    return [linear_limit(method, state_jacobian(x, params, fl, variant, features))
-            for x, fl in zip(X, flags)]
+    return linear_limits(method, _state_jacobians(X, params, flags, variant, features))
 
 
 @functools.lru_cache(maxsize=1024)
@@ -413,9 +543,9 @@ def _friction_load(params: Params, variant: str) -> float:
     P0 = params.replace(mu_s=0.0, mu_d=0.0)
     load = 0.0
     for x, fl in zip(X[:len(STANCE_STATES)], flags[:len(STANCE_STATES)]):
-        s = contact_forces(x, params, flags=fl, variant=variant).s
+        s = _contact(x, params, fl, variant).s
         anchors = tuple(float(s[i]) if fl[i] else 0.0 for i in range(2))
-        cs = contact_forces(x, P0, flags=fl, anchors=anchors, variant=variant)
+        cs = _contact(x, P0, fl, variant, anchors)
         i = fl.index(1)
         need, cap = abs(float(cs.F_t[i])), params.mu_s * float(cs.F_n[i])
         load = max(load, need / cap if cap > 0 else (math.inf if need > 0 else 0.0))
@@ -439,6 +569,36 @@ def _preset_table():
     return {(preset, variant): {m: _dt_max_computed(getattr(Params, preset)(), m, variant)
                                 for m in FIXED_STEP}
             for preset, variant in PRESET_DT_MAX}
+
+
+_BOUNDS: dict = {}
+
+
+def _safe(params: Params, method: str, variant: str, dt: float, f: float) -> bool:
+    """Is ``dt`` at most ``f`` x `_dt_max` (no warning), proven without the whole search? The
+    searches of `_dt_max_computed` run cut short (`linear_limits`' ``enough``): each stops at
+    the first stable step whose calibrated value already covers dt, a lower bound of its limit
+    (a search's limit is never below a step it found stable, and rounding is monotone, so the
+    answer is exactly `check_step`'s). The bound is kept per (params, method, variant); a dt
+    it does not cover goes the whole way (`_dt_max`). The first call of a process with new
+    parameters pays this instead of the whole search (issue 23)."""
+    key = (params, method, variant)
+    bound = _BOUNDS.get(key)
+    if bound is None:
+        c = CALIBRATION[variant][method]
+        X, flags = stance_states(params, variant)
+        hs = linear_limits(method, _state_jacobians(X, params, flags, variant),
+                           enough=lambda h: not dt > f * (c * h))
+        bound = c * min(hs)
+        if _friction_load(params, variant) >= FRICTION_LOAD:
+            n = len(STANCE_STATES)
+            hc = linear_limits(method, _state_jacobians(X[:n], params, flags[:n], variant, None),
+                               enough=lambda h: not dt > f * (CHATTER_CALIBRATION * h))
+            bound = min(bound, CHATTER_CALIBRATION * min(hc))
+        if len(_BOUNDS) >= 1024:
+            _BOUNDS.clear()
+        _BOUNDS[key] = bound
+    return not dt > f * bound
 
 
 def _dt_max(params, method, variant):
@@ -530,7 +690,11 @@ def check_step(dt: float, params: Params, method: str, variant: str, mode: str =
     if mode == "off" or method not in FIXED_STEP:
         return None
     f = law_factor(law_of(contact), method, contact, variant)
-    if not dt > f * _dt_max(law_params(params, contact), method, variant):
+    lp = law_params(params, contact)
+    known = preset_limits(lp, variant)
+    if (known is None or method not in known) and _safe(lp, method, variant, dt, f):
+        return None
+    if not dt > f * _dt_max(lp, method, variant):
         return None
     lim = step_limit(params, method, variant, contact)
     msg = lim.message(dt)

@@ -51,17 +51,20 @@ CASES = [
     ("_hybrid.walk(P, Y0, 0.0, 2 ** 64, {}, 0)", "n_steps", "InvalidInputError"),
     ("_hybrid.walk(P, Y0, 0.0, 3, {}, BIG)", "rec_cap", "InvalidInputError"),
     ("_hybrid.step(P, Y0, {}, 0.0, 0.0, BIG)", "rec_cap", "InvalidInputError"),
-    ("_core.run(0, 0, X0, P, 0, 1, 1e-4, BIG, 0, False, 0.2, 0.1, 1e3)", "n_steps",
+    ("_core.run(0, 0, X0, P, 0, 1, dict(dt=1e-4, n_steps=BIG, max_speed=1e3))", "n_steps",
      "InvalidInputError"),
-    ("_core.run(0, 0, X0, P, 0, 1, 1e-4, 10, 1, False, 0.2, 0.1, 1e3, max_records=BIG)",
+    ("_core.run(0, 0, X0, P, 0, 1, dict(dt=1e-4, n_steps=10, record_every=1, max_speed=1e3), "
+     "max_records=BIG)",
      "max_records", "InvalidInputError"),
-    ("_core.run(0, 0, X0, P, 0, 1, 1e-4, 10, 1, False, 0.2, 0.1, 1e3, event_capacity=BIG)",
+    ("_core.run(0, 0, X0, P, 0, 1, dict(dt=1e-4, n_steps=10, record_every=1, record_events=1, "
+     "max_speed=1e3), event_capacity=BIG)",
      "event_capacity", "InvalidInputError"),
-    ("_core.run(0, 0, X0, P, 0, 1, 1e-4, 2 ** 64, 0, False, 0.2, 0.1, 1e3)", "n_steps",
+    ("_core.run(0, 0, X0, P, 0, 1, dict(dt=1e-4, n_steps=2 ** 64, max_speed=1e3))", "n_steps",
      "InvalidInputError"),
     ("_core.bench(0, 'rhs', X0, P, 0, 1, 0.0, 0.0, BIG)", "n", "InvalidInputError"),
     # found by the round-three fuzz run: a poll before every step, so never a step (a hang)
-    ("_core.run(0, 0, X0, P, 0, 1, 1e-4, 20, 1, True, 0.25, 0.125, 1e3, poll_every=1)",
+    ("_core.run(0, 0, X0, P, 0, 1, dict(dt=1e-4, n_steps=20, record_every=1, max_speed=1e3), "
+     "poll_every=1)",
      "poll_every", "InvalidInputError"),
 ]
 
@@ -103,7 +106,7 @@ x = np.tile(X0, (n, 1))
 outd = B._outputs(n)
 try:
     _batch.run_range(0, x, P[None], np.tile(np.array([0, 1], np.intc), (n, 1)),
-                     np.full(n, 0.2), np.full(n, 0.1), 1e-4, BIG, 1e3, 0, 0, 0.0,
+                     np.full(n, 0.2), np.full(n, 0.1), dict(dt=1e-4, n_steps=BIG, max_speed=1e3),
                      outd, 0, n, 1, False)
 except Exception as e:
     print("RAISED", type(e).__name__, "|", e)
@@ -127,7 +130,9 @@ def test_counts_within_range_still_run():
     res, t, y, k = _hybrid.walk(p, np.array([0.2, -0.2, -1.0, -0.3]), 0.0, 2, {}, 100)
     assert len(res) >= 1
     raw = _core.run(0, 0, np.array(pdw.X0_PAPER), parameter_vector(pdw.Params.paper()), 0, 1,
-                    1e-4, 10, 1, False, 0.2, 0.1, 1e3, max_records=16, event_capacity=8)
+                    dict(dt=1e-4, n_steps=10, record_every=1, record_events=1, fall_hip_height=0.2,
+                         fall_depth=0.1, max_speed=1e3), record_contact=False, max_records=16,
+                    event_capacity=8)
     assert len(raw["t"]) == 11
     g = pdw.hybrid.find_gait(pdw.Params.paper_steady(), settle_steps=5)
     assert g.period > 0
@@ -169,7 +174,7 @@ SHAPE_CASES = [
      "contact"),
     ("_core.precompute(np.ones(3), np.empty(NP))", "params"),
     ("_core.precompute(pdw.Params().as_array(), np.empty(3))", "p"),
-    ("_core.run(0, 0, np.zeros(3), P, 0, 1, 1e-4, 10, 1, True, 0.2, 0.1, 1e3)", "x0"),
+    ("_core.run(0, 0, np.zeros(3), P, 0, 1, dict(dt=1e-4, n_steps=10, max_speed=1e3))", "x0"),
     ("_core.bench(0, 'rhs', np.zeros(3), P, 0, 1, 0.0, 0.0, 10)", "x"),
     ("_hybrid.step_batch(P, np.zeros((4, 4)), {}, np.empty((1, 4)), np.empty(4, np.intc))",
      "y_plus"),
@@ -234,7 +239,8 @@ def _array_args(fn):
     parts = [p.split("=")[0].split() for p in raw]
     # the required arguments (no default), with a valid scalar for the non-array ones
     scalar = {"int": 0, "long": 0, "double": 0.0, "bint": False, "str": "rhs", "dict": {}}
-    names = [(p[-1], scalar.get(p[0], None)) for p, r in zip(parts, raw) if "=" not in r]
+    names = [(p[-1], scalar.get(p[0], None)) for p, r in zip(parts, raw)
+             if "=" not in r and p != ["*"]]      # keyword-only ones after "*" have defaults
     arrays = []
     for p in parts:
         m = re.fullmatch(r"(const )?(double|int|long)\[([:, 0-9]*)\] (\w+)", " ".join(p))
@@ -320,7 +326,7 @@ def test_batch_outputs_of_the_wrong_dtype_are_named():
     finally:
         mp.undo()
     args, kw = calls[0]
-    i_out = next(i for i, v in enumerate(args) if isinstance(v, dict))
+    i_out = next(i for i, v in enumerate(args) if isinstance(v, dict) and "status" in v)
     for key in ("n_steps", "x_final", "gait"):
         out = dict(args[i_out])
         out[key] = out[key].astype(np.float32 if out[key].dtype != np.float32 else np.float64)
@@ -360,8 +366,12 @@ P = parameter_vector(pdw.Params.paper())
 X = np.tile(np.array(pdw.X0_PAPER), (2, 1))
 F = np.tile(np.array([0, 1], dtype=np.intc), (2, 1))
 H, D = np.full(2, 0.5), np.full(2, 0.1)
+O = dict(dt=1e-4, n_steps=50, record_every=1, record_events=1, fall_hip_height=0.2,
+         fall_depth=0.1, max_speed=1e3)
 def rr(x=X, p=P[None], f=F, dt=1e-4, n=50, stop=0, pk=0, out=None):
-    return _batch.run_range(0, x, p, f, H, D, dt, n, 1e3, stop, pk, 1e-3,
+    return _batch.run_range(0, x, p, f, H, D, dict(dt=dt, n_steps=n, max_speed=1e3,
+                                                   stop_steps=stop, periodic_k=pk,
+                                                   periodic_tol=1e-3),
                             _outputs(len(x)) if out is None else out, 0, len(x), 4, False)
 def tampered(**arrays):
     b = RecordBuffer(100)
@@ -380,9 +390,9 @@ CRASH_CASES = [
     ("pdw.simulate(t_end=0.005, out=tampered(x=np.zeros((1, NX))))", "out.x"),
     ("pdw.simulate(t_end=0.05, out=tampered(t=np.zeros(5000)))", "out.x"),
     ("pdw.simulate(t_end=0.005, out=tampered(flags=np.zeros((100, 2))))", "out.flags"),
-    ("_core.run(0, 0, X[0], P, 0, 1, 1e-4, 50, 1, True, 0.2, 0.1, 1e3, buffers=bufs(nc=1))",
+    ("_core.run(0, 0, X[0], P, 0, 1, O, buffers=bufs(nc=1))",
      "contact"),
-    ("_core.run(0, 0, X[0], P, 0, 1, 1e-4, 50, 1, True, 0.2, 0.1, 1e3, "
+    ("_core.run(0, 0, X[0], P, 0, 1, O, "
      "buffers=bufs()[:1] + (np.zeros((3, NX)),) + bufs()[2:])", "x"),
     ("rr(f=np.array([[7, 1], [0, 1]], np.intc))", "flags0"),
     ("rr(dt=float('nan'))", "dt"),

@@ -259,8 +259,10 @@ def test_resumption_after_full_event_buffer_is_exact(name):
     k, p, x0 = kernel_index("paper"), parameter_vector(None), np.array(X0_PAPER)
     dt = 1e-4 if name in ("cdm", "rodas4") else 2e-6
     t_end = 1.0 if name in ("cdm", "rodas4") else 0.4
-    args = (k, METHODS.index(name), x0, p, 0, 1, dt, int(round(t_end / dt)), 50, True,
-            0.25, 0.125, 1e3, 1e-6, 1e-8, 0.0)
+    args = (k, METHODS.index(name), x0, p, 0, 1,
+            dict(dt=dt, n_steps=int(round(t_end / dt)), record_every=50, record_events=1,
+                 fall_hip_height=0.25, fall_depth=0.125, max_speed=1e3, rtol=1e-6, atol=1e-8,
+                 event_tol=1e-9))
     a = _core.run(*args, event_capacity=4)
     b = _core.run(*args, event_capacity=256)
     assert len(a["events"]) >= 2

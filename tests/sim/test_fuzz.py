@@ -333,9 +333,12 @@ def _compiled(data):
             _core.precompute(data.draw(arrays((19,))), data.draw(arrays((_core.NP,))))
         else:
             _core.run(max(k, 0), data.draw(st.integers(-1, 5)), data.draw(arrays((_core.NX,))),
-                      P, data.draw(st.integers(-1, 2)), 1, data.draw(st.sampled_from([1e-4, 0.0])),
-                      data.draw(st.integers(-2, 50)), data.draw(st.integers(-1, 3)), True,
-                      0.25, 0.125, 1e3, t_end=0.005)
+                      P, data.draw(st.integers(-1, 2)), 1,
+                      dict(dt=data.draw(st.sampled_from([1e-4, 0.0])),
+                           n_steps=data.draw(st.integers(-2, 50)),
+                           record_every=data.draw(st.integers(-1, 3)), record_events=1,
+                           fall_hip_height=0.25, fall_depth=0.125, max_speed=1e3, rtol=1e-6,
+                           atol=1e-8, event_tol=1e-9, t_end=0.005))
     except (ValueError, IndexError, TypeError, BufferError):
         pass                                      # a refusal; a crash would end the test run
 
@@ -528,10 +531,13 @@ def _batch_compiled(data):
         _batch.run_range(data.draw(st.integers(-1, len(_core.kernel_table()))),
                          data.draw(arrays((n, _core.NX))), data.draw(arrays((1, _core.NP))),
                          data.draw(arrays((n, 2), np.intc)), data.draw(arrays((n,))),
-                         data.draw(arrays((n,))), data.draw(st.sampled_from([1e-4, 0.0]) | ANY_FLOAT),
-                         data.draw(st.integers(-2, 30)), data.draw(st.sampled_from([1e3]) | ANY_FLOAT),
-                         data.draw(st.integers(-1, 3)), data.draw(st.integers(-1, 40)),
-                         data.draw(st.sampled_from([1e-3]) | ANY_FLOAT), out,
+                         data.draw(arrays((n,))),
+                         dict(dt=data.draw(st.sampled_from([1e-4, 0.0]) | ANY_FLOAT),
+                              n_steps=data.draw(st.integers(-2, 30)),
+                              max_speed=data.draw(st.sampled_from([1e3]) | ANY_FLOAT),
+                              stop_steps=data.draw(st.integers(-1, 3)),
+                              periodic_k=data.draw(st.integers(-1, 40)),
+                              periodic_tol=data.draw(st.sampled_from([1e-3]) | ANY_FLOAT)), out,
                          data.draw(st.integers(-1, n + 1)), data.draw(st.integers(-1, n + 1)),
                          data.draw(st.integers(-1, 70)), data.draw(st.booleans()))
     except (ValueError, IndexError, TypeError, BufferError, KeyError):
@@ -742,15 +748,21 @@ def _counts(data):
         elif which == "run":
             name = data.draw(st.sampled_from(["max_records", "event_capacity", "stop_steps",
                                               "max_steps", "poll_every"]))
-            _core.run(0, 0, X0, P, 0, 1, 1e-4, c1 if not 0 <= c1 <= 60 else 20,
-                      data.draw(st.integers(0, 3)), True, 0.25, 0.125, 1e3, **{name: c2})
+            o = dict(dt=1e-4, n_steps=c1 if not 0 <= c1 <= 60 else 20,
+                     record_every=data.draw(st.integers(0, 3)), record_events=1,
+                     fall_hip_height=0.25, fall_depth=0.125, max_speed=1e3)
+            if name in ("stop_steps", "max_steps"):
+                _core.run(0, 0, X0, P, 0, 1, o | {name: c2})
+            else:
+                _core.run(0, 0, X0, P, 0, 1, o, **{name: c2})
         elif which == "batch":
             from pdw.sim.batch import _outputs
             out = _outputs(1)
             _batch.run_range(0, X0[None].copy(), P[None].copy(), np.array([[0, 1]], np.intc),
-                             np.array([0.2]), np.array([0.1]), 1e-4,
-                             c1 if not 0 <= c1 <= 60 else 20, 1e3, c2 if c2 > 60 or c2 < 0
-                             else 0, 0, 0.0, out, 0, 1, 1, False)
+                             np.array([0.2]), np.array([0.1]),
+                             dict(dt=1e-4, n_steps=c1 if not 0 <= c1 <= 60 else 20, max_speed=1e3,
+                                  stop_steps=c2 if c2 > 60 or c2 < 0 else 0),
+                             out, 0, 1, 1, False)
         else:
             pdw.hybrid.find_gait(pdw.Params.paper_steady(), settle_steps=c1 if c1 > 60 or c1 < 0
                                  else 1, max_iter=c2 if c2 > 60 or c2 < 0 else 1)

@@ -1,5 +1,6 @@
 """The option objects of a run (pdw/sim/options.py): validation, one name per option, the
 Scene holding the same objects, outcomes, and simulate_batch's progress and repr."""
+import dataclasses
 import io
 import warnings
 
@@ -194,43 +195,23 @@ def test_batch_takes_the_same_objects_as_simulate():
     assert np.array_equal(m.x_final, b.x_final)
 
 
-# --- the options reach the compiled loops by their C names -------------------------------------
+# --- the options reach the compiled loops by their C names (more: tests/test_run_opts.py) ---------
 
-def test_c_options_set_pdw_run_opts_by_name():
-    """An option with a C name (`_f(..., c=NAME)`) reaches pdw_run_opts through ``opts`` alone:
-    _core.run with stop_touch_down given only in ``opts`` stops where the argument stops."""
+def test_c_options_names_the_fields_of_pdw_run_opts():
+    """c_options: each option with a C name (`_f(..., c=NAME)`) under that name, then what the
+    run derives; every name is a field of pdw_run_opts."""
     from pdw.core import _core
-    from pdw.core.model import kernel_index, parameter_vector
     from pdw.sim.options import c_options
-    names = c_options(Integrator(h_max=1.0, max_steps=5), Record(), Stop(), Limits())
-    assert set(names) == {"rtol", "atol", "event_tol", "record_every", "record_events",
-                          "stop_steps", "periodic_tol", "stop_touch_down", "max_speed"}
-    k = kernel_index("paper", None)
-    p = parameter_vector(pdw.Params.paper())
-    x = np.array(pdw.X0_PAPER)
-    args = (k, 0, x, p, 0, 1, 1e-4, 20000, 0, False, 0.4, 0.2, 1e3)
-    by_arg = _core.run(*args, stop_touch_down=1)
-    by_opts = _core.run(*args, opts=c_options(Stop(touch_down=1)))
-    plain = _core.run(*args)
-    assert by_arg["n_steps"] == by_opts["n_steps"] < plain["n_steps"]
-    assert np.array_equal(by_arg["x_final"], by_opts["x_final"])
-    _core.run(*args, opts=c_options(Integrator(), Record(), Stop(), Limits()))
-    with pytest.raises(ValueError, match="no field"):
-        _core.run(*args, opts={"stop_on_moon": 1})
-
-
-def test_run_args_are_fields_and_a_new_c_field_is_passed():
-    """Every name of RUN_ARGS is a pdw_run_opts field (_core.run accepts it in opts), and a
-    C-named option that is not one of them reaches the run through ``opts``."""
-    from pdw.core import _core
-    from pdw.core.model import kernel_index, parameter_vector
-    from pdw.sim.options import RUN_ARGS, c_options
-    x, p = np.array(pdw.X0_PAPER), parameter_vector(pdw.Params.paper())
-    args = (kernel_index("paper", None), 0, x, p, 0, 1, 1e-4, 10, 0, False, 0.4, 0.2, 1e3)
-    _core.run(*args, opts={name: 0 for name in RUN_ARGS if name not in ("dt",)} | {"n_steps": 10})
-    assert c_options(Stop(touch_down=1), skip=RUN_ARGS) == {}
+    objs = (Integrator(h_max=1.0, max_steps=5), Record(), Stop(), Limits())
+    names = c_options(*objs)
+    named = {f.metadata["c"] for o in objs for f in dataclasses.fields(o) if f.metadata["c"]}
+    assert set(names) == named >= {"rtol", "atol", "event_tol", "record_every",
+                                   "record_events", "stop_steps", "periodic_tol",
+                                   "stop_touch_down", "max_speed"}
+    assert set(names) <= set(_core.OPT_FIELDS)
     assert c_options(Stop(touch_down=1)) == {"stop_steps": 0, "periodic_tol": 1e-3,
                                              "stop_touch_down": 1}
+    assert c_options(Stop(touch_down=1), dt=1e-4, stop_touch_down=2)["stop_touch_down"] == 2
 
 
 @pytest.mark.parametrize("fn", [pdw.simulate_batch, pdw.simulate_many])

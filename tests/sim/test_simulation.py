@@ -105,7 +105,9 @@ def test_recording_is_optional_and_events_are_always_kept():
 def test_event_buffer_grows_and_the_loop_resumes_exactly():
     p = parameter_vector(pdw.Params.paper_steady())
     k = kernel_index("paper")
-    args = (k, 0, np.array(X0_PAPER), p, 0, 1, 1e-4, 60000, 0, False, 0.25, 0.125, 1e3)
+    args = (k, 0, np.array(X0_PAPER), p, 0, 1,
+            dict(dt=1e-4, n_steps=60000, record_events=1, fall_hip_height=0.25, fall_depth=0.125,
+                 max_speed=1e3))
     small = _core.run(*args, event_capacity=4)
     big = _core.run(*args, event_capacity=1000)
     assert len(big["events"]) > 8

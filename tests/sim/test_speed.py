@@ -52,7 +52,8 @@ def test_a_run_that_outgrows_its_records_keeps_every_sample():
     k = 0
     p = pdw.core.model.parameter_vector(pdw.Params.paper())
     x0 = np.array(pdw.X0_PAPER)
-    args = (k, 0, x0, p, 0, 1, 1e-4, 300, 1, True, 0.4, 0.2, 1e3)
+    args = (k, 0, x0, p, 0, 1, dict(dt=1e-4, n_steps=300, record_every=1, record_events=1,
+                                    fall_hip_height=0.4, fall_depth=0.2, max_speed=1e3))
     a = _core.run(*args, max_records=5)
     b = _core.run(*args)
     for name in ("t", "x", "flags", "contact"):

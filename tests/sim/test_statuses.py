@@ -179,11 +179,11 @@ def test_polling_changes_no_number():
     p = parameter_vector(pdw.Params.paper())
     x0 = np.array(pdw.X0_PAPER)
     for m in (0, pdw.METHODS.index("rodas4"), pdw.METHODS.index("rk4")):
-        kw = dict(rtol=1e-6, atol=1e-8, t_end=0.8)
-        a = _core.run(kernel_index("paper"), m, x0, p, 0, 1, 1e-4, 8000, 3, True, 0.25, 0.125,
-                      1e3, poll_every=0, **kw)
-        b = _core.run(kernel_index("paper"), m, x0, p, 0, 1, 1e-4, 8000, 3, True, 0.25, 0.125,
-                      1e3, poll_every=7, max_records=5, **kw)
+        o = dict(dt=1e-4, n_steps=8000, record_every=3, record_events=1, fall_hip_height=0.25,
+                 fall_depth=0.125, max_speed=1e3, rtol=1e-6, atol=1e-8, event_tol=1e-9,
+                 t_end=0.8)
+        a = _core.run(kernel_index("paper"), m, x0, p, 0, 1, o, poll_every=0)
+        b = _core.run(kernel_index("paper"), m, x0, p, 0, 1, o, poll_every=7, max_records=5)
         assert a["status"] == b["status"] == 1
         for key in ("t", "x", "flags", "contact", "events", "x_final"):
             assert np.array_equal(a[key], b[key]), (m, key)

@@ -50,16 +50,10 @@ typedef struct pdw_gait {
     double ring[PDW_STEP_RING][PDW_NSTEP];   /* step k (from 0) is ring[k % PDW_STEP_RING] */
 } pdw_gait;
 
-/* A loop status beyond the generated PDW_STATUS_*: the record buffer is full. Like
- * PDW_STATUS_EVENTS_FULL it never reaches Python's result: _core.run grows the record arrays
- * and calls advance again, which resumes where it stopped. Only adaptive methods (whose
- * number of samples is not known in advance) return it. */
-enum { PDW_STATUS_RECORDS_FULL = 64 };
-
-/* A loop status beyond the generated ones: poll_every loop iterations have passed. The loop
- * returns it at a point where it resumes exactly (like PDW_STATUS_EVENTS_FULL); _core.run takes
- * the GIL, checks for signals (Ctrl-C) and the step budget, and calls advance again. */
-enum { PDW_STATUS_POLL = 65 };
+/* PDW_STATUS_RECORDS_FULL and PDW_STATUS_POLL, the returns of a loop that never reach a Result
+ * (the caller grows the record buffer, or checks for signals, and resumes), the record buffer
+ * sizes and the poll interval: generated from derive/layout.py's RESUME (pdw_model.h), with
+ * the messages pdw/core/_layout.py's RESUME_TEXT gives Python. */
 
 /* The options a loop reads: pdw.sim.options' Integrator, Record, Stop and Limits as C (plus
  * n_steps and the fixed t_end, derived from them). Filled once before a run (pdw/core/_core.pyx
