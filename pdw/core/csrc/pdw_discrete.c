@@ -200,7 +200,7 @@ void pdw_record_final(pdw_sim *s, double t)
     pdw_record_now(s, t);
 }
 
-int pdw_check_feet(pdw_sim *s, double t)
+int pdw_check_feet_fail(pdw_sim *s, double t)
 {
     const double *kin = s->work + PDW_WORK_KIN;
     for (int i = 0; i < 2; ++i) {
@@ -212,7 +212,7 @@ int pdw_check_feet(pdw_sim *s, double t)
     return 0;
 }
 
-int pdw_check_state(pdw_sim *s, const double *xnew, double t)
+int pdw_check_state_fail(pdw_sim *s, const double *xnew, double t)
 {
     /* the walker's 8 states with a compile-time loop (the common case costs what it did before
      * LuGre), then the friction law's extra states, if any */
@@ -260,12 +260,6 @@ int pdw_switch_pending(const pdw_sim *s, const double *x, double *work)
         for (int i = 0; i < 2; ++i)
             if (zone_of(s->ground, d->flags[i], kin + i*PDW_NKIN) != d->zone[i]) mask |= 1 << i;
     return mask;
-}
-
-void pdw_record(pdw_sim *s, double t)
-{
-    if (s->opt.record_every <= 0 || s->n % s->opt.record_every != 0) return;
-    pdw_record_now(s, t);
 }
 
 void pdw_record_now(pdw_sim *s, double t)
