@@ -9,7 +9,7 @@ static void kinematics(const pdw_kernel *k, const pdw_ground *g, const double *p
 {
     pdw_trig(x, work + PDW_WORK_TRIG);
     if (g) pdw_terrain_kinematics(k, g, x, work + PDW_WORK_TRIG, p, anchors, work + PDW_WORK_KIN,
-                                  work + PDW_WORK_GROUND);
+                                  work + PDW_WORK_GROUND, work + PDW_WORK_GROUND_CELL);
     else k->kinematics(x, work + PDW_WORK_TRIG, p, anchors, work + PDW_WORK_KIN);
 }
 

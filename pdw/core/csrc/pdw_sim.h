@@ -151,7 +151,8 @@ static inline void pdw_sim_kinematics(const pdw_sim *s, const double *x, const d
 {
     if (s->ground)
         pdw_terrain_kinematics(s->kernel, s->ground, x, work + PDW_WORK_TRIG, s->p, anchors,
-                               work + PDW_WORK_KIN, work + PDW_WORK_GROUND);
+                               work + PDW_WORK_KIN, work + PDW_WORK_GROUND,
+                               work + PDW_WORK_GROUND_CELL);
     else s->kernel->kinematics(x, work + PDW_WORK_TRIG, s->p, anchors, work + PDW_WORK_KIN);
 }
 
