@@ -25,6 +25,20 @@ static inline void inv_normals(double dh0, double dh1, double *n0, double *n1)
 #endif
 }
 
+/* Copy n doubles one at a time. The contact stage has just stored them one by one, and a wider
+ * load across two fresh 8-byte stores cannot take its value from the store buffer (it waits
+ * until they are written: tens of cycles per load); the empty asm keeps the compiler from
+ * merging the copies into vector moves. */
+static inline void copy_fresh(double *dst, const double *src, int n)
+{
+    for (int f = 0; f < n; ++f) {
+        dst[f] = src[f];
+#if defined(__GNUC__)
+        __asm__ volatile("" ::: "memory");
+#endif
+    }
+}
+
 void pdw_terrain_kinematics(const pdw_kernel *k, const pdw_ground *g, const double *x,
                             const double *trig, const double *p, const double *anchors,
                             double *kin, double *gnd, double *cell)
@@ -71,7 +85,7 @@ void pdw_terrain_contact(const pdw_kernel *k, const pdw_ground *g, const double 
         memcpy(pi, p, sizeof pi);
         pdw_ground_params(g, kin[i*PDW_NKIN + PDW_KIN_X_D], p, pi);
         stage(kin, fl, pi, ci);
-        memcpy(contact + i*PDW_NCONTACT, ci + i*PDW_NCONTACT, PDW_NCONTACT * sizeof(double));
+        copy_fresh(contact + i*PDW_NCONTACT, ci + i*PDW_NCONTACT, PDW_NCONTACT);
     }
 }
 
@@ -80,7 +94,7 @@ void pdw_terrain_forces(const double *contact, const double *gnd, const double *
 {
     double gf[2*PDW_NGFORCE];
     pdw_ground_forces(contact, gnd, p, gf);
-    memcpy(cw, contact, 2*PDW_NCONTACT * sizeof(double));
+    copy_fresh(cw, contact, 2*PDW_NCONTACT);
     for (int i = 0; i < 2; ++i) {
         cw[i*PDW_NCONTACT + PDW_CONTACT_F_N] = gf[i*PDW_NGFORCE + PDW_GFORCE_F_Y];
         cw[i*PDW_NCONTACT + PDW_CONTACT_F_T] = gf[i*PDW_NGFORCE + PDW_GFORCE_F_X];
