@@ -146,4 +146,14 @@ static inline int pdw_ground_zone(const pdw_ground *g, double s)
     return z;
 }
 
+/* pdw_ground_zone with a hint z (the foot's zone at the last step, or -1): z itself while s stays
+ * inside that zone's interval [zones[z-1], zones[z]) (the cached interval), else the scan. */
+static inline int pdw_ground_zone_hint(const pdw_ground *g, double s, int z)
+{
+    if (z >= 0 && z <= g->n_zones && (z == 0 || g->zones[z - 1] <= s)
+        && (z == g->n_zones || s < g->zones[z]))
+        return z;
+    return pdw_ground_zone(g, s);
+}
+
 #endif /* PDW_GROUND_EVAL_H */
