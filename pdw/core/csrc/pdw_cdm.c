@@ -64,9 +64,14 @@ typedef char pdw_cdm_dblock_check[
  * remaining terms in the dense loop's order (j ascending) and start from -0.0 (-0.0 + a = a), so
  * every value is the dense loop's (an exactly-zero term changes a sum only in the sign of a zero
  * result); the lane loop of pdw_batch_soa.inc gives the same bits. */
-int pdw_cdm_update(pdw_sim *s, const double *M, const double *C, const double *QmG, double t)
+static inline int cdm_update(pdw_sim *s, const double *M, const double *C, const double *QmG,
+                             double t)
 {
-    const double dt = s->opt.dt, idt2 = 1.0/(dt*dt), ih = 0.5/dt;
+    const double dt = s->opt.dt;
+    if (dt != s->cdm_dt || dt == 0.0) {  /* 1/dt^2 and 1/(2 dt): computed once per run */
+        s->cdm_dt = dt; s->cdm_idt2 = 1.0/(dt*dt); s->cdm_ih = 0.5/dt;
+    }
+    const double idt2 = s->cdm_idt2, ih = s->cdm_ih;
     double K[PDW_NQ*PDW_NQ], b[PDW_NQ], u[PDW_NQ], xnew[PDW_NX_MAX];
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC unroll 4
@@ -122,6 +127,12 @@ int pdw_cdm_update(pdw_sim *s, const double *M, const double *C, const double *Q
     return 0;
 }
 
+/* The shared entry (pdw_batch.c); pdw_cdm_advance below has the update inline. */
+int pdw_cdm_update(pdw_sim *s, const double *M, const double *C, const double *QmG, double t)
+{
+    return cdm_update(s, M, C, QmG, t);
+}
+
 int pdw_cdm_advance(pdw_sim *s)
 {
     const pdw_kernel *k = s->kernel;
@@ -159,7 +170,7 @@ int pdw_cdm_advance(pdw_sim *s)
             k->cdm_terms(s->x, trig, s->p, contact, M, C, QmG);
         }
         if (s->n > 0) pdw_record(s, t);  /* sample 0 was recorded at the start */
-        if (pdw_cdm_update(s, M, C, QmG, t)) return s->status;
+        if (cdm_update(s, M, C, QmG, t)) return s->status;
     }
     /* final sample: flags and forces at t_end */
     const int r = pdw_update_flags(s, s->n * dt);

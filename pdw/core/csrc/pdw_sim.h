@@ -128,6 +128,8 @@ typedef struct pdw_sim {
     double h_prev;              /* adaptive methods: previous accepted step (0: none yet) */
     double cdm_kdiag[2], cdm_kinv[2];   /* cdm: K[2][2], K[3][3] of the last step and their
                                          * inverses (pdw_cdm_update; 0: none) */
+    double cdm_dt, cdm_idt2, cdm_ih;    /* cdm: the dt that 1/dt^2 and 1/(2 dt) were computed for
+                                         * (0: none) */
     /* --- work counters (every method) --- */
     long n_rhs, n_jac, n_rejected;
     /* --- online gait analysis (every method; see pdw_update_flags) --- */
