@@ -6,6 +6,7 @@ PIP    := $(PY) -m pip
 OUT    ?= out/typical_gait
 BUILT  := $(VENV)/.pdw-built
 STAMP  := $(VENV)/.pdw-installed
+BARE_CDM := build/bench/libbare_cdm.so
 SOURCES := $(wildcard generated/*.c generated/*.h pdw/core/*.pyx pdw/core/*.pxi pdw/core/csrc/*.c pdw/core/csrc/*.h pdw/core/csrc/*.inc) setup.py pyproject.toml
 # an extra's requirements, read from pyproject.toml (installed without rebuilding pdw)
 EXTRA_REQS = $(PY) -c "import sys, tomllib; print('\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies'][sys.argv[1]]))"
@@ -70,8 +71,9 @@ check-generated: $(STAMP)
 ## bench: micro-benchmarks and the run-time benchmarks, written to out/benchmarks/;
 ## `make bench UPDATE_DOCS=--update-docs` writes the committed benchmarks/results/ and docs/figures/
 UPDATE_DOCS ?=
-bench: $(STAMP)
+bench: $(STAMP) $(BARE_CDM)
 	$(PY) benchmarks/bench_model.py $(UPDATE_DOCS)
+	$(PY) benchmarks/bench_cdm_step.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_simulate.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_integrators.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_scenes.py $(UPDATE_DOCS)
@@ -82,6 +84,13 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_terrain.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_mfpt.py $(UPDATE_DOCS)
 	$(PY) benchmarks/continuation.py codim2 fold_kn $(UPDATE_DOCS)
+
+## build/bench/libbare_cdm.so: the bare-C central-difference loop that bench_cdm_step.py measures
+## pdw's cdm loop against (benchmarks/bare_cdm.c with the generated model, pdw's own flags)
+$(BARE_CDM): benchmarks/bare_cdm.c generated/pdw_model.c generated/pdw_model.h
+	@mkdir -p $(dir $@)
+	$(CC) -O3 -std=c99 -fno-math-errno -fPIC -shared -Igenerated -Ipdw/core/csrc -o $@ benchmarks/bare_cdm.c \
+	  generated/pdw_model.c -lm
 
 ## instructions: the instruction-count guard (valgrind's callgrind; benchmarks/instructions.py):
 ## the paper run with and without recording, a first call, 64-walker batches, find_gait,

@@ -179,4 +179,5 @@ def work_layout():
         ("f", NQ),
         ("qdd", NQ),
         ("ground", 2 * len(GROUND)),      # the ground sampled under each foot (shaped ground)
+        ("ground_cell", 2),               # each foot's last height cell (a hint: pdw_ground.h)
     ]

@@ -104,6 +104,20 @@ def cdm_terms(spec: KernelSpec):
     return [_trig(e) for e in list(mech.M) + list(mech.C) + list(QmG)]
 
 
+def cdm_pattern():
+    """Structural non-zeros of the matrices of `cdm_terms`: bit masks (bit NQ*i + j: entry (i, j),
+    row-major) of the entries of M and of C that are not identically zero. The mechanics do not
+    depend on the kernel (contact laws, features, variant enter Q_f - G only), so one pattern
+    holds for every kernel; the central difference update (pdw/core/csrc/pdw_cdm.c) touches only
+    these entries."""
+    mech = mdl.mechanics()
+
+    def mask(A):
+        return sum(1 << k for k, e in enumerate(A) if sp.expand(e) != 0)
+
+    return mask(mech.M), mask(mech.C)
+
+
 def contact_partial_symbols():
     """Symbols standing for the contact stage's outputs of foot i: {(i, field): Symbol}."""
     return {(i, f): mdl._real("%s_%d" % (f, i + 1)) for i in range(2) for f in layout.CONTACT}

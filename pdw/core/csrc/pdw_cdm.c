@@ -20,6 +20,7 @@ void pdw_cdm_start(pdw_sim *s)
     pdw_sim_rhs(s, s->x, xdot, s->work);
     for (int i = 0; i < PDW_NQ; ++i)
         s->u_prev[i] = s->x[i] - dt*s->x[PDW_NQ + i] + 0.5*dt*dt*xdot[PDW_NQ + i];
+    s->cdm_kdiag[0] = s->cdm_kdiag[1] = 0.0;      /* pdw_cdm_update's cache: empty */
     s->started = 1;
     s->n = 0;
     s->t = 0.0;
@@ -51,21 +52,62 @@ static void bristle_update(const pdw_sim *s, double dt, double *xnew)
     }
 }
 
-int pdw_cdm_update(pdw_sim *s, const double *M, const double *C, const double *QmG, double t)
+/* pdw_solve_dblock needs the lower-right 2x2 block of K = M/dt^2 + C/(2dt) diagonal: a
+ * compile-time check of the emitted pattern (an array of size -1 if an entry there is not zero) */
+typedef char pdw_cdm_dblock_check[
+    (PDW_CDM_NZ(PDW_CDM_M_NZ | PDW_CDM_C_NZ, 2, 3) || PDW_CDM_NZ(PDW_CDM_M_NZ | PDW_CDM_C_NZ, 3, 2))
+    ? -1 : 1];
+
+/* The assembly touches only the structural non-zeros of M and C (PDW_CDM_M_NZ, PDW_CDM_C_NZ,
+ * emitted by derive/ from the symbolic matrices): with the 4x4 loops unrolled, each entry's test
+ * is a compile-time constant and the terms of a zero entry are not compiled. The sums keep their
+ * remaining terms in the dense loop's order (j ascending) and start from -0.0 (-0.0 + a = a), so
+ * every value is the dense loop's (an exactly-zero term changes a sum only in the sign of a zero
+ * result); the lane loop of pdw_batch_soa.inc gives the same bits. */
+static inline int cdm_update(pdw_sim *s, const double *M, const double *C, const double *QmG,
+                             double t)
 {
-    const double dt = s->opt.dt, idt2 = 1.0/(dt*dt), ih = 0.5/dt;
+    const double dt = s->opt.dt;
+    if (dt != s->cdm_dt || dt == 0.0) {  /* 1/dt^2 and 1/(2 dt): computed once per run */
+        s->cdm_dt = dt; s->cdm_idt2 = 1.0/(dt*dt); s->cdm_ih = 0.5/dt;
+    }
+    const double idt2 = s->cdm_idt2, ih = s->cdm_ih;
     double K[PDW_NQ*PDW_NQ], b[PDW_NQ], u[PDW_NQ], xnew[PDW_NX_MAX];
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC unroll 4
+#endif
     for (int i = 0; i < PDW_NQ; ++i) {
-        double mu = 0.0, ku = 0.0;
+        double mu = -0.0, ku = -0.0;
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC unroll 4
+#endif
         for (int j = 0; j < PDW_NQ; ++j) {
-            const double m = M[i*PDW_NQ + j], c = C[i*PDW_NQ + j];
-            K[i*PDW_NQ + j] = m*idt2 + c*ih;
-            mu += m * s->x[j];
-            ku += (m*idt2 - c*ih) * s->u_prev[j];
+            const int mz = PDW_CDM_NZ(PDW_CDM_M_NZ, i, j), cz = PDW_CDM_NZ(PDW_CDM_C_NZ, i, j);
+            const int ij = i*PDW_NQ + j;
+            double kp = 0.0, km = 0.0;       /* M/dt^2 + C/2dt and M/dt^2 - C/2dt at (i, j) */
+            if (mz && cz) { kp = M[ij]*idt2 + C[ij]*ih; km = M[ij]*idt2 - C[ij]*ih; }
+            else if (mz) kp = km = M[ij]*idt2;
+            else if (cz) { kp = C[ij]*ih; km = -(C[ij]*ih); }
+            K[ij] = kp;
+            if (mz) mu += M[ij] * s->x[j];
+            if (mz || cz) ku += km * s->u_prev[j];
         }
         b[i] = QmG[i] + 2.0*idt2*mu - ku;
     }
-    if (pdw_solve_dblock(K, b, u)) {
+    /* 1/K[2][2] and 1/K[3][3]: the diagonal block is M's (C's is zero), which in the walker's
+     * mechanics depends on the parameters only; the last step's inverses are reused while the
+     * entries are bitwise the same (the same divisions, not redone; s->cdm_kdiag is zero at
+     * the start, and a zero entry is never reused) */
+    double id[2];
+    for (int i = 0; i < 2; ++i) {
+        const double kd = K[(2 + i)*(PDW_NQ + 1)];
+        if (kd == s->cdm_kdiag[i] && kd != 0.0) id[i] = s->cdm_kinv[i];
+        else { id[i] = 1.0 / kd; s->cdm_kdiag[i] = kd; s->cdm_kinv[i] = id[i]; }
+    }
+    double fac[PDW_DBLOCK_NFAC];
+    const int singular = pdw_dblock_factor_inv(K, id[0], id[1], fac);
+    pdw_dblock_solve(K, fac, b, u);
+    if (singular) {
         s->status = PDW_STATUS_SINGULAR;
         s->failure.reason = PDW_REASON_SINGULAR; s->failure.leg = -1; s->failure.t = t;
         memcpy(s->failure.x, s->x, sizeof s->x);
@@ -83,6 +125,12 @@ int pdw_cdm_update(pdw_sim *s, const double *M, const double *C, const double *Q
     s->t = s->n * dt;
     s->n_rhs++;
     return 0;
+}
+
+/* The shared entry (pdw_batch.c); pdw_cdm_advance below has the update inline. */
+int pdw_cdm_update(pdw_sim *s, const double *M, const double *C, const double *QmG, double t)
+{
+    return cdm_update(s, M, C, QmG, t);
 }
 
 int pdw_cdm_advance(pdw_sim *s)
@@ -122,7 +170,7 @@ int pdw_cdm_advance(pdw_sim *s)
             k->cdm_terms(s->x, trig, s->p, contact, M, C, QmG);
         }
         if (s->n > 0) pdw_record(s, t);  /* sample 0 was recorded at the start */
-        if (pdw_cdm_update(s, M, C, QmG, t)) return s->status;
+        if (cdm_update(s, M, C, QmG, t)) return s->status;
     }
     /* final sample: flags and forces at t_end */
     const int r = pdw_update_flags(s, s->n * dt);

@@ -9,14 +9,15 @@ static void kinematics(const pdw_kernel *k, const pdw_ground *g, const double *p
 {
     pdw_trig(x, work + PDW_WORK_TRIG);
     if (g) pdw_terrain_kinematics(k, g, x, work + PDW_WORK_TRIG, p, anchors, work + PDW_WORK_KIN,
-                                  work + PDW_WORK_GROUND);
+                                  work + PDW_WORK_GROUND, work + PDW_WORK_GROUND_CELL);
     else k->kinematics(x, work + PDW_WORK_TRIG, p, anchors, work + PDW_WORK_KIN);
 }
 
-/* The blend zone of foot i's contact point (support), -1 (swing or no patches). */
-static inline int zone_of(const pdw_ground *g, int support, const double *ki)
+/* The blend zone of foot i's contact point (support), -1 (swing or no patches); hint: its zone at
+ * the last step (or -1). */
+static inline int zone_of(const pdw_ground *g, int support, const double *ki, int hint)
 {
-    return g && g->n_zones > 0 && support ? pdw_ground_zone(g, ki[PDW_KIN_X_D]) : -1;
+    return g && g->n_zones > 0 && support ? pdw_ground_zone_hint(g, ki[PDW_KIN_X_D], hint) : -1;
 }
 
 void pdw_discrete_init(const pdw_kernel *k, const pdw_ground *g, const double *p, const double *x,
@@ -32,7 +33,7 @@ void pdw_discrete_init(const pdw_kernel *k, const pdw_ground *g, const double *p
         /* approach speed of a foot that starts in contact: its penetration rate, if any (the
          * laws that use it take at least v_in_min) */
         d->anchors[PDW_ANCHOR_V_IN1 + i] = d->flags[i] ? fmax(-ki[PDW_KIN_V_Y], 0.0) : 0.0;
-        d->zone[i] = zone_of(g, d->flags[i], ki);
+        d->zone[i] = zone_of(g, d->flags[i], ki, -1);
     }
 }
 
@@ -184,7 +185,8 @@ int pdw_update_flags_trig(pdw_sim *s, double t)
     /* a new anchor changes xi: refresh the kinematics (trig stays valid) */
     if (changed) pdw_sim_kinematics(s, s->x, d->anchors, s->work);
     if (s->ground)
-        for (int i = 0; i < 2; ++i) d->zone[i] = zone_of(s->ground, d->flags[i], kin + i*PDW_NKIN);
+        for (int i = 0; i < 2; ++i) d->zone[i] = zone_of(s->ground, d->flags[i], kin + i*PDW_NKIN,
+                                                d->zone[i]);
     if (stop != PDW_STOP_NONE) {
         s->stop_reason = stop;
         s->status = stop == PDW_STOP_PERIODIC ? PDW_STATUS_PERIODIC : PDW_STATUS_DONE;
@@ -200,7 +202,7 @@ void pdw_record_final(pdw_sim *s, double t)
     pdw_record_now(s, t);
 }
 
-int pdw_check_feet(pdw_sim *s, double t)
+int pdw_check_feet_fail(pdw_sim *s, double t)
 {
     const double *kin = s->work + PDW_WORK_KIN;
     for (int i = 0; i < 2; ++i) {
@@ -212,7 +214,7 @@ int pdw_check_feet(pdw_sim *s, double t)
     return 0;
 }
 
-int pdw_check_state(pdw_sim *s, const double *xnew, double t)
+int pdw_check_state_fail(pdw_sim *s, const double *xnew, double t)
 {
     /* the walker's 8 states with a compile-time loop (the common case costs what it did before
      * LuGre), then the friction law's extra states, if any */
@@ -258,14 +260,8 @@ int pdw_switch_pending(const pdw_sim *s, const double *x, double *work)
     }
     if (s->ground && s->ground->n_zones > 0)         /* a support foot entered another blend zone */
         for (int i = 0; i < 2; ++i)
-            if (zone_of(s->ground, d->flags[i], kin + i*PDW_NKIN) != d->zone[i]) mask |= 1 << i;
+            if (zone_of(s->ground, d->flags[i], kin + i*PDW_NKIN, d->zone[i]) != d->zone[i]) mask |= 1 << i;
     return mask;
-}
-
-void pdw_record(pdw_sim *s, double t)
-{
-    if (s->opt.record_every <= 0 || s->n % s->opt.record_every != 0) return;
-    pdw_record_now(s, t);
 }
 
 void pdw_record_now(pdw_sim *s, double t)

@@ -45,10 +45,29 @@ static inline long pdw_ground_cell(const pdw_ground *g, double s)
     return k;
 }
 
-/* h, h', h'' at s into out[0..2]. */
-static inline void pdw_ground_eval(const pdw_ground *g, double s, double *out)
+/* pdw_ground_cell with a hint: *hint (the caller's scratch, a cell index as a double; any value,
+ * NaN included, is safe) if that cell contains s, else the search; *hint := the cell found. The
+ * cell is pdw_ground_cell's (the one k with s_k <= s < s_k+1, the end cells beyond the extent).
+ * A foot moves a fraction of a cell per step: the test is a predicted branch and the cell's
+ * coefficients load before s is known, where the search waits on s. */
+static inline long pdw_ground_cell_hint(const pdw_ground *g, double s, double *hint)
 {
-    const double *c = g->cells + pdw_ground_cell(g, s)*PDW_NGCELL;
+    const double hd = *hint;
+    if (hd >= 0.0 && hd < (double)g->n_cells) {
+        const long k = (long)hd;
+        if ((k == 0 || s >= g->cells[k*PDW_NGCELL + PDW_GCELL_S])
+            && (k + 1 == g->n_cells || s < g->cells[(k + 1)*PDW_NGCELL + PDW_GCELL_S]))
+            return k;
+    }
+    const long k = pdw_ground_cell(g, s);
+    *hint = (double)k;
+    return k;
+}
+
+/* h, h', h'' at s in cell k into out[0..2]. */
+static inline void pdw_ground_eval_cell(const pdw_ground *g, long k, double s, double *out)
+{
+    const double *c = g->cells + k*PDW_NGCELL;
     const double iw = c[PDW_GCELL_INV_W], u = (s - c[PDW_GCELL_S]) * iw;
     const double *a = c + PDW_GCELL_A0;
     /* Estrin's scheme: short dependency chains (the time loops wait on these values) */
@@ -56,6 +75,12 @@ static inline void pdw_ground_eval(const pdw_ground *g, double s, double *out)
     out[0] = (a[0] + a[1]*u) + u2*(a[2] + a[3]*u) + u4*(a[4] + a[5]*u);
     out[1] = ((a[1] + 2.0*a[2]*u) + u2*(3.0*a[3] + 4.0*a[4]*u) + u4*(5.0*a[5])) * iw;
     out[2] = ((2.0*a[2] + 6.0*a[3]*u) + u2*(12.0*a[4] + 20.0*a[5]*u)) * (iw * iw);
+}
+
+/* h, h', h'' at s into out[0..2]. */
+static inline void pdw_ground_eval(const pdw_ground *g, double s, double *out)
+{
+    pdw_ground_eval_cell(g, pdw_ground_cell(g, s), s, out);
 }
 
 /* The arc length sigma(s) [m] from s_min. */
@@ -119,6 +144,16 @@ static inline int pdw_ground_zone(const pdw_ground *g, double s)
     int z = 0;
     while (z < g->n_zones && g->zones[z] <= s) ++z;
     return z;
+}
+
+/* pdw_ground_zone with a hint z (the foot's zone at the last step, or -1): z itself while s stays
+ * inside that zone's interval [zones[z-1], zones[z]) (the cached interval), else the scan. */
+static inline int pdw_ground_zone_hint(const pdw_ground *g, double s, int z)
+{
+    if (z >= 0 && z <= g->n_zones && (z == 0 || g->zones[z - 1] <= s)
+        && (z == g->n_zones || s < g->zones[z]))
+        return z;
+    return pdw_ground_zone(g, s);
 }
 
 #endif /* PDW_GROUND_EVAL_H */

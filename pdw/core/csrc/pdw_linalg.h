@@ -9,10 +9,11 @@
 
 enum { PDW_DBLOCK_NFAC = 6 };  /* fac = [1/d0, 1/d1, Sinv00, Sinv01, Sinv10, Sinv11] */
 
-/* Factor K; returns 0 on success, -1 if K is singular or not finite. */
-static inline int pdw_dblock_factor(const double *restrict K, double *restrict fac)
+/* Factor K given id0 = 1/K[10] and id1 = 1/K[15] (a caller that knows them saves the two
+ * divisions); returns 0 on success, -1 if K is singular or not finite. */
+static inline int pdw_dblock_factor_inv(const double *restrict K, double id0, double id1,
+                                        double *restrict fac)
 {
-    const double id0 = 1.0 / K[10], id1 = 1.0 / K[15];
     const double s00 = K[0] - K[2]*K[8]*id0 - K[3]*K[12]*id1;
     const double s01 = K[1] - K[2]*K[9]*id0 - K[3]*K[13]*id1;
     const double s10 = K[4] - K[6]*K[8]*id0 - K[7]*K[12]*id1;
@@ -22,6 +23,12 @@ static inline int pdw_dblock_factor(const double *restrict K, double *restrict f
     fac[0] = id0; fac[1] = id1;
     fac[2] = s11*idet; fac[3] = -s01*idet; fac[4] = -s10*idet; fac[5] = s00*idet;
     return (det != 0.0 && idet == idet && id0 == id0 && id1 == id1) ? 0 : -1;
+}
+
+/* Factor K; returns 0 on success, -1 if K is singular or not finite. */
+static inline int pdw_dblock_factor(const double *restrict K, double *restrict fac)
+{
+    return pdw_dblock_factor_inv(K, 1.0 / K[10], 1.0 / K[15], fac);
 }
 
 /* Solve K u = b with the factors of pdw_dblock_factor. */

@@ -7,6 +7,7 @@
 #ifndef PDW_SIM_H
 #define PDW_SIM_H
 
+#include <math.h>
 #include <string.h>
 #include "pdw_model.h"
 #include "pdw_terrain.h"
@@ -119,6 +120,10 @@ typedef struct pdw_sim {
     int cache_valid;            /* cache holds a value for the current x and discrete state */
     double err_prev;            /* adaptive methods: previous accepted error (step controllers) */
     double h_prev;              /* adaptive methods: previous accepted step (0: none yet) */
+    double cdm_kdiag[2], cdm_kinv[2];   /* cdm: K[2][2], K[3][3] of the last step and their
+                                         * inverses (pdw_cdm_update; 0: none) */
+    double cdm_dt, cdm_idt2, cdm_ih;    /* cdm: the dt that 1/dt^2 and 1/(2 dt) were computed for
+                                         * (0: none) */
     /* --- work counters (every method) --- */
     long n_rhs, n_jac, n_rejected;
     /* --- online gait analysis (every method; see pdw_update_flags) --- */
@@ -142,7 +147,8 @@ static inline void pdw_sim_kinematics(const pdw_sim *s, const double *x, const d
 {
     if (s->ground)
         pdw_terrain_kinematics(s->kernel, s->ground, x, work + PDW_WORK_TRIG, s->p, anchors,
-                               work + PDW_WORK_KIN, work + PDW_WORK_GROUND);
+                               work + PDW_WORK_KIN, work + PDW_WORK_GROUND,
+                               work + PDW_WORK_GROUND_CELL);
     else s->kernel->kinematics(x, work + PDW_WORK_TRIG, s->p, anchors, work + PDW_WORK_KIN);
 }
 
@@ -219,12 +225,36 @@ static inline int pdw_events_room(const pdw_sim *s, long n)
 /* Reset the online gait analysis (before the first step). */
 void pdw_gait_init(pdw_gait *g);
 
-/* After pdw_update_flags: fell if a foot is deeper than fall_depth (sets status, returns 1). */
-int pdw_check_feet(pdw_sim *s, double t);
+/* The checks of pdw_check_feet and pdw_check_state in their order, with the failure's status,
+ * reason and leg set (pdw_discrete.c): the slow path, taken only when a check failed. */
+int pdw_check_feet_fail(pdw_sim *s, double t);
+int pdw_check_state_fail(pdw_sim *s, const double *xnew, double t);
 
-/* Check a new state (finite, speeds, hip height); on failure sets s->status and s->failure
- * and returns nonzero. */
-int pdw_check_state(pdw_sim *s, const double *xnew, double t);
+/* After pdw_update_flags: fell if a foot is deeper than fall_depth (sets status, returns 1). */
+static inline int pdw_check_feet(pdw_sim *s, double t)
+{
+    const double *kin = s->work + PDW_WORK_KIN;
+    if (kin[PDW_KIN_Y_D] < -s->opt.fall_depth || kin[PDW_NKIN + PDW_KIN_Y_D] < -s->opt.fall_depth)
+        return pdw_check_feet_fail(s, t);
+    return 0;
+}
+
+/* Check a new state (finite, speeds, hip height, on a shaped ground the hip within a leg length
+ * of the defined extent's ends); on failure sets s->status and s->failure and returns nonzero.
+ * Inline, every check one flag and one branch for all (a NaN fails every comparison here): only
+ * a failed state takes pdw_check_state_fail, which finds the first failed check in order. */
+static inline int pdw_check_state(pdw_sim *s, const double *xnew, double t)
+{
+    int ok = 1;
+    for (int i = 0; i < PDW_NQ; ++i) ok &= xnew[i] - xnew[i] == 0.0;     /* finite */
+    for (int i = PDW_NQ; i < PDW_NX; ++i) ok &= fabs(xnew[i]) <= s->opt.max_speed;
+    for (int i = PDW_NX; i < s->nx; ++i) ok &= xnew[i] - xnew[i] == 0.0;
+    ok &= xnew[PDW_X_Y_O] >= s->opt.fall_hip_height;
+    if (s->ground)
+        ok &= (xnew[PDW_X_X_O] - s->p[PDW_P_L] >= s->ground->s_min)
+              & (xnew[PDW_X_X_O] + s->p[PDW_P_L] <= s->ground->s_max);
+    return ok ? 0 : pdw_check_state_fail(s, xnew, t);
+}
 /* The central difference method's start-up and one update (pdw_cdm.c), shared by
  * pdw_cdm_advance and the lane loop of pdw_batch.c. */
 void pdw_cdm_start(pdw_sim *s);
@@ -234,12 +264,16 @@ int pdw_cdm_update(pdw_sim *s, const double *M, const double *C, const double *Q
  * sample if step n is a recording step (contact forces computed here). */
 void pdw_record_final(pdw_sim *s, double t);
 
-/* Store sample n (time t) if it is a recording step. */
-void pdw_record(pdw_sim *s, double t);
-
 /* Store a sample of s->x at time t now, whatever n (if there is room); the contact forces are
  * taken from s->work's contact block, which the caller must have filled for s->x. */
 void pdw_record_now(pdw_sim *s, double t);
+
+/* Store sample n (time t) if it is a recording step. */
+static inline void pdw_record(pdw_sim *s, double t)
+{
+    if (s->opt.record_every <= 0 || s->n % s->opt.record_every != 0) return;
+    pdw_record_now(s, t);
+}
 
 /* Would pdw_update_flags change the discrete state (flag, arming) at state x? Returns a bit
  * mask (bit i: leg i), 0 if nothing would change. Mirrors pdw_update_flags's rules exactly;

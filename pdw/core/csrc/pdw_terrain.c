@@ -1,25 +1,63 @@
 /* The shaped-ground kernel (pdw_terrain.h; docs/terrain.md). */
 #include <math.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include "pdw_terrain.h"
 #include "pdw_jacobian.h"
 
+/* 1/N = 1/sqrt(1 + h'^2) of both feet: with SSE2 one vector multiply, add, square root and
+ * division (each an IEEE operation on each lane: the bits of the scalar expression) instead of
+ * two chains of them; the time loops wait on these values. Level ground under both feet (h' = 0:
+ * a plane, the flat parts of steps and patches) gives 1 exactly without them. */
+static inline void inv_normals(double dh0, double dh1, double *n0, double *n1)
+{
+    if (dh0 == 0.0 && dh1 == 0.0) { *n0 = *n1 = 1.0; return; }    /* flat under both: exact */
+#if defined(__SSE2__)
+    const __m128d d = _mm_set_pd(dh1, dh0), one = _mm_set1_pd(1.0);
+    const __m128d r = _mm_div_pd(one, _mm_sqrt_pd(_mm_add_pd(one, _mm_mul_pd(d, d))));
+    _mm_storel_pd(n0, r);
+    _mm_storeh_pd(n1, r);
+#else
+    *n0 = 1.0 / sqrt(1.0 + dh0*dh0);
+    *n1 = 1.0 / sqrt(1.0 + dh1*dh1);
+#endif
+}
+
+/* Copy n doubles one at a time. The contact stage has just stored them one by one, and a wider
+ * load across two fresh 8-byte stores cannot take its value from the store buffer (it waits
+ * until they are written: tens of cycles per load); the empty asm keeps the compiler from
+ * merging the copies into vector moves. */
+static inline void copy_fresh(double *dst, const double *src, int n)
+{
+    for (int f = 0; f < n; ++f) {
+        dst[f] = src[f];
+#if defined(__GNUC__)
+        __asm__ volatile("" ::: "memory");
+#endif
+    }
+}
+
 void pdw_terrain_kinematics(const pdw_kernel *k, const pdw_ground *g, const double *x,
                             const double *trig, const double *p, const double *anchors,
-                            double *kin, double *gnd)
+                            double *kin, double *gnd, double *cell)
 {
-    double sA[2], e[3];
+    double sA[2], e[2][3];
     pdw_ground_points(x, trig, p, sA);
     for (int i = 0; i < 2; ++i) {
         double *gi = gnd + i*PDW_NGROUND;
-        pdw_ground_eval(g, sA[i], e);
-        gi[PDW_GROUND_H] = e[0];
-        gi[PDW_GROUND_DH] = e[1];
-        gi[PDW_GROUND_DDH] = e[2];
-        gi[PDW_GROUND_INV_N] = 1.0 / sqrt(1.0 + e[1]*e[1]);
+        pdw_ground_eval_cell(g, pdw_ground_cell_hint(g, sA[i], cell + i), sA[i], e[i]);
+        gi[PDW_GROUND_H] = e[i][0];
+        gi[PDW_GROUND_DH] = e[i][1];
+        gi[PDW_GROUND_DDH] = e[i][2];
+    }
+    inv_normals(e[0][1], e[1][1], gnd + PDW_GROUND_INV_N, gnd + PDW_NGROUND + PDW_GROUND_INV_N);
+    for (int i = 0; i < 2; ++i) {
+        double *gi = gnd + i*PDW_NGROUND;
         if (k->variant == 1) {          /* consistent: the rolling coordinate needs sigma, alpha */
             gi[PDW_GROUND_SIGMA] = pdw_ground_arc(g, sA[i]);
-            gi[PDW_GROUND_ALPHA] = atan(e[1]);
+            gi[PDW_GROUND_ALPHA] = atan(e[i][1]);
         } else {
             gi[PDW_GROUND_SIGMA] = 0.0;
             gi[PDW_GROUND_ALPHA] = 0.0;
@@ -47,7 +85,7 @@ void pdw_terrain_contact(const pdw_kernel *k, const pdw_ground *g, const double 
         memcpy(pi, p, sizeof pi);
         pdw_ground_params(g, kin[i*PDW_NKIN + PDW_KIN_X_D], p, pi);
         stage(kin, fl, pi, ci);
-        memcpy(contact + i*PDW_NCONTACT, ci + i*PDW_NCONTACT, PDW_NCONTACT * sizeof(double));
+        copy_fresh(contact + i*PDW_NCONTACT, ci + i*PDW_NCONTACT, PDW_NCONTACT);
     }
 }
 
@@ -56,7 +94,7 @@ void pdw_terrain_forces(const double *contact, const double *gnd, const double *
 {
     double gf[2*PDW_NGFORCE];
     pdw_ground_forces(contact, gnd, p, gf);
-    memcpy(cw, contact, 2*PDW_NCONTACT * sizeof(double));
+    copy_fresh(cw, contact, 2*PDW_NCONTACT);
     for (int i = 0; i < 2; ++i) {
         cw[i*PDW_NCONTACT + PDW_CONTACT_F_N] = gf[i*PDW_NGFORCE + PDW_GFORCE_F_Y];
         cw[i*PDW_NCONTACT + PDW_CONTACT_F_T] = gf[i*PDW_NGFORCE + PDW_GFORCE_F_X];
@@ -72,7 +110,7 @@ void pdw_terrain_rhs(const pdw_kernel *k, const pdw_ground *g, const double *x, 
     double *f = work + PDW_WORK_F, *qdd = work + PDW_WORK_QDD, *gnd = work + PDW_WORK_GROUND;
     double cw[2*PDW_NCONTACT], moment[2];
     pdw_trig(x, trig);
-    pdw_terrain_kinematics(k, g, x, trig, p, anchors, kin, gnd);
+    pdw_terrain_kinematics(k, g, x, trig, p, anchors, kin, gnd, work + PDW_WORK_GROUND_CELL);
     pdw_terrain_contact(k, g, kin, flags, p, contact, 0);
     pdw_terrain_forces(contact, gnd, p, cw, moment);
     k->dynamics(x, trig, p, cw, M, f);

@@ -10,10 +10,12 @@
 #include "pdw_ground.h"
 
 /* kin (2 PDW_NKIN, in the local surface frame: y_D the gap along the normal, v_x the slip, v_y the
- * normal rate) and gnd (2 PDW_NGROUND: the ground sampled under each foot) of x; trig given. */
+ * normal rate) and gnd (2 PDW_NGROUND: the ground sampled under each foot) of x; trig given.
+ * cell (2): each foot's height cell of the last call, a hint (any value is safe; work's
+ * PDW_WORK_GROUND_CELL block), updated. */
 void pdw_terrain_kinematics(const pdw_kernel *k, const pdw_ground *g, const double *x,
                             const double *trig, const double *p, const double *anchors,
-                            double *kin, double *gnd);
+                            double *kin, double *gnd, double *cell);
 
 /* The kernel's contact stage (forces, or with partials = 1 forces and partials) with each foot's
  * parameters at its contact point (the patches of g, blended; none: one call, as the kernel). */
