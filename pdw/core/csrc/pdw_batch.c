@@ -180,7 +180,7 @@ static void cdm_round(pdw_lanes *L)
     const int W = L->W, vector = *(const int *)L->ctx;
     pdw_sim *lanes = L->sims;
     if (vector) {
-        double a[2*PDW_BATCH_MAXW], sn[2*PDW_BATCH_MAXW], cs[2*PDW_BATCH_MAXW];
+        double a[2*PDW_BATCH_MAXW] = {0.0}, sn[2*PDW_BATCH_MAXW], cs[2*PDW_BATCH_MAXW];
         for (int l = 0; l < W; ++l) {
             const double *x = lanes[l].x;
             a[l] = L->walker[l] >= 0 ? x[PDW_X_THETA1] : 0.0;
