@@ -296,7 +296,11 @@ int pdw_batch_isa_supported(int isa)
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
     __builtin_cpu_init();
     if (isa == PDW_ISA_AVX2) return __builtin_cpu_supports("avx2") != 0;
-    if (isa == PDW_ISA_AVX512) return __builtin_cpu_supports("avx512f") != 0;
+    /* the AVX-512 variant is compiled for Skylake-SP's set (F, VL, DQ, BW): the masks of the
+     * lane loops' int rows need VL/DQ/BW to stay in vector registers */
+    if (isa == PDW_ISA_AVX512)
+        return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl")
+               && __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw");
 #endif
     return 0;
 }
