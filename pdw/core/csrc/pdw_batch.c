@@ -306,7 +306,7 @@ int pdw_batch_isa_supported(int isa)
 }
 
 /* pdw_soa_trig_libm's loop; skip: NULL, or lanes to leave alone (nonzero) */
-static void trig_rows(int W, const double *x, double *trig, const int *skip)
+static void trig_rows(int W, const double *x, double *trig, const long long *skip)
 {
     for (int l = 0; l < W; ++l) {
         if (skip && skip[l]) continue;
@@ -340,6 +340,7 @@ static void soa_load(pdw_soa_state *S, int l, const pdw_sim *s)
     for (int i = 0; i < PDW_NANCHOR; ++i) S->anchors[i*PDW_SOA_STRIDE + l] = s->disc.anchors[i];
     for (int i = 0; i < 2; ++i) {
         S->flags[i*PDW_SOA_STRIDE + l] = s->disc.flags[i];
+        S->flagw[i*PDW_SOA_STRIDE + l] = s->disc.flags[i];
         S->armed[i*PDW_SOA_STRIDE + l] = s->disc.armed[i];
     }
     S->upd[l] = s->n > 0;
@@ -350,7 +351,7 @@ static void soa_store(const pdw_soa_state *S, int l, pdw_sim *s)
 {
     for (int i = 0; i < PDW_NX; ++i) s->x[i] = S->x[i*PDW_SOA_STRIDE + l];
     for (int i = 0; i < PDW_NQ; ++i) s->u_prev[i] = S->u_prev[i*PDW_SOA_STRIDE + l];
-    for (int i = 0; i < 2; ++i) s->disc.armed[i] = S->armed[i*PDW_SOA_STRIDE + l];
+    for (int i = 0; i < 2; ++i) s->disc.armed[i] = (int)S->armed[i*PDW_SOA_STRIDE + l];
 }
 
 /* pdw_batch_cdm_soa's state */

@@ -75,9 +75,12 @@ typedef struct pdw_soa_state {
     double x[PDW_NX*PDW_SOA_STRIDE], u_prev[PDW_NQ*PDW_SOA_STRIDE];
     double p[PDW_NP*PDW_SOA_STRIDE], anchors[PDW_NANCHOR*PDW_SOA_STRIDE];
     double hip[PDW_SOA_STRIDE], depth[PDW_SOA_STRIDE];
-    int flags[2*PDW_SOA_STRIDE], armed[2*PDW_SOA_STRIDE], armed_next[2*PDW_SOA_STRIDE];
-    int upd[PDW_SOA_STRIDE];    /* 1: past the first step (the flags are updated first) */
-    int rare[PDW_SOA_STRIDE];   /* out: 1 = nothing committed, run the scalar step */
+    int flags[2*PDW_SOA_STRIDE];    /* the support flags (the generated stages' int rows) */
+    /* 64-bit, as wide as the doubles: the lane loops that mix them vectorize with one vector
+     * width (int32 rows halve it) */
+    long long flagw[2*PDW_SOA_STRIDE], armed[2*PDW_SOA_STRIDE], armed_next[2*PDW_SOA_STRIDE];
+    long long upd[PDW_SOA_STRIDE];  /* 1: past the first step (the flags are updated first) */
+    long long rare[PDW_SOA_STRIDE]; /* out: 1 = nothing committed, run the scalar step */
     double trig[PDW_NTRIG*PDW_SOA_STRIDE], kin[2*PDW_NKIN*PDW_SOA_STRIDE];
     double contact[2*PDW_NCONTACT*PDW_SOA_STRIDE];
     double M[PDW_NQ*PDW_NQ*PDW_SOA_STRIDE], C[PDW_NQ*PDW_NQ*PDW_SOA_STRIDE];
