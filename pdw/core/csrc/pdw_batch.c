@@ -340,7 +340,6 @@ static void soa_load(pdw_soa_state *S, int l, const pdw_sim *s)
     for (int i = 0; i < PDW_NANCHOR; ++i) S->anchors[i*PDW_SOA_STRIDE + l] = s->disc.anchors[i];
     for (int i = 0; i < 2; ++i) {
         S->flags[i*PDW_SOA_STRIDE + l] = s->disc.flags[i];
-        S->flagw[i*PDW_SOA_STRIDE + l] = s->disc.flags[i];
         S->armed[i*PDW_SOA_STRIDE + l] = s->disc.armed[i];
     }
     S->upd[l] = s->n > 0;

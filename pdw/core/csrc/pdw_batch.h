@@ -75,10 +75,9 @@ typedef struct pdw_soa_state {
     double x[PDW_NX*PDW_SOA_STRIDE], u_prev[PDW_NQ*PDW_SOA_STRIDE];
     double p[PDW_NP*PDW_SOA_STRIDE], anchors[PDW_NANCHOR*PDW_SOA_STRIDE];
     double hip[PDW_SOA_STRIDE], depth[PDW_SOA_STRIDE];
-    int flags[2*PDW_SOA_STRIDE];    /* the support flags (the generated stages' int rows) */
     /* 64-bit, as wide as the doubles: the lane loops that mix them vectorize with one vector
-     * width (int32 rows halve it) */
-    long long flagw[2*PDW_SOA_STRIDE], armed[2*PDW_SOA_STRIDE], armed_next[2*PDW_SOA_STRIDE];
+     * width (int32 rows halve it on AVX-512) */
+    long long flags[2*PDW_SOA_STRIDE], armed[2*PDW_SOA_STRIDE], armed_next[2*PDW_SOA_STRIDE];
     long long upd[PDW_SOA_STRIDE];  /* 1: past the first step (the flags are updated first) */
     long long rare[PDW_SOA_STRIDE]; /* out: 1 = nothing committed, run the scalar step */
     double trig[PDW_NTRIG*PDW_SOA_STRIDE], kin[2*PDW_NKIN*PDW_SOA_STRIDE];
@@ -104,7 +103,8 @@ typedef struct pdw_ros_soa {
     double p[PDW_NP*PDW_SOA_STRIDE], anchors[PDW_NANCHOR*PDW_SOA_STRIDE];
     double hip[PDW_SOA_STRIDE], depth[PDW_SOA_STRIDE];
     double h[PDW_SOA_STRIDE];           /* the attempt's step */
-    int flags[2*PDW_SOA_STRIDE], armed[2*PDW_SOA_STRIDE];
+    long long flags[2*PDW_SOA_STRIDE];  /* 64-bit: the generated contact stages' rows */
+    int armed[2*PDW_SOA_STRIDE];
     int jac[PDW_SOA_STRIDE];            /* 1: a new point, J of x wanted */
     /* kept: J = d qdd / d x at x (row i*PDW_NX + j), the factors of the attempt */
     double J[PDW_NQ*PDW_NX*PDW_SOA_STRIDE];
