@@ -369,6 +369,7 @@ static int soa_start(pdw_lanes *L, long i, int l)
     for (int j = 0; j < PDW_NP; ++j) S->p[j*PDW_SOA_STRIDE + l] = s->p[j];
     S->hip[l] = s->opt.fall_hip_height;
     S->depth[l] = s->opt.fall_depth;
+    S->kc_stale = 1;
     soa_load(S, l, s);
     return 1;
 }
@@ -386,6 +387,7 @@ static void soa_begin(pdw_lanes *L)
         S->depth[l] = S->depth[0];
         soa_load(S, l, &L->sims[0]);
     }
+    S->kc_stale = 1;
 }
 
 static void soa_park(pdw_lanes *L, int l)

@@ -17,6 +17,8 @@
 enum { PDW_BATCH_MAXW = 64 };
 /* the row stride of pdw_soa_state: the generated stages' PDW_SOA (generated/pdw_batch_gen.h) */
 enum { PDW_SOA_STRIDE = 72 };
+/* room for the generated stages' PDW_SOA_NKC rows of per-walker constants */
+enum { PDW_SOA_KC_ROWS = 8 };
 
 typedef struct pdw_batch_job {
     /* --- inputs --- */
@@ -84,6 +86,10 @@ typedef struct pdw_soa_state {
     double contact[2*PDW_NCONTACT*PDW_SOA_STRIDE];
     double M[PDW_NQ*PDW_NQ*PDW_SOA_STRIDE], C[PDW_NQ*PDW_NQ*PDW_SOA_STRIDE];
     double QmG[PDW_NQ*PDW_SOA_STRIDE];
+    /* the contact law's parameter-only temporaries of each lane (the kernel's contact_consts,
+     * generated/pdw_batch_gen.h), computed again before the next step when kc_stale */
+    double kc[PDW_SOA_KC_ROWS*PDW_SOA_STRIDE];
+    int kc_stale;
 } pdw_soa_state;
 
 /* The trig of lanes l < W from libm (bitwise pdw_trig): all lanes, or (only_first != 0) only
