@@ -100,3 +100,26 @@ def test_a_cancelled_token_stops_every_lane_loop(method, isa, n, lanes, monkeypa
     res = e.value.result
     assert np.all(res.t_final < 2.0), res.t_final
     assert np.all(np.isfinite(res.x_final))
+
+
+@pytest.mark.parametrize("isa", LANE_ISAS)
+def test_per_walker_friction_constants_follow_each_walker(isa, monkeypatch):
+    """The cdm lanes compute the friction law's parameter-only terms (2/(v_d - v_s), ...)
+    once per walker (contact_consts): with a different law per walker and more walkers than
+    lanes (refills), each walker is still bit for bit its scalar run; constants left over
+    from a lane's previous walker would change its numbers."""
+    monkeypatch.setenv(ISA_ENV, isa)
+    n = 9
+    x = _states(n, seed=6)
+    params = [pdw.Params.paper(v_s=1e-4 * (1 + 0.5 * i), v_d=1e-3 * (1 + 0.7 * i),
+                               mu_s=0.5 + 0.05 * i) for i in range(n)]
+    _batch.lane_steps(reset=True)
+    b = simulate_batch(x, t_end=T_END, params=params, lanes=4, threads=1, check_step="off")
+    assert _batch.lane_steps(reset=True) > 0
+    for i in range(n):
+        r = pdw.simulate(x[i], t_end=T_END, params=params[i], record_every=1,
+                         record_forces=False, on_failure="return", check_step="off")
+        assert b.status[i] == r.status, i
+        assert b.n_steps[i] == r.n_steps, i
+        assert np.array_equal(b.x_final[i], r.x_final), (i, b.x_final[i] - r.x_final)
+    assert len(set(np.round(b.x_final[:, 6], 9))) > 1
