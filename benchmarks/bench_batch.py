@@ -6,7 +6,8 @@ a few of which fall), no recording. Interleaved in one process, round by round: 
 `pdw.simulate_batch` with W lanes: every cdm lane loop this CPU runs (PDW_BATCH_ISA: "scalar" =
 the generated scalar stages per lane, then the structure-of-arrays step compiled for the
 baseline, AVX2, AVX-512F), bitwise (libm sin/cos) and vector (libmvec sin/cos), on 1 thread,
-then on 2 threads; and rodas4 (rtol 1e-6, atol 1e-8) scalar against batch, per accepted step,
+then on 2 threads; a batch of 1 walker per call (N calls, default lanes; the serial loop
+with libm's trig, the lanes with vector sin/cos); and rodas4 (rtol 1e-6, atol 1e-8) scalar against batch, per accepted step,
 on every rodas4 lane loop ("scalar" = the scalar rodas4 per lane, then its structure-of-arrays
 try step per instruction set; bitwise, and once with vector sin/cos).
 Medians of ROUNDS rounds; the load average is printed before and after (the machine is shared:
@@ -62,6 +63,13 @@ def main():
                 os.environ.pop(ISA_ENV)
         return run
 
+    def batch_of_one(vector=False):
+        def run():
+            return sum(int(pdw.simulate_batch(xi[None], t_end=T_END, dt=DT, vector=vector,
+                                              threads=1, check_step="off").n_steps.sum())
+                       for xi in x)
+        return run
+
     def scalar_rodas():
         return sum(pdw.simulate(xi, t_end=T_END, method="rodas4", rtol=RTOL, record_every=0,
                                 record_events=False, on_failure="return",
@@ -83,6 +91,8 @@ def main():
     cases += [("batch W=8 bitwise %s, 1 thr" % n, batch(8, False, 1, n), 1) for n in isas]
     cases += [("batch W=8 vector %s, 1 thr" % best, batch(8, True, 1), 1),
               ("batch W=16 vector %s, 1 thr" % best, batch(16, True, 1), 1),
+              ("batch of 1 walker (N calls), bitwise", batch_of_one(), 1),
+              ("batch of 1 walker (N calls), vector", batch_of_one(True), 1),
               ("batch W=8 bitwise %s, 2 thr" % best, batch(8, False, 2), 2),
               ("batch W=8 vector %s, 2 thr" % best, batch(8, True, 2), 2),
               ("rodas4: scalar simulate, 1 thr", scalar_rodas, 1)]

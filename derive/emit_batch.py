@@ -70,6 +70,11 @@ def emit_kernel(spec, names, c_block, nforces):
     for suffix, nout in (("contact", nforces), ("contact_partials", len(layout.CONTACT))):
         out.append(_contact_function(k + "_" + suffix, stages.contact(spec)[:nout],
                                      layout.CONTACT[:nout], soa, c_block))
+    # the cdm lane loop's contact stage: the friction law's parameter-only temporaries (its
+    # divisions by v_d - v_s, ...) once per walker, into rows kc
+    consts, contact_kc, nkc = _contact_consts(k + "_contact", stages.contact(spec)[:nforces],
+                                              soa, c_block)
+    out += [consts, contact_kc, "enum { %s_NKC = %d };\n" % (k.upper(), nkc)]
     targets = [_soa("M[%d]" % i) for i in range(16)] + [_soa("C[%d]" % i) for i in range(16)] \
         + [_soa("QmG[%d]" % i) for i in range(4)]
     code, _ = c_block(stages.cdm_terms(spec), targets, soa, indent="        ")
@@ -95,9 +100,98 @@ def emit_kernel(spec, names, c_block, nforces):
     return "\n".join(out)
 
 
+_FUNCS = {"sqrt", "fabs", "pow", "exp", "expm1", "log", "sin", "cos", "tanh", "atan", "fmin",
+          "fmax"}
+_TEMP = re.compile(r"^\s*const double (t\d+) = (.*);$")
+_IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
+def _hoist(code):
+    """Split the lane loop's code (c_block's lines) into the temporaries that depend on the
+    parameters only (pv_* locals) and the rest: (per-step lines, per-walker lines, the
+    per-walker temporaries the per-step lines read). The per-walker lines are the very same
+    statements, so a lane that reads their values from rows computed once per walker gets
+    the same bits."""
+    const, step, names = set(), [], []
+    walker = []
+    for line in code.split("\n"):
+        m = _TEMP.match(line)
+        if m and all(w.startswith("pv_") or w in const or w in _FUNCS
+                     for w in _IDENT.findall(m.group(2))):
+            const.add(m.group(1))
+            walker.append(line)
+        else:
+            step.append(line)
+    used = set().union(*(set(_IDENT.findall(line)) for line in step)) if step else set()
+    names = [t for t in (_TEMP.match(line).group(1) for line in walker) if t in used]
+    return step, walker, names
+
+
+def _loads(pre, text, indent="            "):
+    """The parameter loads the code in text reads."""
+    used = set(_IDENT.findall(text))
+    return "".join("%sconst double %s = %s;\n" % (indent, v, load)
+                   for v, load in sorted(pre.items()) if v in used)
+
+
+def _contact_consts(fname, exprs, soa, c_block):
+    """The contact stage with its parameter-only temporaries read from rows kc (computed once
+    per walker by fname_consts): (the two functions' C, the number of kc rows)."""
+    used = set().union(*(e.free_symbols for e in exprs))
+    pre = {s_: "pv_%s" % n for n, s_ in mdl.P.items() if s_ in used}
+    outs = ["o_%s" % f.lower() for f in layout.CONTACT[:len(exprs)]]
+    code, _ = c_block(exprs, outs, {**soa, **pre}, indent="            ")
+    step, walker, names = _hoist(code)
+    loads = {v: soa[s_] for s_, v in pre.items()}
+    body_w = "\n".join(walker)
+    consts = _function(
+        "static void %s_consts(int W, const double *restrict p, double *restrict kc)" % fname,
+        "    for (int l0 = 0; l0 < W; l0 += PDW_SOA_CHUNK) {\n"
+        "    #pragma omp simd\n"
+        "    for (int l = l0; l < l0 + PDW_SOA_CHUNK; ++l) {\n"
+        + _loads(loads, body_w, "        ") + body_w.replace("            ", "        ") + "\n"
+        + "".join("        kc[%d*PDW_SOA + l] = %s;\n" % (j, t) for j, t in enumerate(names))
+        + "    }\n    }")
+    reads = "".join("            const double %s = kc[%d*PDW_SOA + l];\n" % (t, j)
+                    for j, t in enumerate(names))
+    body_s = "\n".join(step)
+    return consts, _contact_body(fname + "_kc", ", const double *restrict kc",
+                                 _loads(loads, body_s) + reads + body_s,
+                                 layout.CONTACT[:len(exprs)], outs), len(names)
+
+
+def _contact_body(fname, extra, code, fields, outs):
+    """The batched contact stage's function around the lane loop's code."""
+    store = "\n".join("            c[PDW_CONTACT_%s*PDW_SOA + l] = on ? %s : 0.0;"
+                      % (f.upper(), o) for f, o in zip(fields, outs))
+    return _function(
+        "static void %s(int W, const double *restrict kin, const long long *restrict flags,\n"
+        "    const double *restrict p%s, double *restrict contact)" % (fname, extra),
+        "    (void)p;\n"
+        "    for (int i = 0; i < 2; ++i) {\n"
+        "        const double *restrict ki = kin + i*PDW_NKIN*PDW_SOA;\n"
+        "        double *restrict c = contact + i*PDW_NCONTACT*PDW_SOA;\n"
+        "        const long long *restrict fl = flags + i*PDW_SOA;\n"
+        "        for (int l0 = 0; l0 < W; l0 += PDW_SOA_CHUNK) {\n"
+        "        #pragma omp simd\n"
+        "        for (int l = l0; l < l0 + PDW_SOA_CHUNK; ++l) {\n"
+        "            /* mask: a penetrating support foot (the scalar stage's branch) */\n"
+        "            const long long on = (fl[l] != 0) & (ki[PDW_KIN_Y_D*PDW_SOA + l] < 0.0);\n"
+        "            const double delta = -ki[PDW_KIN_Y_D*PDW_SOA + l];\n"
+        "            const double deltad = -ki[PDW_KIN_V_Y*PDW_SOA + l];\n"
+        "            const double v_t = ki[PDW_KIN_V_X*PDW_SOA + l];\n"
+        "            const double xi = ki[PDW_KIN_XI*PDW_SOA + l];\n"
+        "            const double v_in = ki[PDW_KIN_V_IN*PDW_SOA + l];\n"
+        "            (void)delta; (void)deltad; (void)v_t; (void)xi; (void)v_in;\n"
+        "            double %s;\n"
+        "%s\n%s\n        }\n        }\n    }" % (", ".join(outs), code, store))
+
+
 def _contact_function(fname, exprs, fields, soa, c_block):
     """A batched contact stage: the scalar stage's branch (a penetrating support foot) as a
-    mask, every lane evaluating the law and keeping it only where its foot is one."""
+    mask, every lane evaluating the law and keeping it only where its foot is one. The flags
+    are 64-bit, as wide as the doubles: with int32 ones GCC vectorizes the lane loop at half
+    the width on AVX-512."""
     outs = ["o_%s" % f.lower() for f in fields]
     # the parameters as locals loaded up front: the law's branches then hold no loads, and the
     # compiler turns them into selects (a branch with a load would need a masked load)
@@ -110,17 +204,17 @@ def _contact_function(fname, exprs, fields, soa, c_block):
     store = "\n".join("            c[PDW_CONTACT_%s*PDW_SOA + l] = on ? %s : 0.0;"
                       % (f.upper(), o) for f, o in zip(fields, outs))
     return _function(
-        "static void %s(int W, const double *restrict kin, const int *restrict flags,\n"
+        "static void %s(int W, const double *restrict kin, const long long *restrict flags,\n"
         "    const double *restrict p, double *restrict contact)" % fname,
         "    for (int i = 0; i < 2; ++i) {\n"
         "        const double *restrict ki = kin + i*PDW_NKIN*PDW_SOA;\n"
         "        double *restrict c = contact + i*PDW_NCONTACT*PDW_SOA;\n"
-        "        const int *restrict fl = flags + i*PDW_SOA;\n"
+        "        const long long *restrict fl = flags + i*PDW_SOA;\n"
         "        for (int l0 = 0; l0 < W; l0 += PDW_SOA_CHUNK) {\n"
         "        #pragma omp simd\n"
         "        for (int l = l0; l < l0 + PDW_SOA_CHUNK; ++l) {\n"
         "            /* mask: a penetrating support foot (the scalar stage's branch) */\n"
-        "            const int on = (fl[l] != 0) & (ki[PDW_KIN_Y_D*PDW_SOA + l] < 0.0);\n"
+        "            const long long on = (fl[l] != 0) & (ki[PDW_KIN_Y_D*PDW_SOA + l] < 0.0);\n"
         "            const double delta = -ki[PDW_KIN_Y_D*PDW_SOA + l];\n"
         "            const double deltad = -ki[PDW_KIN_V_Y*PDW_SOA + l];\n"
         "            const double v_t = ki[PDW_KIN_V_X*PDW_SOA + l];\n"
@@ -157,18 +251,27 @@ enum {{ PDW_SOA_CHUNK = 8 }};
 typedef struct pdw_soa_kernel {{
     void (*kinematics)(int W, const double *x, const double *trig, const double *p,
                        const double *anchors, double *kin);
-    void (*contact)(int W, const double *kin, const int *flags, const double *p,
+    void (*contact)(int W, const double *kin, const long long *flags, const double *p,
                     double *contact);
     void (*cdm_terms)(int W, const double *x, const double *trig, const double *p,
                       const double *contact, double *M, double *C, double *QmG);
     /* the right-hand side's and the Jacobian's (rodas4's lane loop) */
-    void (*contact_partials)(int W, const double *kin, const int *flags, const double *p,
-                             double *contact);
+    void (*contact_partials)(int W, const double *kin, const long long *flags,
+                             const double *p, double *contact);
     void (*dynamics)(int W, const double *x, const double *trig, const double *p,
                      const double *contact, double *M, double *f);
     void (*dynamics_jacobian)(int W, const double *x, const double *trig, const double *p,
                               const double *contact, const double *qdd, double *A);
+    /* the cdm lane loop's contact stage: contact_consts (once per walker) writes the law's
+     * parameter-only temporaries into nkc rows kc, which contact_kc reads (same bits) */
+    void (*contact_consts)(int W, const double *p, double *kc);
+    void (*contact_kc)(int W, const double *kin, const long long *flags, const double *p,
+                       const double *kc, double *contact);
+    int nkc;
 }} pdw_soa_kernel;
+
+/* the most rows kc of any kernel */
+enum {{ PDW_SOA_NKC = {nkc} }};
 
 {body}
 /* indexed like pdw_kernels[] */
@@ -182,13 +285,17 @@ static const pdw_soa_kernel pdw_soa_kernels[PDW_NKERNELS] = {{
 
 def header(banner, h, kernels, names_of, c_block, nforces):
     """The text of generated/pdw_batch_gen.h."""
-    body, rows = [], []
+    body, rows, nkc = [], [], 0
     for spec in kernels:
         if spec.normal != "hunt_crossley" or getattr(spec, "friction", "coulomb") != "coulomb":
-            rows.append("    {NULL, NULL, NULL, NULL, NULL, NULL},   /* %s */" % spec.name)
+            rows.append("    {NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, 0},   /* %s */"
+                        % spec.name)
             continue
         body.append(emit_kernel(spec, names_of(spec), c_block, nforces))
         rows.append("    {%s_kinematics, %s_contact, %s_cdm_terms,\n"
-                    "     %s_contact_partials, %s_dynamics, %s_dynamics_jacobian},"
-                    % (("pdw_soa_" + spec.name,) * 6))
-    return HEADER.format(banner=banner, hash=h, body="\n".join(body), table="\n".join(rows))
+                    "     %s_contact_partials, %s_dynamics, %s_dynamics_jacobian,\n"
+                    "     %s_contact_consts, %s_contact_kc, %s_NKC},"
+                    % (("pdw_soa_" + spec.name,) * 8 + (("PDW_SOA_" + spec.name).upper(),)))
+        nkc = max(nkc, int(re.search(r"_NKC = (\d+)", body[-1]).group(1)))
+    return HEADER.format(banner=banner, hash=h, body="\n".join(body), table="\n".join(rows),
+                         nkc=nkc)

@@ -40,6 +40,71 @@ void pdw_batch_finish(const pdw_batch_job *job, long i, const pdw_sim *s)
     for (int j = 0; j < PDW_NX; ++j) job->fail_x[i*PDW_NX + j] = failed ? s->failure.x[j] : NAN;
 }
 
+/* ---- the lane scheduler (pdw_batch.h) ------------------------------------------------- */
+
+/* Fill lane l with the next walker that does not finish at its start (walkers that do are
+ * written at once); none left: walker -1. */
+static void lanes_fill(pdw_lanes *L, int l)
+{
+    for (long i; (i = pdw_batch_take(L->job, &L->next, L->i1)) >= 0; ) {
+        if (L->ops->start(L, i, l)) {
+            L->walker[l] = i;
+            L->running++;
+            return;
+        }
+        pdw_batch_finish(L->job, i, &L->sims[l]);
+        L->done++;
+    }
+    L->walker[l] = -1;
+}
+
+void pdw_lanes_retire(pdw_lanes *L, int l)
+{
+    pdw_batch_finish(L->job, L->walker[l], &L->sims[l]);
+    L->walker[l] = -1;
+    L->running--;
+    L->done++;
+    lanes_fill(L, l);
+}
+
+long pdw_lanes_run(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *sims,
+                   const pdw_lane_ops *ops, void *ctx, long poll_rounds)
+{
+    pdw_lanes L;
+    long since_poll = 0;
+    L.job = job;
+    L.ops = ops;
+    L.ctx = ctx;
+    L.sims = sims;
+    L.W = W < 1 ? 1 : W > PDW_BATCH_MAXW ? PDW_BATCH_MAXW : W;
+    L.running = 0;
+    L.next = i0;
+    L.i1 = i1;
+    L.done = 0;
+    L.lane_steps = 0;
+    for (int l = 0; l < L.W; ++l) lanes_fill(&L, l);
+    if (ops->begin && L.running > 0) ops->begin(&L);
+    while (L.running > 0) {
+        if (job->poll && ++since_poll >= poll_rounds) {
+            since_poll = 0;
+            if (job->poll(job->poll_ctx)) {
+                /* stopped: the running walkers as they are (a lane of an adaptive method holds
+                 * its last accepted step) */
+                for (int l = 0; l < L.W; ++l) {
+                    if (L.walker[l] < 0) continue;
+                    if (ops->park) ops->park(&L, l);
+                    pdw_batch_finish(job, L.walker[l], &L.sims[l]);
+                    job->status[L.walker[l]] = PDW_STATUS_RUNNING;
+                }
+                break;
+            }
+        }
+        ops->round(&L);
+    }
+    if (job->lane_steps) *job->lane_steps += L.lane_steps;
+    return L.done;
+}
+
 /* Load walker i into lane s and take the start-up of pdw_cdm_advance. Returns 1 if the walker
  * is still running, 0 if it finished at once (a stop condition at t = 0). */
 /* What every lane takes of walker i, whatever the method: its parameters, the job's options
@@ -101,72 +166,53 @@ static int step(pdw_sim *s)
     return 0;
 }
 
+/* ---- pdw_batch_cdm: the generated scalar stages per lane --------------------------------- */
+
+static int cdm_start(pdw_lanes *L, long i, int l)
+{
+    return start(L->job, i, &L->sims[l]);
+}
+
+/* (1) the trig of every lane past its first step (at n = 0 the start-up left it in work),
+ * (2) the step of every lane */
+static void cdm_round(pdw_lanes *L)
+{
+    const int W = L->W, vector = *(const int *)L->ctx;
+    pdw_sim *lanes = L->sims;
+    if (vector) {
+        double a[2*PDW_BATCH_MAXW] = {0.0}, sn[2*PDW_BATCH_MAXW], cs[2*PDW_BATCH_MAXW];
+        for (int l = 0; l < W; ++l) {
+            const double *x = lanes[l].x;
+            a[l] = L->walker[l] >= 0 ? x[PDW_X_THETA1] : 0.0;
+            a[W + l] = L->walker[l] >= 0 ? x[PDW_X_THETA2] : 0.0;
+        }
+        pdw_batch_sincos(2*W, a, sn, cs);
+        for (int l = 0; l < W; ++l) {
+            if (L->walker[l] < 0 || lanes[l].n == 0) continue;
+            double *trig = lanes[l].work + PDW_WORK_TRIG;
+            trig[PDW_TRIG_SIN_THETA1] = sn[l];
+            trig[PDW_TRIG_COS_THETA1] = cs[l];
+            trig[PDW_TRIG_SIN_THETA2] = sn[W + l];
+            trig[PDW_TRIG_COS_THETA2] = cs[W + l];
+        }
+    } else {
+        for (int l = 0; l < W; ++l)
+            if (L->walker[l] >= 0 && lanes[l].n > 0) pdw_trig(lanes[l].x, lanes[l].work + PDW_WORK_TRIG);
+    }
+    for (int l = 0; l < W; ++l)
+        if (L->walker[l] >= 0 && !step(&lanes[l])) pdw_lanes_retire(L, l);
+}
+
+static const pdw_lane_ops cdm_ops = {cdm_start, cdm_round, NULL, NULL};
+
 long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes, int vector)
 {
-    long walker[PDW_BATCH_MAXW], next = i0;
-    double a[2*PDW_BATCH_MAXW], sn[2*PDW_BATCH_MAXW], cs[2*PDW_BATCH_MAXW];
-    int running = 0;
-    long since_poll = 0, done = 0;
-    if (W < 1) W = 1;
-    if (W > PDW_BATCH_MAXW) W = PDW_BATCH_MAXW;
-    /* fill every lane (a walker that finishes at its start-up is written out at once) */
-    for (int l = 0; l < W; ++l) {
-        walker[l] = -1;
-        for (long i; (i = pdw_batch_take(job, &next, i1)) >= 0; ) {
-            if (start(job, i, &lanes[l])) { walker[l] = i; running++; break; }
-            pdw_batch_finish(job, i, &lanes[l]);
-            done++;
-        }
-    }
-    while (running > 0) {
-        if (job->poll && ++since_poll >= PDW_BATCH_POLL) {
-            since_poll = 0;
-            if (job->poll(job->poll_ctx)) {      /* stopped: write the running walkers as they are */
-                for (int l = 0; l < W; ++l)
-                    if (walker[l] >= 0) pdw_batch_finish(job, walker[l], &lanes[l]);
-                return done;
-            }
-        }
-        /* (1) trig of every lane past its first step (at n = 0 the start-up left it in work) */
-        if (vector) {
-            for (int l = 0; l < W; ++l) {
-                const double *x = lanes[l].x;
-                a[l] = walker[l] >= 0 ? x[PDW_X_THETA1] : 0.0;
-                a[W + l] = walker[l] >= 0 ? x[PDW_X_THETA2] : 0.0;
-            }
-            pdw_batch_sincos(2*W, a, sn, cs);
-            for (int l = 0; l < W; ++l) {
-                if (walker[l] < 0 || lanes[l].n == 0) continue;
-                double *trig = lanes[l].work + PDW_WORK_TRIG;
-                trig[PDW_TRIG_SIN_THETA1] = sn[l];
-                trig[PDW_TRIG_COS_THETA1] = cs[l];
-                trig[PDW_TRIG_SIN_THETA2] = sn[W + l];
-                trig[PDW_TRIG_COS_THETA2] = cs[W + l];
-            }
-        } else {
-            for (int l = 0; l < W; ++l)
-                if (walker[l] >= 0 && lanes[l].n > 0) pdw_trig(lanes[l].x, lanes[l].work + PDW_WORK_TRIG);
-        }
-        /* (2) the step of every lane; refill the finished ones */
-        for (int l = 0; l < W; ++l) {
-            if (walker[l] < 0 || step(&lanes[l])) continue;
-            pdw_batch_finish(job, walker[l], &lanes[l]);
-            walker[l] = -1;
-            running--;
-            done++;
-            for (long i; (i = pdw_batch_take(job, &next, i1)) >= 0; ) {
-                if (start(job, i, &lanes[l])) { walker[l] = i; running++; break; }
-                pdw_batch_finish(job, i, &lanes[l]);
-                done++;
-            }
-        }
-    }
-    return done;
+    return pdw_lanes_run(job, i0, i1, W, lanes, &cdm_ops, &vector, PDW_BATCH_POLL);
 }
 
 /* Load walker i into lane s with the settings pdw/core/_core.pyx's run gives pdw.simulate's
- * pdw_sim (nothing recorded, events only counted), polling after every step. */
-void pdw_batch_start_method(const pdw_batch_job *job, long i, pdw_sim *s)
+ * pdw_sim (nothing recorded, events only counted), polling every poll_every loop iterations. */
+void pdw_batch_start_method(const pdw_batch_job *job, long i, pdw_sim *s, long poll_every)
 {
     const pdw_method *m = &pdw_methods[job->method];
     memset(s, 0, sizeof *s);
@@ -175,61 +221,62 @@ void pdw_batch_start_method(const pdw_batch_job *job, long i, pdw_sim *s)
     s->opt.event_tol = job->opt.event_tol > 0.0 ? job->opt.event_tol : 1e-9;
     s->opt.max_steps = m->adaptive ? job->opt.max_steps : 0;
     s->h = job->opt.dt;
-    /* a poll every 2 loop iterations returns after each (accepted) step: the drivers poll at
-     * the top of an iteration, where a resumed call continues exactly */
-    s->poll_every = 2;
+    s->poll_every = poll_every;
 }
 
-/* Every PDW_BATCH_POLL rounds: job->poll; if it says stop, write the running walkers as they
- * are (status running) and return 1. */
-int pdw_batch_poll_stop(const pdw_batch_job *job, long *since_poll, const long *walker, int W,
-                        const pdw_sim *lanes)
+/* ---- pdw_batch_method: any method's own advance per lane ---------------------------------- */
+
+/* a poll every 2 loop iterations returns after each (accepted) step: the drivers poll at the
+ * top of an iteration, where a resumed call continues exactly */
+static int method_start(pdw_lanes *L, long i, int l)
 {
-    if (!job->poll || ++*since_poll < PDW_BATCH_POLL) return 0;
-    *since_poll = 0;
-    if (!job->poll(job->poll_ctx)) return 0;
-    for (int l = 0; l < W; ++l)
-        if (walker[l] >= 0) pdw_batch_finish(job, walker[l], &lanes[l]);
+    pdw_batch_start_method(L->job, i, &L->sims[l], 2);
     return 1;
 }
 
+static void method_round(pdw_lanes *L)
+{
+    const pdw_advance_fn advance = pdw_methods[L->job->method].advance;
+    for (int l = 0; l < L->W; ++l) {
+        /* nothing recorded and events not stored: RECORDS_FULL and EVENTS_FULL cannot occur,
+         * POLL is the end of this lane's step */
+        if (L->walker[l] >= 0 && advance(&L->sims[l]) != PDW_STATUS_POLL) pdw_lanes_retire(L, l);
+    }
+}
+
+static const pdw_lane_ops method_ops = {method_start, method_round, NULL, NULL};
+
 long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes)
 {
-    long walker[PDW_BATCH_MAXW], next = i0;
-    const pdw_advance_fn advance = pdw_methods[job->method].advance;
-    int running = 0;
-    long since_poll = 0, done = 0;
-    if (W < 1) W = 1;
-    if (W > PDW_BATCH_MAXW) W = PDW_BATCH_MAXW;
-    for (int l = 0; l < W; ++l) {
-        if ((walker[l] = pdw_batch_take(job, &next, i1)) >= 0) {
-            pdw_batch_start_method(job, walker[l], &lanes[l]);
-            running++;
-        }
-    }
-    while (running > 0) {
-        if (pdw_batch_poll_stop(job, &since_poll, walker, W, lanes)) {
-            /* a lane stopped inside its round holds the state of its last accepted step */
-            for (int l = 0; l < W; ++l)
-                if (walker[l] >= 0) job->status[walker[l]] = PDW_STATUS_RUNNING;
-            return done;
-        }
-        for (int l = 0; l < W; ++l) {
-            if (walker[l] < 0) continue;
-            /* nothing recorded and events not stored: RECORDS_FULL and EVENTS_FULL cannot
-             * occur, POLL is the end of this lane's step */
-            if (advance(&lanes[l]) == PDW_STATUS_POLL) continue;
-            pdw_batch_finish(job, walker[l], &lanes[l]);
-            walker[l] = -1;
-            running--;
-            done++;
-            if ((walker[l] = pdw_batch_take(job, &next, i1)) >= 0) {
-                pdw_batch_start_method(job, walker[l], &lanes[l]);
-                running++;
-            }
-        }
-    }
-    return done;
+    return pdw_lanes_run(job, i0, i1, W, lanes, &method_ops, NULL, PDW_BATCH_POLL);
+}
+
+/* ---- pdw_batch_serial: the scalar loop per walker (small batches) -------------------------- */
+
+/* the method's own advance runs PDW_BATCH_POLL loop iterations per call: one lane, one walker
+ * after the other, polled after every call */
+static int serial_start(pdw_lanes *L, long i, int l)
+{
+    pdw_batch_start_method(L->job, i, &L->sims[l], PDW_BATCH_POLL);
+    return 1;
+}
+
+static void serial_round(pdw_lanes *L)
+{
+    if (pdw_methods[L->job->method].advance(&L->sims[0]) != PDW_STATUS_POLL) pdw_lanes_retire(L, 0);
+}
+
+static const pdw_lane_ops serial_ops = {serial_start, serial_round, NULL, NULL};
+
+long pdw_batch_serial(const pdw_batch_job *job, long i0, long i1, pdw_sim *lanes)
+{
+    return pdw_lanes_run(job, i0, i1, 1, lanes, &serial_ops, NULL, 1);
+}
+
+int pdw_batch_serial_pays(long i0, long i1, int W, int vector)
+{
+    const long block = (i1 - i0) < W ? (i1 - i0) : W;
+    return !vector && block <= PDW_BATCH_SERIAL;
 }
 
 /* ---- the structure-of-arrays lane loop ------------------------------------------------ */
@@ -249,13 +296,17 @@ int pdw_batch_isa_supported(int isa)
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
     __builtin_cpu_init();
     if (isa == PDW_ISA_AVX2) return __builtin_cpu_supports("avx2") != 0;
-    if (isa == PDW_ISA_AVX512) return __builtin_cpu_supports("avx512f") != 0;
+    /* the AVX-512 variant is compiled for Skylake-SP's set (F, VL, DQ, BW): the masks of the
+     * lane loops' int rows need VL/DQ/BW to stay in vector registers */
+    if (isa == PDW_ISA_AVX512)
+        return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl")
+               && __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw");
 #endif
     return 0;
 }
 
 /* pdw_soa_trig_libm's loop; skip: NULL, or lanes to leave alone (nonzero) */
-static void trig_rows(int W, const double *x, double *trig, const int *skip)
+static void trig_rows(int W, const double *x, double *trig, const long long *skip)
 {
     for (int l = 0; l < W; ++l) {
         if (skip && skip[l]) continue;
@@ -299,110 +350,101 @@ static void soa_store(const pdw_soa_state *S, int l, pdw_sim *s)
 {
     for (int i = 0; i < PDW_NX; ++i) s->x[i] = S->x[i*PDW_SOA_STRIDE + l];
     for (int i = 0; i < PDW_NQ; ++i) s->u_prev[i] = S->u_prev[i*PDW_SOA_STRIDE + l];
-    for (int i = 0; i < 2; ++i) s->disc.armed[i] = S->armed[i*PDW_SOA_STRIDE + l];
+    for (int i = 0; i < 2; ++i) s->disc.armed[i] = (int)S->armed[i*PDW_SOA_STRIDE + l];
 }
 
+/* pdw_batch_cdm_soa's state */
+typedef struct soa_loop {
+    pdw_soa_state *S;
+    void (*stepfn)(int, pdw_soa_state *, int, double, double, int);
+    int kernel, vector;
+} soa_loop;
+
 /* Start walker i in lane l (pdw_sim and S). Returns 1 if it runs, 0 if it finished at once. */
-static int soa_start(const pdw_batch_job *job, long i, pdw_sim *s, pdw_soa_state *S, int l)
+static int soa_start(pdw_lanes *L, long i, int l)
 {
-    if (!start(job, i, s)) return 0;
+    pdw_soa_state *S = ((soa_loop *)L->ctx)->S;
+    pdw_sim *s = &L->sims[l];
+    if (!start(L->job, i, s)) return 0;
     for (int j = 0; j < PDW_NP; ++j) S->p[j*PDW_SOA_STRIDE + l] = s->p[j];
     S->hip[l] = s->opt.fall_hip_height;
     S->depth[l] = s->opt.fall_depth;
+    S->kc_stale = 1;
     soa_load(S, l, s);
     return 1;
 }
 
-/* Fill lane l with the next walker of [next, i1) that does not finish at its start. */
-static long soa_refill(const pdw_batch_job *job, long *next, long i1, pdw_sim *s,
-                       pdw_soa_state *S, int l, long *done)
+/* lanes without a walker and the padding lanes up to a multiple of 8 (computed, never read)
+ * step a copy of lane 0: ordinary numbers, no denormal or NaN slow paths (if lane 0 has no
+ * walker, none has) */
+static void soa_begin(pdw_lanes *L)
 {
-    for (long i; (i = pdw_batch_take(job, next, i1)) >= 0; ) {
-        if (soa_start(job, i, s, S, l)) return i;
-        pdw_batch_finish(job, i, s);
-        ++*done;
+    pdw_soa_state *S = ((soa_loop *)L->ctx)->S;
+    for (int l = 1; l < ((L->W + 7) & ~7) && L->walker[0] >= 0; ++l) {
+        if (l < L->W && L->walker[l] >= 0) continue;
+        for (int j = 0; j < PDW_NP; ++j) S->p[j*PDW_SOA_STRIDE + l] = S->p[j*PDW_SOA_STRIDE];
+        S->hip[l] = S->hip[0];
+        S->depth[l] = S->depth[0];
+        soa_load(S, l, &L->sims[0]);
     }
-    return -1;
+    S->kc_stale = 1;
 }
+
+static void soa_park(pdw_lanes *L, int l)
+{
+    soa_store(((soa_loop *)L->ctx)->S, l, &L->sims[l]);
+}
+
+/* one structure-of-arrays step of every lane; per lane its commit, or the scalar step */
+static void soa_round(pdw_lanes *L)
+{
+    const soa_loop *c = L->ctx;
+    pdw_soa_state *S = c->S;
+    const pdw_batch_job *job = L->job;
+    c->stepfn(c->kernel, S, L->W, job->opt.dt, job->opt.max_speed, c->vector);
+    for (int l = 0; l < L->W; ++l) {
+        if (L->walker[l] < 0) continue;
+        pdw_sim *s = &L->sims[l];
+        int more;
+        if (S->rare[l]) {
+            /* the scalar step from the same state and trig: it takes the event, the fall
+             * or the failure exactly as pdw_cdm_advance */
+            soa_store(S, l, s);
+            for (int j = 0; j < PDW_NTRIG; ++j)
+                s->work[PDW_WORK_TRIG + j] = S->trig[j*PDW_SOA_STRIDE + l];
+            more = step(s);
+            if (more) soa_load(S, l, s);
+        } else {
+            s->n++;
+            s->t = s->n * s->opt.dt;
+            s->n_rhs++;
+            L->lane_steps++;
+            S->upd[l] = 1;
+            more = s->n < s->opt.n_steps;
+            if (!more) {
+                /* final flags at t_end (scalar trig), as step() */
+                soa_store(S, l, s);
+                if (pdw_update_flags(s, s->n * s->opt.dt) == 0) s->status = PDW_STATUS_DONE;
+            }
+        }
+        if (!more) pdw_lanes_retire(L, l);
+    }
+}
+
+static const pdw_lane_ops soa_ops = {soa_start, soa_round, soa_begin, soa_park};
 
 long pdw_batch_cdm_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
                        int vector, int isa, pdw_soa_state *S)
 {
     const long kid = job->kernel - pdw_kernels;
-    void (*stepfn)(int, pdw_soa_state *, int, double, double, int) = NULL;
-    if (isa == PDW_ISA_BASE) stepfn = pdw_soa_cdm_step_base;
-    else if (isa == PDW_ISA_AVX2) stepfn = pdw_soa_cdm_step_avx2;
-    else if (isa == PDW_ISA_AVX512) stepfn = pdw_soa_cdm_step_avx512;
+    soa_loop c = {S, NULL, (int)kid, vector};
+    if (isa == PDW_ISA_BASE) c.stepfn = pdw_soa_cdm_step_base;
+    else if (isa == PDW_ISA_AVX2) c.stepfn = pdw_soa_cdm_step_avx2;
+    else if (isa == PDW_ISA_AVX512) c.stepfn = pdw_soa_cdm_step_avx512;
     if (kid < 0 || kid >= PDW_NKERNELS || !pdw_soa_has_kernel_base((int)kid)
-        || stepfn == NULL || !pdw_batch_isa_supported(isa))
+        || c.stepfn == NULL || !pdw_batch_isa_supported(isa))
         return pdw_batch_cdm(job, i0, i1, W, lanes, vector);
-    long walker[PDW_BATCH_MAXW], next = i0;
-    int running = 0;
-    long since_poll = 0, done = 0, lane_steps = 0;
-    if (W < 1) W = 1;
-    if (W > PDW_BATCH_MAXW) W = PDW_BATCH_MAXW;
+    if (pdw_batch_serial_pays(i0, i1, W, vector)) return pdw_batch_serial(job, i0, i1, lanes);
     memset(S, 0, sizeof *S);
-    for (int l = 0; l < W; ++l) {
-        walker[l] = soa_refill(job, &next, i1, &lanes[l], S, l, &done);
-        if (walker[l] >= 0) running++;
-    }
-    /* lanes without a walker and the padding lanes up to a multiple of 8 (computed, never
-     * read) step a copy of lane 0: ordinary numbers, no denormal or NaN slow paths (if lane 0
-     * has no walker, none has) */
-    for (int l = 1; l < ((W + 7) & ~7) && walker[0] >= 0; ++l) {
-        if (l < W && walker[l] >= 0) continue;
-        for (int j = 0; j < PDW_NP; ++j) S->p[j*PDW_SOA_STRIDE + l] = S->p[j*PDW_SOA_STRIDE];
-        S->hip[l] = S->hip[0];
-        S->depth[l] = S->depth[0];
-        soa_load(S, l, &lanes[0]);
-    }
-    while (running > 0) {
-        if (job->poll && ++since_poll >= PDW_BATCH_POLL) {
-            since_poll = 0;
-            if (job->poll(job->poll_ctx)) {   /* stopped: the running walkers as they are */
-                for (int l = 0; l < W; ++l) {
-                    if (walker[l] < 0) continue;
-                    soa_store(S, l, &lanes[l]);
-                    pdw_batch_finish(job, walker[l], &lanes[l]);
-                }
-                if (job->lane_steps) *job->lane_steps += lane_steps;
-                return done;
-            }
-        }
-        stepfn((int)kid, S, W, job->opt.dt, job->opt.max_speed, vector);
-        for (int l = 0; l < W; ++l) {
-            if (walker[l] < 0) continue;
-            pdw_sim *s = &lanes[l];
-            int more;
-            if (S->rare[l]) {
-                /* the scalar step from the same state and trig: it takes the event, the fall
-                 * or the failure exactly as pdw_cdm_advance */
-                soa_store(S, l, s);
-                for (int j = 0; j < PDW_NTRIG; ++j)
-                    s->work[PDW_WORK_TRIG + j] = S->trig[j*PDW_SOA_STRIDE + l];
-                more = step(s);
-                if (more) soa_load(S, l, s);
-            } else {
-                s->n++;
-                s->t = s->n * s->opt.dt;
-                s->n_rhs++;
-                lane_steps++;
-                S->upd[l] = 1;
-                more = s->n < s->opt.n_steps;
-                if (!more) {
-                    /* final flags at t_end (scalar trig), as step() */
-                    soa_store(S, l, s);
-                    if (pdw_update_flags(s, s->n * s->opt.dt) == 0) s->status = PDW_STATUS_DONE;
-                }
-            }
-            if (more) continue;
-            pdw_batch_finish(job, walker[l], s);
-            running--;
-            done++;
-            walker[l] = soa_refill(job, &next, i1, s, S, l, &done);
-            if (walker[l] >= 0) running++;
-        }
-    }
-    if (job->lane_steps) *job->lane_steps += lane_steps;
-    return done;
+    return pdw_lanes_run(job, i0, i1, W, lanes, &soa_ops, &c, PDW_BATCH_POLL);
 }

@@ -17,6 +17,8 @@
 enum { PDW_BATCH_MAXW = 64 };
 /* the row stride of pdw_soa_state: the generated stages' PDW_SOA (generated/pdw_batch_gen.h) */
 enum { PDW_SOA_STRIDE = 72 };
+/* room for the generated stages' PDW_SOA_NKC rows of per-walker constants */
+enum { PDW_SOA_KC_ROWS = 8 };
 
 typedef struct pdw_batch_job {
     /* --- inputs --- */
@@ -75,13 +77,19 @@ typedef struct pdw_soa_state {
     double x[PDW_NX*PDW_SOA_STRIDE], u_prev[PDW_NQ*PDW_SOA_STRIDE];
     double p[PDW_NP*PDW_SOA_STRIDE], anchors[PDW_NANCHOR*PDW_SOA_STRIDE];
     double hip[PDW_SOA_STRIDE], depth[PDW_SOA_STRIDE];
-    int flags[2*PDW_SOA_STRIDE], armed[2*PDW_SOA_STRIDE], armed_next[2*PDW_SOA_STRIDE];
-    int upd[PDW_SOA_STRIDE];    /* 1: past the first step (the flags are updated first) */
-    int rare[PDW_SOA_STRIDE];   /* out: 1 = nothing committed, run the scalar step */
+    /* 64-bit, as wide as the doubles: the lane loops that mix them vectorize with one vector
+     * width (int32 rows halve it on AVX-512) */
+    long long flags[2*PDW_SOA_STRIDE], armed[2*PDW_SOA_STRIDE], armed_next[2*PDW_SOA_STRIDE];
+    long long upd[PDW_SOA_STRIDE];  /* 1: past the first step (the flags are updated first) */
+    long long rare[PDW_SOA_STRIDE]; /* out: 1 = nothing committed, run the scalar step */
     double trig[PDW_NTRIG*PDW_SOA_STRIDE], kin[2*PDW_NKIN*PDW_SOA_STRIDE];
     double contact[2*PDW_NCONTACT*PDW_SOA_STRIDE];
     double M[PDW_NQ*PDW_NQ*PDW_SOA_STRIDE], C[PDW_NQ*PDW_NQ*PDW_SOA_STRIDE];
     double QmG[PDW_NQ*PDW_SOA_STRIDE];
+    /* the contact law's parameter-only temporaries of each lane (the kernel's contact_consts,
+     * generated/pdw_batch_gen.h), computed again before the next step when kc_stale */
+    double kc[PDW_SOA_KC_ROWS*PDW_SOA_STRIDE];
+    int kc_stale;
 } pdw_soa_state;
 
 /* The trig of lanes l < W from libm (bitwise pdw_trig): all lanes, or (only_first != 0) only
@@ -101,7 +109,8 @@ typedef struct pdw_ros_soa {
     double p[PDW_NP*PDW_SOA_STRIDE], anchors[PDW_NANCHOR*PDW_SOA_STRIDE];
     double hip[PDW_SOA_STRIDE], depth[PDW_SOA_STRIDE];
     double h[PDW_SOA_STRIDE];           /* the attempt's step */
-    int flags[2*PDW_SOA_STRIDE], armed[2*PDW_SOA_STRIDE];
+    long long flags[2*PDW_SOA_STRIDE];  /* 64-bit: the generated contact stages' rows */
+    int armed[2*PDW_SOA_STRIDE];
     int jac[PDW_SOA_STRIDE];            /* 1: a new point, J of x wanted */
     /* kept: J = d qdd / d x at x (row i*PDW_NX + j), the factors of the attempt */
     double J[PDW_NQ*PDW_NX*PDW_SOA_STRIDE];
@@ -149,6 +158,23 @@ long pdw_batch_cdm(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *l
  * next walker. Returns the walkers finished (fewer when job->poll stopped the range). */
 long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes);
 
+/* Advance walkers [i0, i1) of job one after the other, each through its method's own advance
+ * (job->method; pdw.simulate's loop, so bitwise its run by construction), polled every
+ * PDW_BATCH_POLL loop iterations; lanes: 1 caller-allocated pdw_sim. The structure-of-arrays
+ * loops take it for small blocks (pdw_batch_serial_pays). Returns as pdw_batch_method. */
+long pdw_batch_serial(const pdw_batch_job *job, long i0, long i1, pdw_sim *lanes);
+
+/* The most walkers a block may hold for which the serial loop beats the structure-of-arrays
+ * lanes: those compute ceil(W/8)*8 lanes whatever the walkers, each lane-step ~1/4 of a scalar
+ * step (benchmarks/bench_batch.py). */
+enum { PDW_BATCH_SERIAL = 2 };
+
+/* 1 if walkers [i0, i1) in blocks of W lanes run faster through pdw_batch_serial: a block
+ * would hold at most PDW_BATCH_SERIAL walkers, and the trig is libm's (vector = 0: the serial
+ * loop is bitwise the lanes; vector = 1 stays in the lanes, whose libmvec trig a walker's
+ * numbers must not depend on the batch size for). */
+int pdw_batch_serial_pays(long i0, long i1, int W, int vector);
+
 /* Advance walkers [i0, i1) of job with rodas4 (job->method must name it), as
  * pdw_batch_method does, the ordinary steps of the lanes through the structure-of-arrays try
  * step compiled for isa (pdw_batch_ros.inc; S caller-allocated, 64-byte aligned): each lane
@@ -161,7 +187,51 @@ long pdw_batch_method(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim
 long pdw_batch_rodas4_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
                           int vector, int isa, pdw_ros_soa *S);
 
-/* --- the lane loops' shared pieces (pdw_batch.c) ------------------------------------------ */
+/* --- the lane scheduler, shared by the lane loops (pdw_batch.c) ------------------------------
+ *
+ * Every lane loop (pdw_batch_cdm, pdw_batch_method, pdw_batch_cdm_soa, pdw_batch_rodas4_soa and
+ * the serial fast path) is pdw_lanes_run with its own pdw_lane_ops: the scheduler fills the W
+ * lanes with walkers of [i0, i1) (pdw_batch_take), writes a walker that finishes at its start
+ * at once, polls job->poll every poll_rounds rounds and on a stop writes the running walkers as
+ * they are (status running), and otherwise calls the loop's round until no lane runs. A round
+ * advances its lanes and hands each lane whose walker finished to pdw_lanes_retire, which
+ * writes that walker and refills the lane. */
+typedef struct pdw_lanes pdw_lanes;
+
+typedef struct pdw_lane_ops {
+    /* Load walker i into lane l. Returns 1 if it runs, 0 if it finished at once (its pdw_sim,
+     * L->sims[l], then holds the outcome). */
+    int (*start)(pdw_lanes *L, long i, int l);
+    /* Advance the running lanes (L->walker[l] >= 0); pdw_lanes_retire each that finished. */
+    void (*round)(pdw_lanes *L);
+    /* May be NULL: after the first fill, before the first round. */
+    void (*begin)(pdw_lanes *L);
+    /* May be NULL: bring lane l's pdw_sim up to date before a stop writes it. */
+    void (*park)(pdw_lanes *L, int l);
+} pdw_lane_ops;
+
+struct pdw_lanes {
+    const pdw_batch_job *job;
+    const pdw_lane_ops *ops;
+    void *ctx;                  /* the lane loop's own state */
+    pdw_sim *sims;              /* (W,) the lanes' walkers */
+    int W;                      /* lanes, 1 .. PDW_BATCH_MAXW */
+    int running;                /* lanes with a walker */
+    long walker[PDW_BATCH_MAXW];/* lane l's walker, -1: none */
+    long next, i1;              /* the range's next walker (without job->next_walker), its end */
+    long done;                  /* walkers written */
+    long lane_steps;            /* += by the loop: steps committed by a structure-of-arrays step */
+};
+
+/* Run walkers [i0, i1) of job through W lanes (clamped to [1, PDW_BATCH_MAXW]) of sims with
+ * ops; ctx: the loop's state (L->ctx). poll_rounds: rounds between job->poll calls. Adds
+ * L->lane_steps to job->lane_steps. Returns the walkers written as finished (fewer than
+ * i1 - i0 when job->poll stopped the range). */
+long pdw_lanes_run(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *sims,
+                   const pdw_lane_ops *ops, void *ctx, long poll_rounds);
+
+/* Lane l's walker finished: write it, and fill the lane with the next walker (or none). */
+void pdw_lanes_retire(pdw_lanes *L, int l);
 
 /* The next walker of [*next, i1) for a lane, or -1 when none is left: from the shared counter
  * job->next_walker when there is one (atomically: threads share it), else from *next. */
@@ -176,11 +246,8 @@ static inline long pdw_batch_take(const pdw_batch_job *job, long *next, long i1)
 /* Write lane s's walker i into job's outputs. */
 void pdw_batch_finish(const pdw_batch_job *job, long i, const pdw_sim *s);
 /* Load walker i into lane s for a method of pdw_methods (job->method) with the settings
- * pdw.simulate gives its pdw_sim, returning (PDW_STATUS_POLL) after each accepted step. */
-void pdw_batch_start_method(const pdw_batch_job *job, long i, pdw_sim *s);
-/* Every PDW_BATCH_POLL calls: job->poll; if it says stop, write the running walkers (walker[l]
- * >= 0) as they are and return 1. */
-int pdw_batch_poll_stop(const pdw_batch_job *job, long *since_poll, const long *walker, int W,
-                        const pdw_sim *lanes);
+ * pdw.simulate gives its pdw_sim, returning (PDW_STATUS_POLL) every poll_every loop
+ * iterations (2: after each accepted step). */
+void pdw_batch_start_method(const pdw_batch_job *job, long i, pdw_sim *s, long poll_every);
 
 #endif /* PDW_BATCH_H */

@@ -73,141 +73,147 @@ static void ros_copy_lane(pdw_ros_soa *S, int d, int l0)
     S->jac[d] = 1;
 }
 
-long pdw_batch_rodas4_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
-                          int vector, int isa, pdw_ros_soa *S)
-{
-    const long kid = job->kernel - pdw_kernels;
-    void (*tryfn)(int, pdw_ros_soa *, int, int, double, double, double, int) = NULL;
-    if (isa == PDW_ISA_BASE) tryfn = pdw_soa_ros_try_base;
-    else if (isa == PDW_ISA_AVX2) tryfn = pdw_soa_ros_try_avx2;
-    else if (isa == PDW_ISA_AVX512) tryfn = pdw_soa_ros_try_avx512;
-    if (kid < 0 || kid >= PDW_NKERNELS || !pdw_soa_has_ros_kernel_base((int)kid)
-        || tryfn == NULL || !pdw_batch_isa_supported(isa)
-        || pdw_methods[job->method].advance != pdw_rodas4_advance
-        || pdw_tableau_rodas4.stages != PDW_ROS_MAXSTAGES)
-        return pdw_batch_method(job, i0, i1, W, lanes);
-    const pdw_adaptive_method *m = &pdw_rodas4_method;
-    long lane_steps = 0;
-    const double t_end = job->opt.t_end;
-    long walker[PDW_BATCH_MAXW], next = i0, since_poll = 0, done = 0;
+/* pdw_batch_rodas4_soa's state: the try step, and per lane its mode and attempt */
+typedef struct ros_loop {
+    pdw_ros_soa *S;
+    void (*tryfn)(int, pdw_ros_soa *, int, int, double, double, double, int);
+    int kernel, vector;
     long nrej[PDW_BATCH_MAXW];              /* rejections of the lane's current step so far */
     double hcur[PDW_BATCH_MAXW];            /* the step size pdw_sim's h would have now */
     int mode[PDW_BATCH_MAXW], fresh[PDW_BATCH_MAXW], newpt[PDW_BATCH_MAXW];
     int lastrej[PDW_BATCH_MAXW], loaded[PDW_BATCH_MAXW];
-    int running = 0;
-    if (W < 1) W = 1;
-    if (W > PDW_BATCH_MAXW) W = PDW_BATCH_MAXW;
-    const int W8 = (W + 7) & ~7;
-    memset(S, 0, sizeof *S);
-    for (int l = 0; l < W8; ++l) loaded[l] = 0;
+} ros_loop;
+
+/* a new walker starts scalar: its first step through pdw_rodas4_advance */
+static int ros_start(pdw_lanes *L, long i, int l)
+{
+    ros_loop *c = L->ctx;
+    pdw_batch_start_method(L->job, i, &L->sims[l], 2);
+    c->fresh[l] = 1;
+    c->mode[l] = LANE_SCALAR;
+    return 1;
+}
+
+static void ros_round(pdw_lanes *L)
+{
+    ros_loop *c = L->ctx;
+    pdw_ros_soa *S = c->S;
+    const pdw_batch_job *job = L->job;
+    const pdw_adaptive_method *m = &pdw_rodas4_method;
+    const double t_end = job->opt.t_end;
+    const int W = L->W, W8 = (W + 7) & ~7;
+    const long *walker = L->walker;
+    pdw_sim *lanes = L->sims;
+    /* (1) the scalar lanes: one accepted step each, or the end of the walker */
     for (int l = 0; l < W; ++l) {
-        mode[l] = LANE_SCALAR;
-        if ((walker[l] = pdw_batch_take(job, &next, i1)) >= 0) {
-            pdw_batch_start_method(job, walker[l], &lanes[l]);
-            fresh[l] = 1;
-            running++;
-        }
-    }
-    while (running > 0) {
-        if (pdw_batch_poll_stop(job, &since_poll, walker, W, lanes)) {
-            /* the lanes' pdw_sim hold their last accepted step */
-            for (int l = 0; l < W; ++l)
-                if (walker[l] >= 0) job->status[walker[l]] = PDW_STATUS_RUNNING;
-            if (job->lane_steps) *job->lane_steps += lane_steps;
-            return done;
-        }
-        /* (1) the scalar lanes: one accepted step each, or the end of the walker */
-        for (int l = 0; l < W; ++l) {
-            while (walker[l] >= 0 && mode[l] == LANE_SCALAR) {
-                pdw_sim *s = &lanes[l];
-                if (pdw_rodas4_advance(s) == PDW_STATUS_POLL) {
-                    ros_load(S, l, s, fresh[l]);
-                    fresh[l] = 0;
-                    loaded[l] = 1;
-                    mode[l] = LANE_VECTOR;
-                    newpt[l] = 1;
-                    lastrej[l] = 0;
-                    nrej[l] = 0;
-                    hcur[l] = s->h;
-                    break;
-                }
-                pdw_batch_finish(job, walker[l], s);
-                walker[l] = -1;
-                running--;
-                done++;
-                if ((walker[l] = pdw_batch_take(job, &next, i1)) >= 0) {
-                    pdw_batch_start_method(job, walker[l], s);
-                    fresh[l] = 1;
-                    running++;
-                }
-            }
-        }
-        /* (2) the vector lanes' attempts, as pdw_adaptive_advance's loop sets them up */
-        int any = 0, any_jac = 0, l0 = -1;
-        for (int l = 0; l < W; ++l) {
-            S->jac[l] = 0;
-            if (walker[l] < 0 || mode[l] != LANE_VECTOR) continue;
-            const pdw_sim *s = &lanes[l];
-            const double h = fmin(hcur[l], s->opt.h_max);
-            const double rem = t_end - s->t;
-            if ((s->opt.max_steps > 0 && s->n + s->n_rejected + nrej[l] >= s->opt.max_steps)
-                || h >= rem - 1e-12 * fmax(1.0, t_end)
-                || !(h > 8.0 * DBL_EPSILON * fmax(fabs(s->t), 1e-3))) {
-                mode[l] = LANE_SCALAR;      /* the budget, the last step, a step too small */
-                continue;
-            }
-            S->h[l] = h;
-            S->jac[l] = newpt[l];
-            any = 1;
-            any_jac |= newpt[l];
-            if (l0 < 0) l0 = l;
-        }
-        if (!any) continue;
-        for (int l = 0; l < W8; ++l) {
-            if (l < W && walker[l] >= 0 && mode[l] == LANE_VECTOR) continue;
-            if (!loaded[l]) { ros_copy_lane(S, l, l0); loaded[l] = 1; }
-            S->jac[l] = 0;
-        }
-        /* (3) every vector lane's attempt */
-        tryfn((int)kid, S, W, any_jac, job->opt.rtol, job->opt.atol, job->opt.max_speed, vector);
-        /* (4) pdw_adaptive_advance's decision, per lane */
-        for (int l = 0; l < W; ++l) {
-            if (walker[l] < 0 || mode[l] != LANE_VECTOR) continue;
+        while (walker[l] >= 0 && c->mode[l] == LANE_SCALAR) {
             pdw_sim *s = &lanes[l];
-            const double err = S->err[l], h = S->h[l];
-            s->n_jac += newpt[l];
-            s->n_rhs += PDW_ROS_MAXSTAGES - 1;
-            if (S->bad[l]) { mode[l] = LANE_SCALAR; continue; }
-            newpt[l] = 0;
-            if (!(err <= 1.0)) {
-                hcur[l] = h * pdw_reject_factor(m, err);
-                nrej[l]++;
-                lastrej[l] = 1;
-                continue;
+            if (pdw_rodas4_advance(s) == PDW_STATUS_POLL) {
+                ros_load(S, l, s, c->fresh[l]);
+                c->fresh[l] = 0;
+                c->loaded[l] = 1;
+                c->mode[l] = LANE_VECTOR;
+                c->newpt[l] = 1;
+                c->lastrej[l] = 0;
+                c->nrej[l] = 0;
+                c->hcur[l] = s->h;
+                break;
             }
-            if (S->rare[l]) { mode[l] = LANE_SCALAR; continue; }
-            /* an ordinary accepted step: pdw_adaptive_advance's commit */
-            const double h_next = h * pdw_accept_factor(m, s, err, h, lastrej[l]);
-            for (int i = 0; i < PDW_NX; ++i) {
-                const double xn = S->xnew[i*PDW_SOA_STRIDE + l], fn = S->fnew[i*PDW_SOA_STRIDE + l];
-                s->x[i] = xn;
-                s->cache[i] = fn;
-                S->x[i*PDW_SOA_STRIDE + l] = xn;
-                S->fx[i*PDW_SOA_STRIDE + l] = fn;
-            }
-            s->cache_valid = 1;
-            s->n_rhs++;
-            s->t = s->t + h;
-            s->n++;
-            s->n_rejected += nrej[l];
-            pdw_accept_memory(m, s, err, h, h_next);
-            lane_steps++;
-            newpt[l] = 1;
-            lastrej[l] = 0;
-            nrej[l] = 0;
-            hcur[l] = s->h;
+            pdw_lanes_retire(L, l);
         }
     }
-    if (job->lane_steps) *job->lane_steps += lane_steps;
-    return done;
+    /* (2) the vector lanes' attempts, as pdw_adaptive_advance's loop sets them up */
+    int any = 0, any_jac = 0, l0 = -1;
+    for (int l = 0; l < W; ++l) {
+        S->jac[l] = 0;
+        if (walker[l] < 0 || c->mode[l] != LANE_VECTOR) continue;
+        const pdw_sim *s = &lanes[l];
+        const double h = fmin(c->hcur[l], s->opt.h_max);
+        const double rem = t_end - s->t;
+        if ((s->opt.max_steps > 0 && s->n + s->n_rejected + c->nrej[l] >= s->opt.max_steps)
+            || h >= rem - 1e-12 * fmax(1.0, t_end)
+            || !(h > 8.0 * DBL_EPSILON * fmax(fabs(s->t), 1e-3))) {
+            c->mode[l] = LANE_SCALAR;       /* the budget, the last step, a step too small */
+            continue;
+        }
+        S->h[l] = h;
+        S->jac[l] = c->newpt[l];
+        any = 1;
+        any_jac |= c->newpt[l];
+        if (l0 < 0) l0 = l;
+    }
+    if (!any) return;
+    for (int l = 0; l < W8; ++l) {
+        if (l < W && walker[l] >= 0 && c->mode[l] == LANE_VECTOR) continue;
+        if (!c->loaded[l]) { ros_copy_lane(S, l, l0); c->loaded[l] = 1; }
+        S->jac[l] = 0;
+    }
+    /* (3) every vector lane's attempt */
+    c->tryfn(c->kernel, S, W, any_jac, job->opt.rtol, job->opt.atol, job->opt.max_speed,
+             c->vector);
+    /* (4) pdw_adaptive_advance's decision, per lane */
+    for (int l = 0; l < W; ++l) {
+        if (walker[l] < 0 || c->mode[l] != LANE_VECTOR) continue;
+        pdw_sim *s = &lanes[l];
+        const double err = S->err[l], h = S->h[l];
+        s->n_jac += c->newpt[l];
+        s->n_rhs += PDW_ROS_MAXSTAGES - 1;
+        if (S->bad[l]) { c->mode[l] = LANE_SCALAR; continue; }
+        c->newpt[l] = 0;
+        if (!(err <= 1.0)) {
+            c->hcur[l] = h * pdw_reject_factor(m, err);
+            c->nrej[l]++;
+            c->lastrej[l] = 1;
+            continue;
+        }
+        if (S->rare[l]) { c->mode[l] = LANE_SCALAR; continue; }
+        /* an ordinary accepted step: pdw_adaptive_advance's commit */
+        const double h_next = h * pdw_accept_factor(m, s, err, h, c->lastrej[l]);
+        for (int i = 0; i < PDW_NX; ++i) {
+            const double xn = S->xnew[i*PDW_SOA_STRIDE + l], fn = S->fnew[i*PDW_SOA_STRIDE + l];
+            s->x[i] = xn;
+            s->cache[i] = fn;
+            S->x[i*PDW_SOA_STRIDE + l] = xn;
+            S->fx[i*PDW_SOA_STRIDE + l] = fn;
+        }
+        s->cache_valid = 1;
+        s->n_rhs++;
+        s->t = s->t + h;
+        s->n++;
+        s->n_rejected += c->nrej[l];
+        pdw_accept_memory(m, s, err, h, h_next);
+        L->lane_steps++;
+        c->newpt[l] = 1;
+        c->lastrej[l] = 0;
+        c->nrej[l] = 0;
+        c->hcur[l] = s->h;
+    }
+}
+
+static const pdw_lane_ops ros_ops = {ros_start, ros_round, NULL, NULL};
+
+long pdw_batch_rodas4_soa(const pdw_batch_job *job, long i0, long i1, int W, pdw_sim *lanes,
+                          int vector, int isa, pdw_ros_soa *S)
+{
+    const long kid = job->kernel - pdw_kernels;
+    ros_loop c;
+    c.S = S;
+    c.tryfn = NULL;
+    c.kernel = (int)kid;
+    c.vector = vector;
+    if (isa == PDW_ISA_BASE) c.tryfn = pdw_soa_ros_try_base;
+    else if (isa == PDW_ISA_AVX2) c.tryfn = pdw_soa_ros_try_avx2;
+    else if (isa == PDW_ISA_AVX512) c.tryfn = pdw_soa_ros_try_avx512;
+    if (kid < 0 || kid >= PDW_NKERNELS || !pdw_soa_has_ros_kernel_base((int)kid)
+        || c.tryfn == NULL || !pdw_batch_isa_supported(isa)
+        || pdw_methods[job->method].advance != pdw_rodas4_advance
+        || pdw_tableau_rodas4.stages != PDW_ROS_MAXSTAGES)
+        return pdw_batch_method(job, i0, i1, W, lanes);
+    if (pdw_batch_serial_pays(i0, i1, W, vector)) return pdw_batch_serial(job, i0, i1, lanes);
+    memset(S, 0, sizeof *S);
+    for (int l = 0; l < PDW_BATCH_MAXW; ++l) {
+        c.loaded[l] = 0;
+        c.mode[l] = LANE_SCALAR;
+    }
+    return pdw_lanes_run(job, i0, i1, W, lanes, &ros_ops, &c, PDW_BATCH_POLL);
 }

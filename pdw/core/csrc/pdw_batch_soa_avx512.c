@@ -4,7 +4,7 @@
  * off, so every target gives the same bits (vector sin/cos aside). */
 #define PDW_SOA_FN(name) name##_avx512
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#pragma GCC target("avx512f")
+#pragma GCC target("avx512f,avx512vl,avx512dq,avx512bw")
 #endif
 #include "pdw_batch_soa.inc"
 #include "pdw_batch_ros.inc"
