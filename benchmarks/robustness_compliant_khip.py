@@ -9,9 +9,12 @@ benchmarks/robustness_compliant.py at k_hip 0.5, 0.95, 1.5), 100 walkers censore
 
 Usage: .venv/bin/python benchmarks/robustness_compliant_khip.py [--update-docs]
 (about 4 minutes of CPU). Writes robustness_compliant_khip.txt and the figure
-robustness_compliant_khip.png.
+robustness_compliant_khip.png. ``--walkers N --khips a,b,...`` (the refinement near the best
+k_hip): N walkers (the first 100 are the default run's) at those k_hip, written to
+robustness_compliant_khip_N.txt / .png.
 """
 import os
+import sys
 import time
 
 import numpy as np
@@ -23,13 +26,20 @@ import pdw
 SIGMA = 0.0015
 KHIPS = (0.5, 0.65, 0.8, 0.95, 1.1, 1.25, 1.5)
 GROUNDS = (("hard", 2.5e5), ("soft", 0.5e5))
+WALKERS = 100
+SUFFIX = ""
+if "--walkers" in sys.argv:
+    WALKERS = int(sys.argv[sys.argv.index("--walkers") + 1])
+    SUFFIX = "_%d" % WALKERS
+if "--khips" in sys.argv:
+    KHIPS = tuple(float(v) for v in sys.argv[sys.argv.index("--khips") + 1].split(","))
 
 
 def main():
     t0, c0 = time.time(), time.process_time()
     lines = ["MFPT [steps] against k_hip (benchmarks/robustness_compliant_khip.py): "
-             "paper_steady, Ground.random(%.1f mm, 0.1 m), 100 walkers each, censored at 300 "
-             "steps, seed 1" % (1e3 * SIGMA),
+             "paper_steady, Ground.random(%.1f mm, 0.1 m), %d walkers each, censored at 300 "
+             "steps, seed 1" % (1e3 * SIGMA, WALKERS),
              "load average at start %.2f %.2f %.2f" % os.getloadavg(), "",
              "| ground | k_n | " + " | ".join("k_hip %.2f" % k for k in KHIPS) + " |",
              "|---|---|" + "---|" * len(KHIPS)]
@@ -43,7 +53,7 @@ def main():
                 cells.append("no gait")
                 continue
             fp = pdw.first_passage(with_(k_n=k_n, k_hip=k), model="continuous",
-                                   ground=pdw.Ground.random(SIGMA, 0.1), walkers=100,
+                                   ground=pdw.Ground.random(SIGMA, 0.1), walkers=WALKERS,
                                    max_steps=300, gait=g, seed=1)
             res[(ground, k)] = fp
             cells.append("%.1f (%.1f-%.1f)" % (fp.mfpt, fp.ci[0], fp.ci[1]))
@@ -51,7 +61,7 @@ def main():
         lines.append("| %s | %.3g | %s |" % (ground, k_n, " | ".join(cells)))
     lines += ["", "wall %.0f s, CPU %.0f s, load average at end %.2f %.2f %.2f"
               % (time.time() - t0, time.process_time() - c0, *os.getloadavg())]
-    publish("robustness_compliant_khip.txt", lines)
+    publish("robustness_compliant_khip%s.txt" % SUFFIX, lines)
     figure(res)
 
 
@@ -77,7 +87,7 @@ def figure(res):
     a.legend(fontsize=8)
     fig.tight_layout()
     FIGURES.mkdir(parents=True, exist_ok=True)
-    fig.savefig(FIGURES / "robustness_compliant_khip.png", dpi=110)
+    fig.savefig(FIGURES / ("robustness_compliant_khip%s.png" % SUFFIX), dpi=110)
     plt.close(fig)
 
 
