@@ -19,6 +19,7 @@ from robustness_compliant import gaits_along, with_
 
 import pdw
 from pdw.analysis import robustness_continuous as RC
+from pdw.analysis.robustness_core import returned
 
 KHIPS = tuple(np.round(np.linspace(0.5, 1.5, 11), 3))
 MATS = tuple(float("%.3g" % m) for m in np.geomspace(3e3, 3e4, 11))
@@ -39,8 +40,7 @@ def main():
                 grid[i, j] = -1
                 continue
             past = int(np.searchsorted(np.cumsum(L), 2.5)) + 1
-            ret, kk = pdw.analysis.robustness.returned(L[past:], T[past:], g.step_length,
-                                                       g.period, 1e-3)
+            ret, kk = returned(L[past:], T[past:], g.step_length, g.period, 1e-3)
             grid[i, j] = kk if ret else 99
     lines = ["Hard floor -> soft mat on s in [1, 2.5] m -> hard floor "
              "(benchmarks/robustness_compliant_mat.py): paper_steady, mat d_n = 10 k_n, 30 "
