@@ -114,6 +114,10 @@ study: $(STAMP)
 	$(PY) benchmarks/basin_study.py 400 200 $(UPDATE_DOCS)
 	$(PY) benchmarks/robustness_studies.py $(UPDATE_DOCS)
 	$(PY) benchmarks/robustness_compliant.py $(UPDATE_DOCS)
+	$(PY) benchmarks/robustness_compliant_khip.py $(UPDATE_DOCS)
+	$(PY) benchmarks/robustness_compliant_mat.py $(UPDATE_DOCS)
+	$(PY) benchmarks/terrain_rigid_limit.py $(UPDATE_DOCS)
+	$(PY) benchmarks/markov_vs_mc.py $(UPDATE_DOCS)
 
 ## sanitize: the compiled core built with AddressSanitizer + UndefinedBehaviorSanitizer (in
 ## build/sanitize, the normal build untouched), and the tests of the compiled boundary, the loops

@@ -28,17 +28,26 @@ def with_(**kw):
     return BASE.replace(**kw)
 
 
-def gaits_along(name, values):
-    """Continuous gaits along one parameter, each from the previous one (one branch)."""
-    out, prev = {}, pdw.find_gait(BASE)
-    order = sorted(values, key=lambda v: abs(v - getattr(BASE, name)))
-    for v in order:
-        try:
-            g = pdw.find_gait(with_(**{name: v}), guess=prev)
-            prev = g
-        except pdw.PdwError:
-            g = None
-        out[v] = g
+def gaits_along(name, values, base=None):
+    """Continuous gaits along one parameter, each from the previous one (one branch): from the
+    base value outward on each side, in steps of at most 10 % of the base value (a jump of
+    0.45 in k_hip from the base gait finds no gait; small steps do)."""
+    base = BASE if base is None else base
+    v0 = getattr(base, name)
+    g0 = pdw.find_gait(base)
+    out = {}
+    for side in ([v for v in values if v < v0][::-1], [v for v in values if v >= v0]):
+        prev, at = g0, v0
+        for v in sorted(side, key=lambda v: abs(v - v0)):
+            g = prev
+            n = max(1, int(np.ceil(abs(v - at) / (0.1 * abs(v0)))))
+            try:
+                for u in np.linspace(at, v, n + 1)[1:]:
+                    g = pdw.find_gait(base.replace(**{name: float(u)}), guess=g)
+                prev, at = g, v
+            except pdw.PdwError:
+                g = None
+            out[v] = g
     return out
 
 
@@ -60,25 +69,28 @@ def max_step_axis(name, values, lines, scale=1.0):
 
 
 def mfpt_table(lines):
-    walkers = 20 if QUICK else 60
-    sig = [0.0012, 0.0018] if QUICK else [0.0010, 0.0014, 0.0018]
+    walkers = 20 if QUICK else 100
+    sig = [0.0012, 0.0018] if QUICK else [0.0012, 0.0015, 0.0018]
+    khips = (0.5, 0.95, 1.5)
     out = {}
     lines += ["", "MFPT [steps] on Ground.random(sigma, correlation 0.1 m), %d walkers each, "
               "censored at 300 steps" % walkers]
     for ground, k_n in (("hard", 2.5e5), ("soft", 0.5e5)):
-        for k in (0.5, 0.95, 1.5):
+        gaits = gaits_along("k_hip", khips, base=with_(k_n=k_n))
+        for k in khips:
             P = with_(k_n=k_n, k_hip=k)
-            try:
-                g = pdw.find_gait(P, guess=pdw.find_gait(with_(k_n=k_n)))
-            except pdw.PdwError:
+            g = gaits[k]
+            if g is None:
                 lines.append("%s ground k_n %.3g, k_hip %.2f: no gait" % (ground, k_n, k))
                 continue
             for s in sig:
+                c0 = time.process_time()
                 fp = pdw.first_passage(P, model="continuous", ground=pdw.Ground.random(s, 0.1),
                                        walkers=walkers, max_steps=300, gait=g, seed=1)
                 out[(ground, k, s)] = fp
-                lines.append("%s k_n %.3g, k_hip %.2f, sigma %.1f mm: %s"
-                             % (ground, k_n, k, s * 1e3, fp))
+                lines.append("%s k_n %.3g, k_hip %.2f, sigma %.1f mm: %s (%.0f s CPU)"
+                             % (ground, k_n, k, s * 1e3, fp, time.process_time() - c0))
+                print(lines[-1], flush=True)
     return out, sig
 
 
@@ -91,11 +103,11 @@ def mat_transition(lines):
               "preset's), 30 steps from the gait: steps after the mat until the step length "
               "and time are within 1e-3 of the gait's (F: fell)"]
     lines.append("%-8s" % "k_hip" + "".join("%12s" % ("mat %.0e" % m) for m in mats))
+    gaits = gaits_along("k_hip", khips)
     for i, k in enumerate(khips):
         P = with_(k_hip=k)
-        try:
-            g = pdw.find_gait(P, guess=pdw.find_gait(BASE))
-        except pdw.PdwError:
+        g = gaits[k]
+        if g is None:
             grid[i] = np.nan
             lines.append("%-8.2f no gait" % k)
             continue
@@ -120,31 +132,63 @@ def mat_transition(lines):
 
 
 def tune(lines):
-    from scipy.optimize import minimize
+    """k_hip (and d_hip) maximizing the largest step-down, by scipy.optimize on pdw.max_step:
+    k_hip alone on a hard and a soft ground (minimize_scalar, bounded), and (k_hip, d_hip)
+    together on the preset's ground (Nelder-Mead with bounds)."""
+    from scipy.optimize import minimize, minimize_scalar
 
-    g0 = pdw.find_gait(BASE)
-    memo = {}
+    def make_neg(base, name_vals):
+        g0 = pdw.find_gait(base)
+        memo = {}
 
-    def neg(x):
-        k, d = float(x[0]), float(x[1])
-        key = (round(k, 6), round(d, 6))
-        if key not in memo:
-            try:
-                P = with_(k_hip=k, d_hip=d)
-                g = pdw.find_gait(P, guess=g0)
-                memo[key] = -pdw.max_step(P, model="continuous", gait=g, budget=BUDGET,
-                                          h_tol=5e-5).height
-            except pdw.PdwError:
-                memo[key] = 0.0
-        return memo[key]
+        def neg(x):
+            x = np.atleast_1d(x)
+            kw = {n: float(v) for n, v in zip(name_vals, x)}
+            key = tuple(round(v, 6) for v in kw.values())
+            if key not in memo:
+                try:
+                    P = base.replace(**kw)
+                    g = gait_towards(base, g0, kw)
+                    memo[key] = -pdw.max_step(P, model="continuous", gait=g, budget=BUDGET,
+                                              h_tol=5e-5).height
+                except pdw.PdwError:
+                    memo[key] = 0.0
+            return memo[key]
+        return neg
 
+    lines += ["", "k_hip maximizing the compliant walker's step-down on a given ground (scipy "
+              "minimize_scalar, bounded on [0.5, 1.5], xatol 0.01, on pdw.max_step):"]
+    for ground, k_n in (("hard", 2.5e5), ("preset", BASE.k_n), ("soft", 0.5e5)):
+        c0 = time.process_time()
+        neg = make_neg(with_(k_n=k_n), ("k_hip",))
+        res = minimize_scalar(neg, bounds=(0.5, 1.5), method="bounded",
+                              options=dict(xatol=0.01, maxiter=8 if QUICK else 20))
+        lines.append("  %s ground (k_n %.3g): k_hip = %.3f, step-down %.3f mm (k_hip 0.95: "
+                     "%.3f mm; 0.5: %.3f mm; 1.5: %.3f mm), %d evaluations, %.0f s CPU"
+                     % (ground, k_n, res.x, -res.fun * 1e3, -neg(0.95) * 1e3, -neg(0.5) * 1e3,
+                        -neg(1.5) * 1e3, res.nfev, time.process_time() - c0))
+        print(lines[-1], flush=True)
+    c0 = time.process_time()
+    neg = make_neg(BASE, ("k_hip", "d_hip"))
     res = minimize(neg, x0=[0.95, 0.010], method="Nelder-Mead",
+                   bounds=[(0.5, 1.5), (0.0, 0.02)],
                    options=dict(maxfev=12 if QUICK else 30, xatol=0.01, fatol=2e-5,
                                 initial_simplex=[[0.95, 0.010], [0.6, 0.010], [0.95, 0.005]]))
     lines += ["", "k_hip, d_hip maximizing the compliant walker's step-down (scipy Nelder-Mead "
-              "on pdw.max_step, %d evaluations): k_hip = %.4f, d_hip = %.5f, step-down %.3f mm "
-              "(paper_steady's k_hip 0.95, d_hip 0.010: %.3f mm)"
-              % (res.nfev, res.x[0], res.x[1], -res.fun * 1e3, -neg([0.95, 0.010]) * 1e3)]
+              "with bounds [0.5, 1.5] x [0, 0.02] on pdw.max_step, %d evaluations): k_hip = "
+              "%.4f, d_hip = %.5f, step-down %.3f mm (paper_steady's k_hip 0.95, d_hip 0.010: "
+              "%.3f mm), %.0f s CPU"
+              % (res.nfev, res.x[0], res.x[1], -res.fun * 1e3, -neg([0.95, 0.010]) * 1e3,
+                 time.process_time() - c0)]
+
+
+def gait_towards(base, g0, kw):
+    """The gait at base.replace(**kw), followed from g0 (at base) in 5 steps."""
+    g = g0
+    for f in np.linspace(0.2, 1.0, 5):
+        u = {n: getattr(base, n) + f * (v - getattr(base, n)) for n, v in kw.items()}
+        g = pdw.find_gait(base.replace(**u), guess=g)
+    return g
 
 
 def main():
@@ -155,10 +199,18 @@ def main():
     n = 4 if QUICK else 6
     ax = {"k_hip": np.linspace(0.5, 1.5, n), "gamma": np.linspace(0.012, 0.035, n),
           "k_n": np.geomspace(0.5e5, 2.5e5, n), "d_n": np.geomspace(0.5e6, 2.5e6, n)}
-    rows = {k: max_step_axis(k, v, lines) for k, v in ax.items()}
+    rows = {}
+    for k, v in ax.items():
+        c1 = time.process_time()
+        rows[k] = max_step_axis(k, v, lines)
+        lines.append("(%.0f s CPU)" % (time.process_time() - c1))
+        print("\n".join(lines[-9:]), flush=True)
+    c1 = time.process_time()
     grid, mats, khips = mat_transition(lines)
-    mf, sig = mfpt_table(lines)
+    lines.append("(%.0f s CPU)" % (time.process_time() - c1))
+    print("\n".join(lines[-8:]), flush=True)
     tune(lines)
+    mf, sig = mfpt_table(lines)
     lines.append("wall %.0f s, CPU %.0f s, load average at end %.2f %.2f %.2f"
                  % (time.time() - t0, time.process_time() - c0, *os.getloadavg()))
     publish("robustness_compliant.txt", lines)

@@ -126,8 +126,12 @@ def dh_nodes(sigma, n_dh, span=5.0):
     return sigma * mean, P
 
 
+#: how a cell of the mesh is represented (`markov_chain`'s ``representative``)
+REPRESENTATIVES = ("first", "centre")
+
+
 def markov_chain(params=None, *, sigma, n_dh=41, resolution=0.01, max_cells=20000, gait=None,
-                 threads=2, **options) -> MarkovChain:
+                 threads=2, representative="first", **options) -> MarkovChain:
     """Byl & Tedrake's Markov-chain MFPT of the hybrid walker with i.i.d. step heights.
 
     Parameters
@@ -144,6 +148,10 @@ def markov_chain(params=None, *, sigma, n_dh=41, resolution=0.01, max_cells=2000
         Largest mesh.
     gait : Gait, optional
     threads : int
+    representative : {"first", "centre"}
+        The state a cell's transitions start from: the first reachable state that fell in it
+        (Byl & Tedrake's sampled mesh; the default), or the cell's centre. The two differ by
+        the mesh's error (docs/robustness.md, "Why the chain and Monte Carlo differ").
     options
         Hybrid step-map options.
 
@@ -159,6 +167,7 @@ def markov_chain(params=None, *, sigma, n_dh=41, resolution=0.01, max_cells=2000
     n_dh = checks.count("n_dh", n_dh, lo=1, hi=10 ** 4)
     resolution = checks.number("resolution", resolution, lo=0.0, lo_open=True)
     max_cells = checks.count("max_cells", max_cells, lo=1, hi=10 ** 7)
+    representative = checks.choice("representative", representative, REPRESENTATIVES)
     gait = _rb._hybrid_gait(params, gait, options)
     dh, w = dh_nodes(sigma, n_dh)
     scale = np.array([1.0, 1.0, 1.0, 1.0]) / np.array(
@@ -192,7 +201,8 @@ def markov_chain(params=None, *, sigma, n_dh=41, resolution=0.01, max_cells=2000
                         fail[i] += w[j]          # unexplored: counted as a failure
                         continue
                     c = index[k] = len(states)
-                    states.append(np.array(y_next[r]))
+                    states.append(np.array(y_next[r]) if representative == "first" else
+                                  (np.array(k) + 0.5) * resolution / scale)
                     fail.append(0.0)
                     new.append(c)
                 rows.append(i)
@@ -216,5 +226,6 @@ def markov_chain(params=None, *, sigma, n_dh=41, resolution=0.01, max_cells=2000
     return MarkovChain(mfpt=float(m[0]), mfpt_eig=1.0 / (1.0 - lam2) if lam2 < 1 else math.inf,
                        lambda2=lam2, Q=Q, fail=fail_arr, states=np.array(states), m=m, start=0,
                        complete=complete, dh=dh, weights=w, sigma=sigma, resolution=resolution,
-                       meta=dict(n_dh=n_dh, max_cells=max_cells, options=dict(options)))
+                       meta=dict(n_dh=n_dh, max_cells=max_cells, representative=representative,
+                                 options=dict(options)))
 
