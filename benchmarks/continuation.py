@@ -498,8 +498,8 @@ def part_fold_kn():
     """The continuous model's (paper_steady, paper variant) low-d_n fold followed in k_n: the
     edge of the paper walker's existence and stability region in (k_n, d_n), with CPU and wall
     time (the issue's budget: 10 minutes on 2 cores), against long walks of the step map."""
-    from pdw.analysis import poincare
     from pdw.analysis.bifurcation.codim2 import continue_bifurcation
+    from pdw.analysis.stepmap import poincare
     say("== paper_steady (continuous, paper variant): its d_n fold followed in k_n ==")
     say("load average before: %s" % (os.getloadavg(),))
     P = pdw.Params.paper_steady()

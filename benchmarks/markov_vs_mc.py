@@ -8,7 +8,7 @@ same i.i.d. heights relative to the stance foot -- so their difference is the ch
 discretizations, measured here one at a time:
 
 1. the step heights: Monte Carlo with each Gaussian height replaced by its bin's conditional
-   mean (`pdw.analysis.markov.dh_nodes`, n_dh bins), paired with the Gaussian walkers (common
+   mean (`pdw.analysis.robust.markov.dh_nodes`, n_dh bins), paired with the Gaussian walkers (common
    random numbers: walker i draws the same normals in both), so the difference of the means
    has a small interval;
 2. the state mesh: the chain against the binned Monte Carlo of the same n_dh (the remaining
@@ -31,9 +31,9 @@ from _results import publish  # noqa: E402
 
 import pdw  # noqa: E402
 from pdw import hybrid as H  # noqa: E402
-from pdw.analysis import first_passage as FP  # noqa: E402
-from pdw.analysis import markov as M  # noqa: E402
-from pdw.analysis import robustness as R  # noqa: E402
+from pdw.analysis.robust import first_passage as FP  # noqa: E402
+from pdw.analysis.robust import markov as M  # noqa: E402
+from pdw.analysis.robust import robustness as R  # noqa: E402
 
 P = pdw.Params.paper_steady()
 SIGMA = 0.002

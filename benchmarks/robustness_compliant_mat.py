@@ -18,8 +18,8 @@ from _results import FIGURES, publish
 from robustness_compliant import gaits_along, with_
 
 import pdw
-from pdw.analysis import robustness_continuous as RC
-from pdw.analysis.robustness_core import returned
+from pdw.analysis.robust import robustness_continuous as RC
+from pdw.analysis.robust.robustness_core import returned
 
 KHIPS = tuple(np.round(np.linspace(0.5, 1.5, 11), 3))
 MATS = tuple(float("%.3g" % m) for m in np.geomspace(3e3, 3e4, 11))

@@ -4,7 +4,7 @@ counterpart of benchmarks/rigid_limit.py (flat ground).
 
 `Params.paper_steady()` with k_n from 1e5 to 1e9 N/m^1.5 and d_n = d_n0 (k_n / k_n0)^(4/3)
 (benchmarks/rigid_limit.py: the stance contact's damping ratio fixed), the ``consistent``
-variant, rodas4 at rtol 1e-8 (`pdw.analysis.robustness_continuous.WALK`), each k from its own
+variant, rodas4 at rtol 1e-8 (`pdw.analysis.robust.robustness_continuous.WALK`), each k from its own
 Newton gait (followed from the previous k), on ``Ground.step(L*/2, -H)``:
 
 * the response: the first ``N_STEPS`` step lengths and step times minus the walker's own gait's,
@@ -14,7 +14,7 @@ Newton gait (followed from the previous k), on ``Ground.step(L*/2, -H)``:
   against the hybrid's.
 
 The figure (docs/figures/terrain_rigid_limit.png): the step-time responses and the errors
-against k_n. The test (`tests/test_terrain_rigid_limit.py`, in `make test`) is the 3-point
+against k_n. The test (`tests/analysis/robust/test_terrain_rigid_limit.py`, in `make test`) is the 3-point
 version of the response part.
 
 Usage: .venv/bin/python benchmarks/terrain_rigid_limit.py [--quick] [--update-docs]
@@ -32,8 +32,8 @@ from _results import FIGURES, publish  # noqa: E402
 
 import pdw  # noqa: E402
 from pdw import hybrid as H  # noqa: E402
-from pdw.analysis import robustness as R  # noqa: E402
-from pdw.analysis import robustness_continuous as RC  # noqa: E402
+from pdw.analysis.robust import robustness as R  # noqa: E402
+from pdw.analysis.robust import robustness_continuous as RC  # noqa: E402
 
 P0 = pdw.Params.paper_steady()
 K_N = (1e5, 3e5, 1e6, 3e6, 1e7, 3e7, 1e8, 3e8, 1e9)

@@ -266,10 +266,10 @@ class ContinuousProblem(_Problem):
         ps = [P for _, P in points]
         if self.executor is not None:
             outs = list(self.executor.map(
-                lambda zp: LC._compose(zp[0], self.period, zp[1], self.variant, self.method,
+                lambda zp: _maps._compose(zp[0], self.period, zp[1], self.variant, self.method,
                                        {**self.opts, "t_hint": self.t_hint}), zip(zs, ps)))
         else:
-            outs = LC.compose_points(zs, self.period, ps, self.variant, self.method,
+            outs = _maps.compose_points(zs, self.period, ps, self.variant, self.method,
                                      {**self.opts, "t_hint": self.t_hint}, self.workers)
         self.n_maps += self.period * len(points)
         return [o[0] for o in outs]

@@ -5,9 +5,9 @@ import pytest
 
 import pdw
 from pdw import hybrid as H
-from pdw.analysis import poincare
 from pdw.analysis.bifurcation.codim2 import continue_bifurcation
 from pdw.analysis.bifurcation.continuation import continue_gait
+from pdw.analysis.stepmap import poincare
 
 DEG = np.pi / 180
 

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 import pdw
-from pdw.analysis import poincare
-from pdw.analysis import variational as V
 from pdw.analysis.bifurcation.continuation import continue_gait
+from pdw.analysis.stepmap import poincare
+from pdw.analysis.stepmap import variational as V
 
 
 @pytest.fixture(scope="module")

@@ -15,8 +15,8 @@ import pytest
 
 import pdw
 from pdw import hybrid as H
-from pdw.analysis import robustness as R
-from pdw.analysis import robustness_continuous as RC
+from pdw.analysis.robust import robustness as R
+from pdw.analysis.robust import robustness_continuous as RC
 
 P0 = pdw.Params.paper_steady()
 HEIGHT = 0.003          # a 3 mm step down (half the hybrid gait's largest, 6.1 mm)

@@ -9,7 +9,7 @@ from scipy.stats import norm
 
 import pdw
 from pdw import hybrid as H
-from pdw.analysis import markov as M
+from pdw.analysis.robust import markov as M
 
 P = pdw.Params.paper_steady()
 
