@@ -377,7 +377,8 @@ def _hip_height(x, params, flags, force=None):
 
 
 def _stance_state(x0, params, flags, foot, force):
-    """One state of `_stance_states` as a search of `_side_by_side`."""
+    """One state of `_stance_states` as a search of `_side_by_side`: the Python reference of
+    `_core.stance_search`, which `_stance_states` calls (tests/sim/test_stance_search.py)."""
     x = np.array(x0, dtype=float)
     x[4] -= float((yield x[None, :]).v_x[0][foot])
     if foot == 1:       # single stance: the stance foot neither sinks nor rises
