@@ -5,7 +5,8 @@ central difference method (issue 23's goals).
   in each round (interleaved), CPU time (time.process_time), medians; ratios to events only;
   peak traced memory (tracemalloc) of each, and the bytes of the samples it records;
 * the first call: `pdw.simulate()` (record_every=0, the default step-size check) in fresh
-  processes, first and second call of each process, CPU time;
+  processes, first and second call of each process, CPU time; and the step check's parts for
+  parameters of no preset in fresh processes;
 * Python around a run: `pdw.simulate` of 2 steps against the compiled loop `_core.run` of the
   same 2 steps (CPU time per call, the difference is the Python set-up and Result assembly).
 
@@ -50,6 +51,22 @@ t = time.process_time(); pdw.simulate(params=P, record=R); t1 = time.process_tim
 pdw.simulate(params=P, record=R); t2 = time.process_time()
 print(t1 - t, t2 - t1)
 """
+
+# the parts of the step check of new parameters in a fresh process (after `import pdw`), CPU
+# time: the representative states, their Jacobians, the stability searches (cut short as in
+# `check_step` at dt = 1e-4), the friction load
+CHECK_PARTS = """
+import time, pdw
+from pdw.sim import stepsize as S
+c = time.process_time
+P = pdw.Params.paper(); P = P.replace(k_n=1.1 * P.k_n)
+t0 = c(); X, fl = S.stance_states(P, "paper"); t1 = c()
+Js = S._state_jacobians(X, P, fl, "paper"); t2 = c()
+S.linear_limits("cdm", Js, enough=lambda h: not 1e-4 > S.CALIBRATION["paper"]["cdm"] * h)
+t3 = c(); S._friction_load(P, "paper"); t4 = c()
+print(t1 - t0, t2 - t1, t3 - t2, t4 - t3)
+"""
+PARTS = ("representative states", "Jacobians", "stability searches", "friction load")
 
 
 def load():
@@ -99,6 +116,9 @@ def first_call(lines):
                                  text=True, check=True).stdout.split()
             firsts.append(float(out[0]))
             seconds.append(float(out[1]))
+    parts = [[float(v) for v in subprocess.run(
+        [sys.executable, "-c", CHECK_PARTS], capture_output=True, text=True,
+        check=True).stdout.split()] for _ in range(FRESH)]
     for kind, (firsts, seconds) in runs.items():
         a, b = statistics.median(firsts), statistics.median(seconds)
         lines.append("  %-44s first %.2f ms, second %.2f ms: first / second = %.2fx (per "
@@ -106,6 +126,10 @@ def first_call(lines):
                                        "Params.paper() with k_n x 1.1 (no preset)", 1e3 * a,
                                        1e3 * b, a / b, ", ".join("%.2f" % (f / s) for f, s
                                                                  in zip(firsts, seconds))))
+    lines.append("  the check of k_n x 1.1 in a fresh process, by part (medians of %d more "
+                 "processes): %s" % (FRESH, ", ".join(
+                     "%s %.3f ms" % (name, 1e3 * statistics.median(p[i] for p in parts))
+                     for i, name in enumerate(PARTS))))
 
 
 def python_overhead(lines, n=2000):

@@ -19,7 +19,7 @@ from cpython.buffer cimport (PyObject_GetBuffer, PyBuffer_Release, PyBUF_C_CONTI
 
 cdef extern from "pdw_model.h":
     enum:
-        PDW_X_Y_O, PDW_X_THETA1, PDW_X_THETA2
+        PDW_X_Y_O, PDW_X_THETA1, PDW_X_THETA2, PDW_X_XD_O, PDW_X_YD_O, PDW_X_THETAD2
         PDW_NX, PDW_NQ, PDW_NP, PDW_NPARAM, PDW_NKIN, PDW_NCONTACT, PDW_NENERGY, PDW_NWORK
         PDW_NKERNELS, PDW_NEVENT, PDW_NREC
         PDW_WORK_TRIG, PDW_WORK_KIN, PDW_WORK_CONTACT, PDW_WORK_M, PDW_WORK_F, PDW_WORK_QDD
@@ -181,6 +181,7 @@ cdef const pdw_kernel *_kernel(int k) except NULL:
 # --- the boundary: every shape is checked once per call, before a pointer is taken -----------
 
 include "_shapes.pxi"
+include "_stepcheck.pxi"
 
 
 cdef int _flags_ok(const int[:, ::1] flags) except -1:

@@ -130,6 +130,24 @@ def step_matrix(method: str, J, h: float) -> np.ndarray:
                             % (method,))
 
 
+def _cdm_maps(Js, hs):
+    """`step_matrix`("cdm", J, h) of each J of Js (n, 8, 8) and h of hs (n,), bit for bit
+    (tests/sim/test_stance_search.py), without its matrix products: with [U_n, U_n-1, U_n-2]
+    the block rows [E Z Z], [Z E Z], [Z Z E], A U_n = [A Z Z] and B (U_n - U_n-2) = [B Z -B]
+    exactly, so the first block row is [2E + h^2 A + h/2 B, -E, -h/2 B] summed in the same
+    order. (n, 12, 12)."""
+    n = len(Js)
+    h2 = (hs * hs)[:, None, None]
+    hb = (0.5 * hs)[:, None, None]
+    Aq, Bv = Js[:, NQ:, :NQ], Js[:, NQ:, NQ:]
+    M = np.zeros((n, 3 * NQ, 3 * NQ))
+    M[:, :NQ, :NQ] = (2.0 * np.eye(NQ) + h2 * Aq) + hb * Bv
+    M[:, :NQ, NQ:2 * NQ] = 0.0 - np.eye(NQ)    # 2 Z - E: +0 off the diagonal
+    M[:, :NQ, 2 * NQ:] = 0.0 + hb * -Bv        # Z + h/2 B (-E): +0 where B is 0
+    M[:, NQ:, :2 * NQ] = np.eye(2 * NQ)
+    return M
+
+
 def _growth(method, J, h):
     return float(np.max(np.abs(np.linalg.eigvals(step_matrix(method, J, h)))))
 
@@ -159,17 +177,18 @@ def linear_limits(method: str, Js, h_lo: float = 1e-10, h_hi: float = 1.0,
     of its limit, not the limit)."""
     if method == "rodas4":
         return [math.inf] * len(Js)
-    Js = [np.asarray(J, dtype=float) for J in Js]
-    searches = []
-    for J in Js:
-        ev = np.linalg.eigvals(J)
-        searches.append(_search(max(0.0, float(np.max(ev.real))), float(np.max(np.abs(ev))),
-                                h_lo, h_hi, rel, enough))
+    Js = np.array(Js, dtype=float).reshape(-1, NX, NX)
+    evs = np.linalg.eigvals(Js)                 # one stacked call, geev per matrix as alone
+    searches = [_search(max(0.0, float(np.max(ev.real))), float(np.max(np.abs(ev))),
+                        h_lo, h_hi, rel, enough) for ev in evs]
     out: list = [None] * len(Js)
     pending = {i: next(g) for i, g in enumerate(searches)}
     while pending:
         idx = list(pending)
-        maps = np.stack([step_matrix(method, Js[i], pending[i]) for i in idx])
+        if method == "cdm":
+            maps = _cdm_maps(Js[idx], np.array([pending[i] for i in idx]))
+        else:
+            maps = np.stack([step_matrix(method, Js[i], pending[i]) for i in idx])
         rhos = np.max(np.abs(np.linalg.eigvals(maps)), axis=1)
         for i, rho in zip(idx, rhos):
             try:
@@ -338,7 +357,7 @@ def _hip_height(x, params, flags, force=None):
         X[:, 1] = y0 - depths
         return X
 
-    d = np.geomspace(1e-9, 0.25 * params.l, 97)
+    d = _depths(params.l)
     for _ in range(3):
         e = (yield grid(d)).F_n.sum(axis=1) - W
         k = int(np.argmax(e > 0))
@@ -358,7 +377,8 @@ def _hip_height(x, params, flags, force=None):
 
 
 def _stance_state(x0, params, flags, foot, force):
-    """One state of `_stance_states` as a search of `_side_by_side`."""
+    """One state of `_stance_states` as a search of `_side_by_side`: the Python reference of
+    `_core.stance_search`, which `_stance_states` calls (tests/sim/test_stance_search.py)."""
     x = np.array(x0, dtype=float)
     x[4] -= float((yield x[None, :]).v_x[0][foot])
     if foot == 1:       # single stance: the stance foot neither sinks nor rises
@@ -415,11 +435,35 @@ def _stance_states(params: Params, variant: str) -> tuple:
     cases = [(x, (0, 1), 1, 1.0) for x in STANCE_STATES] + \
         [(DOUBLE_SUPPORT_STATE, LANDING_FLAGS, 0, DOUBLE_SUPPORT_LOAD)]
     flags = [fl for _, fl, _, _ in cases]
-    out = _side_by_side([_stance_state(x0, params, fl, foot, load * params.weight)
-                         for x0, fl, foot, load in cases], flags, params, variant)
-    X = np.array(out)
+    X = np.array([x for x, _, _, _ in cases], dtype=float)
+    # `_stance_state` of each case in one compiled call, bit for bit (tests/sim/
+    # test_stance_search.py): a fifth of the check's first call in a fresh process (issue 23)
+    _core.stance_search(kernel_index(variant, None), X, parameter_vector(params),
+                        np.array(flags, dtype=np.intc),
+                        np.array([foot for _, _, foot, _ in cases], dtype=np.intc),
+                        np.array([load * params.weight for _, _, _, load in cases]),
+                        _depths(params.l), params.l - params.r, _KI["y_D"], _KI["v_x"], _FN,
+                        len(_layout.KIN), len(_layout.CONTACT))
     X.flags.writeable = False
     return X, tuple(flags)
+
+
+@functools.lru_cache(maxsize=64)
+def _depths(l: float) -> np.ndarray:
+    """The first grid of `_hip_height`: 97 depths, geometric from 1e-9 m to l/4: numpy.geomspace's
+    arithmetic (log10, linspace, power, the end points set), bit for bit (tests/sim/
+    test_stance_search.py), in a fifth of its numpy calls (its first call in a process costs
+    0.15 ms, half the compiled search)."""
+    lo, hi = 1e-9, 0.25 * l
+    ls, le = np.log10(np.array([lo, hi]))
+    y = np.arange(97, dtype=float)
+    y *= (le - ls) / 96
+    y += ls
+    y[-1] = le
+    d = np.power(10.0, y)
+    d[0], d[-1] = lo, hi
+    d.flags.writeable = False
+    return d
 
 
 # --------------------------------------------------------------------------------------------
@@ -539,15 +583,17 @@ def _linear(params: Params, method: str, variant: str):
 @functools.lru_cache(maxsize=1024)
 def _friction_load(params: Params, variant: str) -> float:
     """Largest |F_t without friction| / (mu_s F_n) of the stuck foot at the single-stance states."""
-    X, flags = stance_states(params, variant)
-    P0 = params.replace(mu_s=0.0, mu_d=0.0)
+    X, flags = _stance_states(params, variant)
+    n = len(STANCE_STATES)
+    F = np.array(flags[:n], dtype=np.intc)
+    # two compiled calls for the n states (rows are evaluated independently: bit for bit
+    # what one call per state gives)
+    anchors = np.where(F > 0, _contact(X[:n], params, F, variant).s, 0.0)
+    cs = _contact(X[:n], params.replace(mu_s=0.0, mu_d=0.0), F, variant, anchors)
     load = 0.0
-    for x, fl in zip(X[:len(STANCE_STATES)], flags[:len(STANCE_STATES)]):
-        s = _contact(x, params, fl, variant).s
-        anchors = tuple(float(s[i]) if fl[i] else 0.0 for i in range(2))
-        cs = _contact(x, P0, fl, variant, anchors)
+    for j, fl in enumerate(flags[:n]):
         i = fl.index(1)
-        need, cap = abs(float(cs.F_t[i])), params.mu_s * float(cs.F_n[i])
+        need, cap = abs(float(cs.F_t[j, i])), params.mu_s * float(cs.F_n[j, i])
         load = max(load, need / cap if cap > 0 else (math.inf if need > 0 else 0.0))
     return load
 
@@ -640,8 +686,8 @@ def step_limit(params: Params | None = None, method: str = "cdm", variant: str =
     `CHATTER_CALIBRATION` x the chatter limit where the stuck foot needs `FRICTION_LOAD` of its
     static friction. For dopri5: its explicit bound with friction (the step its controller
     keeps below by itself); for rodas4: inf. Cached per
-    (params, method, variant); about 40 ms the first time (the force's exponents take five
-    more linear limits).
+    (params, method, variant); about 10 ms of CPU the first time, warm (the force's exponents
+    take five more linear limits).
     With another law (``contact``, `pdw.Contact`; ``params`` the run's, contact.parameters(params)),
     a fixed-step method's dt_max is multiplied by the law's factor (`pdw.sim.stepsize_laws`).
     """
@@ -680,9 +726,10 @@ def check_step(dt: float, params: Params, method: str, variant: str, mode: str =
 
     ``mode``: "warn" (a `pdw.StepSizeWarning` when dt > `step_limit`), "error" (raise
     `pdw.StepSizeError` instead), "off". Adaptive methods are not checked (their dt is only
-    the first trial step). Returns the `StepLimit` when dt exceeds it, else None. Costs ~5 ms
-    per new (params, method, variant), nothing after (cached), and nothing for the presets
-    (`PRESET_DT_MAX`).
+    the first trial step). Returns the `StepLimit` when dt exceeds it, else None. Costs ~0.4 ms
+    of CPU per new (params, method, variant) for a dt below the limit (cut short, `_safe`;
+    ~1.4 ms above it, warm; ~0.7 ms more than the presets' first call in a fresh process),
+    nothing after (cached), and nothing for the presets (`PRESET_DT_MAX`).
     """
     if mode not in CHECK_MODES:
         raise InvalidInputError("check_step must be one of %s, got %r"
