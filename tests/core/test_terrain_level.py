@@ -73,3 +73,31 @@ def test_level_path_is_the_general_path_bitwise(name, method, variant):
         assert getattr(a, f).tobytes() == getattr(b, f).tobytes(), f
     assert repr(a.events) == repr(b.events)
 
+
+
+# ---- patches: one contact call with the penetrating foot's parameters (pdw_terrain.c) -------
+
+def _patched(*patches):
+    return Ground.flat(extent=(-2.0, 50.0)).with_patches(list(patches))
+
+
+@pytest.mark.parametrize("contact", [None, {"normal": "flores", "e": 0.5}], ids=["hc", "flores"])
+@pytest.mark.parametrize("method", ["cdm", "rodas4"])
+def test_a_patch_only_a_swing_foot_passes_over_changes_nothing(method, contact):
+    # paper_steady's support feet roll over s in [0.33, 0.48], [0.69, 0.85], [1.06, 1.22]: the
+    # swing foot passes over the patches at [0.54, 0.64] and [0.90, 1.00], no support foot
+    # touches them, so the run is bitwise the one with the patch far away; a kernel that took a
+    # swing foot's parameters for the support foot would differ (k_n 1e3 vs 2e5)
+    kw = dict(params=P, t_end=2.0, limits=pdw.Limits(on_failure="return"), contact=contact)
+    kw.update(method="cdm" if method == "cdm" else None)
+    if method != "cdm":
+        kw["integrator"] = pdw.Integrator(method=method, rtol=1e-8, atol=1e-10)
+    far = pdw.simulate(ground=_patched(dict(s_a=40.0, s_b=41.0, k_n=1e3)), **kw)
+    near = pdw.simulate(ground=_patched(dict(s_a=0.54, s_b=0.64, k_n=1e3),
+                                        dict(s_a=0.90, s_b=1.00, k_n=1e3, mu_s=0.1)), **kw)
+    assert far.n_gait_steps >= 2 and far.event_counts is not None
+    for f in ("t", "x", "flags", "Fn", "Ft"):
+        assert getattr(far, f).tobytes() == getattr(near, f).tobytes(), f
+    # a patch under a support foot does change the run
+    under = pdw.simulate(ground=_patched(dict(s_a=0.70, s_b=0.80, k_n=3e4)), **kw)
+    assert not np.array_equal(under.x, far.x)

@@ -101,6 +101,22 @@ void pdw_terrain_contact(const pdw_kernel *k, const pdw_ground *g, const double 
         return;
     }
     double pi[PDW_NP], ci[2*PDW_NCONTACT];
+    /* Every contact stage writes 0.0 for a foot that is not a penetrating support foot,
+     * whatever p (derive/emit.py _contact_function): with at most one penetrating foot, one call
+     * with that foot's parameters gives both feet's values (single support, the common case) */
+    const int pen0 = flags[0] && kin[PDW_KIN_Y_D] < 0.0;
+    const int pen1 = flags[1] && kin[PDW_NKIN + PDW_KIN_Y_D] < 0.0;
+    if (!(pen0 && pen1)) {
+        const double s = kin[(pen1 ? PDW_NKIN : 0) + PDW_KIN_X_D];
+        if (!(pen0 || pen1) || !pdw_ground_patched(g, s)) {
+            stage(kin, flags, p, contact);
+            return;
+        }
+        memcpy(pi, p, sizeof pi);
+        pdw_ground_params(g, s, p, pi);
+        stage(kin, flags, pi, contact);
+        return;
+    }
     for (int i = 0; i < 2; ++i) {
         const int fl[2] = {i == 0 ? flags[0] : 0, i == 1 ? flags[1] : 0};
         memcpy(pi, p, sizeof pi);
