@@ -68,7 +68,10 @@ class GroundTable:
         mid = 0.5 * (a + b)
         # one-sided values at each cell's ends (the piece of the cell's midpoint)
         va, vb = _knot_values(g, knots, mid)
-        coef = _hermite5(w, va, vb)
+        # + 0.0: every zero coefficient +0 (a -0 becomes +0, the same polynomial): a flat cell's
+        # a_1 .. a_5 are then all bits zero, which the C kernel's level-cell test reads
+        # (pdw_ground.h pdw_ground_cell_level)
+        coef = _hermite5(w, va, vb) + 0.0
         cells = np.column_stack([a, 1.0 / w, coef])
         # arc length: exact values at the knots by Gauss-Legendre on the table's own polynomial,
         # Hermite within the cell from sigma' = sqrt(1 + h'^2), sigma'' = h' h'' / sigma'

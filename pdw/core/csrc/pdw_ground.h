@@ -16,6 +16,7 @@
 #define PDW_GROUND_EVAL_H
 
 #include <math.h>
+#include <string.h>
 #include "pdw_model.h"
 
 typedef struct pdw_ground {
@@ -62,6 +63,20 @@ static inline long pdw_ground_cell_hint(const pdw_ground *g, double s, double *h
     const long k = pdw_ground_cell(g, s);
     *hint = (double)k;
     return k;
+}
+
+/* Is cell k level: a_1 .. a_5 all +0.0 (all bits zero; h = a_0 over the cell: a plane on the
+ * slope, the flat parts of steps and patches)? There, for every finite s, pdw_ground_eval_cell
+ * gives exactly h = a_0 + 0.0 (a_0, or +0 for a_0 = -0) and h' = h'' = +0: each product with a
+ * +0 coefficient is a zero, and a sum with a zero is the other term (+0 when both are zeros,
+ * round to nearest). The coefficients' loads and the test need only k, not s: a predicted
+ * branch the time loops do not wait on. */
+static inline int pdw_ground_cell_level(const pdw_ground *g, long k)
+{
+    const double *a = g->cells + k*PDW_NGCELL + PDW_GCELL_A0;
+    unsigned long long bits = 0, b;
+    for (int j = 1; j < 6; ++j) { memcpy(&b, a + j, sizeof b); bits |= b; }
+    return bits == 0;
 }
 
 /* h, h', h'' at s in cell k into out[0..2]. */

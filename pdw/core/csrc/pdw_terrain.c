@@ -13,7 +13,20 @@
  * a plane, the flat parts of steps and patches) gives 1 exactly without them. */
 static inline void inv_normals(double dh0, double dh1, double *n0, double *n1)
 {
-    if (dh0 == 0.0 && dh1 == 0.0) { *n0 = *n1 = 1.0; return; }    /* flat under both: exact */
+    /* a foot on level ground (h' = 0: a plane on the slope, the flat parts of steps and patches)
+     * gets 1 exactly (1/sqrt(1 + 0)) without waiting for the other foot's square root: a support
+     * foot on a flat part while the swing foot passes an edge (branches, not a blend, so that no
+     * value waits on the other lane) */
+    if (dh0 == 0.0) {
+        *n0 = 1.0;
+        *n1 = dh1 == 0.0 ? 1.0 : 1.0 / sqrt(1.0 + dh1*dh1);
+        return;
+    }
+    if (dh1 == 0.0) {
+        *n0 = 1.0 / sqrt(1.0 + dh0*dh0);
+        *n1 = 1.0;
+        return;
+    }
 #if defined(__SSE2__)
     const __m128d d = _mm_set_pd(dh1, dh0), one = _mm_set1_pd(1.0);
     const __m128d r = _mm_div_pd(one, _mm_sqrt_pd(_mm_add_pd(one, _mm_mul_pd(d, d))));
@@ -47,7 +60,15 @@ void pdw_terrain_kinematics(const pdw_kernel *k, const pdw_ground *g, const doub
     pdw_ground_points(x, trig, p, sA);
     for (int i = 0; i < 2; ++i) {
         double *gi = gnd + i*PDW_NGROUND;
-        pdw_ground_eval_cell(g, pdw_ground_cell_hint(g, sA[i], cell + i), sA[i], e[i]);
+        const long c = pdw_ground_cell_hint(g, sA[i], cell + i);
+        if (pdw_ground_cell_level(g, c) && sA[i] - sA[i] == 0.0) {
+            /* a level cell (finite s): exactly pdw_ground_eval_cell's values (pdw_ground.h),
+             * known before s_A is (the time loop's chain skips u and the quintic) */
+            e[i][0] = g->cells[c*PDW_NGCELL + PDW_GCELL_A0] + 0.0;
+            e[i][1] = e[i][2] = 0.0;
+        } else {
+            pdw_ground_eval_cell(g, c, sA[i], e[i]);
+        }
         gi[PDW_GROUND_H] = e[i][0];
         gi[PDW_GROUND_DH] = e[i][1];
         gi[PDW_GROUND_DDH] = e[i][2];
@@ -80,6 +101,22 @@ void pdw_terrain_contact(const pdw_kernel *k, const pdw_ground *g, const double 
         return;
     }
     double pi[PDW_NP], ci[2*PDW_NCONTACT];
+    /* Every contact stage writes 0.0 for a foot that is not a penetrating support foot,
+     * whatever p (derive/emit.py _contact_function): with at most one penetrating foot, one call
+     * with that foot's parameters gives both feet's values (single support, the common case) */
+    const int pen0 = flags[0] && kin[PDW_KIN_Y_D] < 0.0;
+    const int pen1 = flags[1] && kin[PDW_NKIN + PDW_KIN_Y_D] < 0.0;
+    if (!(pen0 && pen1)) {
+        const double s = kin[(pen1 ? PDW_NKIN : 0) + PDW_KIN_X_D];
+        if (!(pen0 || pen1) || !pdw_ground_patched(g, s)) {
+            stage(kin, flags, p, contact);
+            return;
+        }
+        memcpy(pi, p, sizeof pi);
+        pdw_ground_params(g, s, p, pi);
+        stage(kin, flags, pi, contact);
+        return;
+    }
     for (int i = 0; i < 2; ++i) {
         const int fl[2] = {i == 0 ? flags[0] : 0, i == 1 ? flags[1] : 0};
         memcpy(pi, p, sizeof pi);
@@ -93,8 +130,25 @@ void pdw_terrain_forces(const double *contact, const double *gnd, const double *
                         double *moment)
 {
     double gf[2*PDW_NGFORCE];
-    pdw_ground_forces(contact, gnd, p, gf);
     copy_fresh(cw, contact, 2*PDW_NCONTACT);
+    if (gnd[PDW_GROUND_DH] == 0.0 && gnd[PDW_NGROUND + PDW_GROUND_DH] == 0.0) {
+        /* level under both feet (h' = +0 and 1/N = 1: pdw_terrain_kinematics sets them so):
+         * ground_forces' expressions with dh = 0 and 1/N = 1 written out, each product by 1/N = 1
+         * dropped (x * 1 is x, bit for bit, NaN and signed zeros included): the same values
+         * without the multiplications the forces wait on */
+        const double r = p[PDW_P_R];
+        for (int i = 0; i < 2; ++i) {
+            const double fn = contact[i*PDW_NCONTACT + PDW_CONTACT_F_N];
+            const double ft = contact[i*PDW_NCONTACT + PDW_CONTACT_F_T];
+            const double dh = gnd[i*PDW_NGROUND + PDW_GROUND_DH];
+            const double t0 = -fn*dh + ft, t1 = fn + ft*dh;
+            cw[i*PDW_NCONTACT + PDW_CONTACT_F_N] = t1;
+            cw[i*PDW_NCONTACT + PDW_CONTACT_F_T] = t0;
+            moment[i] = r*(dh*t1 - t0*(1.0 - 1.0));
+        }
+        return;
+    }
+    pdw_ground_forces(contact, gnd, p, gf);
     for (int i = 0; i < 2; ++i) {
         cw[i*PDW_NCONTACT + PDW_CONTACT_F_N] = gf[i*PDW_NGFORCE + PDW_GFORCE_F_Y];
         cw[i*PDW_NCONTACT + PDW_CONTACT_F_T] = gf[i*PDW_NGFORCE + PDW_GFORCE_F_X];
