@@ -160,14 +160,15 @@ def _contact_consts(fname, exprs, soa, c_block):
                                  layout.CONTACT[:len(exprs)], outs), len(names)
 
 
-def _contact_body(fname, extra, code, fields, outs):
-    """The batched contact stage's function around the lane loop's code."""
+def _contact_body(fname, extra, code, fields, outs, void_p=True):
+    """The batched contact stage's function around the lane loop's code (``void_p``: the code
+    may not read p)."""
     store = "\n".join("            c[PDW_CONTACT_%s*PDW_SOA + l] = on ? %s : 0.0;"
                       % (f.upper(), o) for f, o in zip(fields, outs))
     return _function(
         "static void %s(int W, const double *restrict kin, const long long *restrict flags,\n"
         "    const double *restrict p%s, double *restrict contact)" % (fname, extra),
-        "    (void)p;\n"
+        ("    (void)p;\n" if void_p else "") +
         "    for (int i = 0; i < 2; ++i) {\n"
         "        const double *restrict ki = kin + i*PDW_NKIN*PDW_SOA;\n"
         "        double *restrict c = contact + i*PDW_NCONTACT*PDW_SOA;\n"
@@ -200,29 +201,7 @@ def _contact_function(fname, exprs, fields, soa, c_block):
     loads = "".join("            const double %s = %s;\n" % (pre[s_], soa[s_])
                     for s_ in sorted(pre, key=lambda s_: pre[s_]))
     code, _ = c_block(exprs, outs, {**soa, **pre}, indent="            ")
-    code = loads + code
-    store = "\n".join("            c[PDW_CONTACT_%s*PDW_SOA + l] = on ? %s : 0.0;"
-                      % (f.upper(), o) for f, o in zip(fields, outs))
-    return _function(
-        "static void %s(int W, const double *restrict kin, const long long *restrict flags,\n"
-        "    const double *restrict p, double *restrict contact)" % fname,
-        "    for (int i = 0; i < 2; ++i) {\n"
-        "        const double *restrict ki = kin + i*PDW_NKIN*PDW_SOA;\n"
-        "        double *restrict c = contact + i*PDW_NCONTACT*PDW_SOA;\n"
-        "        const long long *restrict fl = flags + i*PDW_SOA;\n"
-        "        for (int l0 = 0; l0 < W; l0 += PDW_SOA_CHUNK) {\n"
-        "        #pragma omp simd\n"
-        "        for (int l = l0; l < l0 + PDW_SOA_CHUNK; ++l) {\n"
-        "            /* mask: a penetrating support foot (the scalar stage's branch) */\n"
-        "            const long long on = (fl[l] != 0) & (ki[PDW_KIN_Y_D*PDW_SOA + l] < 0.0);\n"
-        "            const double delta = -ki[PDW_KIN_Y_D*PDW_SOA + l];\n"
-        "            const double deltad = -ki[PDW_KIN_V_Y*PDW_SOA + l];\n"
-        "            const double v_t = ki[PDW_KIN_V_X*PDW_SOA + l];\n"
-        "            const double xi = ki[PDW_KIN_XI*PDW_SOA + l];\n"
-        "            const double v_in = ki[PDW_KIN_V_IN*PDW_SOA + l];\n"
-        "            (void)delta; (void)deltad; (void)v_t; (void)xi; (void)v_in;\n"
-        "            double %s;\n"
-        "%s\n%s\n        }\n        }\n    }" % (", ".join(outs), code, store))
+    return _contact_body(fname, "", loads + code, fields, outs, void_p=False)
 
 
 HEADER = """\
