@@ -4,7 +4,7 @@ central difference method (issue 23's goals).
 * recording: the run with events only, with full recording and with every 10th state, in turn
   in each round (interleaved), CPU time (time.process_time), medians; ratios to events only;
   peak traced memory (tracemalloc) of each, and the bytes of the samples it records;
-* the first call: `pdw.simulate()` (record_every=0, the default step-size check) in fresh
+* the first call: `pdw.simulate()` (record=Record(every=0), the default step-size check) in fresh
   processes, first and second call of each process, CPU time; and the step check's parts for
   parameters of no preset in fresh processes;
 * Python around a run: `pdw.simulate` of 2 steps against the compiled loop `_core.run` of the
@@ -35,9 +35,9 @@ FRESH = 7
 clock = time.process_time
 SAMPLE = 8 * (1 + _core.NX + 1 + len(_layout.RECORD_CONTACT))
 CASES = [
-    ("events only", dict(record_every=0, record_forces=False)),
-    ("full recording (state, flags, forces every step)", dict(record_every=1, record_forces=True)),
-    ("state every 10th step", dict(record_every=10, record_forces=False)),
+    ("events only", dict(record=pdw.Record(every=0, forces=False))),
+    ("full recording (state, flags, forces every step)", dict(record=pdw.Record(every=1, forces=True))),
+    ("state every 10th step", dict(record=pdw.Record(every=10, forces=False))),
 ]
 # the first and second call of a fresh process: the preset parameters (whose step limits are
 # precomputed, pdw.sim.stepsize_presets) and parameters of no preset (k_n 10 % up: the check
@@ -101,7 +101,7 @@ def recording(lines):
         t = statistics.median(times[label])
         mem, r = peak_memory(params=P, **kw)
         assert r.status == "walked"
-        rec = len(r.t) * (SAMPLE if kw["record_forces"] else SAMPLE - 8 * len(_layout.RECORD_CONTACT))
+        rec = len(r.t) * (SAMPLE if kw["record"].forces else SAMPLE - 8 * len(_layout.RECORD_CONTACT))
         lines.append("%-50s %8.2f %8.1f %8.2fx %11.3f %11.3f" % (
             label, 1e3 * t, 1e9 * t / r.n_steps, t / base, mem / 1e6, rec / 1e6))
 
