@@ -679,8 +679,8 @@ def run(int k, int method, const double[::1] x0, const double[::1] p, int f1, in
     }
 
 
-def _real_states(x, bint allow_rows):
-    """x as a C-contiguous float64 array of shape (8,) (or (N, 8) when allow_rows): real
+def _real_states(x, bint allow_rows, int nx=PDW_NX):
+    """x as a C-contiguous float64 array of shape (nx,) (or (N, nx) when allow_rows): real
     numbers only, no strings, complex, booleans or reshaping (`pdw.core.checks.real_array`;
     finiteness is not checked per call)."""
     if isinstance(x, (str, bytes)):
@@ -691,9 +691,9 @@ def _real_states(x, bint allow_rows):
         raise InvalidInputError("x must be an array of numbers, got %r" % (x,)) from None
     if arr.dtype.kind not in "iuf":
         raise InvalidInputError("x must hold real numbers (not %s)" % arr.dtype)
-    if not (arr.shape == (PDW_NX,) or (allow_rows and arr.ndim == 2 and arr.shape[1] == PDW_NX)):
+    if not (arr.shape == (nx,) or (allow_rows and arr.ndim == 2 and arr.shape[1] == nx)):
         raise InvalidInputError("x must have shape (%d,)%s, got %s"
-                                % (PDW_NX, " or (N, %d)" % PDW_NX if allow_rows else "", arr.shape))
+                                % (nx, " or (N, %d)" % nx if allow_rows else "", arr.shape))
     return np.ascontiguousarray(arr, dtype=np.float64)
 
 

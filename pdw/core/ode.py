@@ -13,6 +13,7 @@ from __future__ import annotations
 from typing import Iterable
 
 from . import _core, _layout, checks
+from .contact import Contact
 from .errors import InvalidInputError
 from .model import check_variant, kernel_index, parameter_vector
 from .params import Params
@@ -47,7 +48,8 @@ def _check_features(features):
 
 def ode_function(params: Params | None = None, variant: str = "paper",
                  flags: tuple[int, int] = (0, 1), anchors: tuple[float, float] = (0.0, 0.0),
-                 features: Iterable[str] | None = None) -> OdeFunction:
+                 features: Iterable[str] | None = None, *, contact=None,
+                 approach_speeds: tuple[float, float] = (0.0, 0.0)) -> OdeFunction:
     """The right-hand side f(t, x) of Eq. A.4 as a fast callable for external solvers.
 
     Parameters
@@ -63,11 +65,21 @@ def ode_function(params: Params | None = None, variant: str = "paper",
         ``consistent`` variant uses them), held fixed.
     features : iterable of str, optional
         Force elements present (``pdw.core._layout.FEATURES``; default all), as in `pdw.simulate`.
+    contact : pdw.Contact, dict or str, optional
+        Contact laws (docs/contact_laws.md; default the paper's, `pdw.Contact`), as in
+        `pdw.simulate`: the compiled f and Jacobian of that law's kernel. Under LuGre friction
+        the state has 10 entries (``f.nx``; the bristle deflections z1, z2 [m] last), and the
+        kernel's Jacobian is a central difference of f (the Coulomb laws' is symbolic).
+    approach_speeds : (float, float)
+        Approach speeds (v_in1, v_in2) [m/s] captured at each foot's touch-down, held fixed;
+        only the lankarani_nikravesh and flores laws read them (through
+        max(v_in, contact.v_in_min)).
 
     Returns
     -------
     OdeFunction
-        ``f(t, x)`` -> ndarray (8,) for a float64 state x of shape (8,) [m, rad, m/s, rad/s]
+        ``f(t, x)`` -> ndarray (nx,) for a float64 state x of shape (nx,) [m, rad, m/s, rad/s]
+        (nx = 8, 10 under LuGre friction)
         (t is ignored: the model is autonomous); ``f.jac(t, x)`` -> (8, 8). Both return a
         fresh array every call (a copy of an internal buffer): keeping it is safe, as
         ``solve_ivp`` does;
@@ -101,7 +113,18 @@ def ode_function(params: Params | None = None, variant: str = "paper",
         raise InvalidInputError(str(e)) from None
     feats = _check_features(features)
     (f1, f2), (a1, a2) = _check_discrete(flags, anchors)
-    k = kernel_index(variant, feats)
-    p = parameter_vector(params if feats == _layout.FEATURES else params.without(feats))
-    return OdeFunction(k, p, f1, f2, a1, a2)
+    v = checks.real_array("approach_speeds", approach_speeds, [(2,)])
+    law = Contact.coerce(contact).for_features(feats)
+    if law.is_default:
+        k = kernel_index(variant, feats)
+        p = parameter_vector(params if feats == _layout.FEATURES else params.without(feats))
+    else:                           # as `pdw.simulate` builds the kernel's parameters
+        params = law.parameters(params)
+        k = kernel_index(variant, feats, law.normal, law.friction)
+        if feats != _layout.FEATURES:
+            params = params.without(feats)
+        p = law.vector(parameter_vector(params), feats, params)
+    f = OdeFunction(k, p, f1, f2, a1, a2)
+    f.set_discrete(f1, f2, a1, a2, (float(v[0]), float(v[1])))
+    return f
 

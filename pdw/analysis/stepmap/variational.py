@@ -26,10 +26,26 @@ arming, Eq. 11's gates), then (x, Phi) from each interval's start to its end by 
 spring-damper of Eqs. 7, 11 does not vanish with it): f- and f+ are the one-sided limits
 (f 1e-9 s before and after the event), not f on the surface.
 
-Scope: the paper variant (the consistent variant's tangential anchors are not differentiated)
-and the default laws (`pdw.ode_function` has no contact argument). Slower than the finite
-differences (one Python integration of 72 equations), so not the continuation's default: it
-is the cross-check of `tests/analysis/stepmap/test_continuation_variational.py` and of a user's doubts near a kink.
+Every contact law with Coulomb friction (`pdw.Contact`: hunt_crossley, hertz, kelvin_voigt,
+lankarani_nikravesh, flores; ``contact=``), through `pdw.ode_function`'s compiled f and
+symbolic Jacobian of that law's kernel. The saltation matrices are built from the one-sided
+limits of f, so a law's own jump needs no special code: Hunt-Crossley, Hertz,
+Lankarani-Nikravesh and Flores give zero normal force at zero penetration (their force is
+continuous at touch-down; the jump of f there is the tangential spring-damper's alone),
+Kelvin-Voigt's force jumps by d * delta_dot at touch-down (d [N s/m] times the landing rate).
+lankarani_nikravesh and flores damp with the approach speeds v_in (captured at each foot's
+touch-down, held until the next; docs/contact_laws.md): the state is augmented with
+(v_in1, v_in2) (v_in' = 0), the touch-down resets v_in_i = -v_i (the foot's normal rate), its
+saltation carries that reset, df/dv_in is a central difference of the compiled f (a smooth
+function of v_in; relative error ~1e-9), and the section's seventh coordinate v_in1 (the
+trailing foot's approach speed, `pdw.analysis.stepmap.section`) is differentiated with the
+rest. LuGre friction is refused: its kernel's Jacobian is itself a central difference (not
+exact) and its bristle states reset at touch-down; use finite differences there.
+
+Scope: the paper variant (the consistent variant's tangential anchors are not differentiated).
+Slower than the finite differences (one Python integration of 72 equations, 110 with approach
+speeds; benchmarks/bench_monodromy.py), so not the continuation's default: it is the
+cross-check of `GaitMap.crosscheck` and of a user's doubts near a kink.
 """
 from __future__ import annotations
 
@@ -37,6 +53,7 @@ import math
 
 import numpy as np
 
+from ...core.contact import Contact
 from ...core.errors import InvalidInputError
 from ...core.ode import ode_function
 from ...core.params import Params
@@ -67,11 +84,21 @@ def _rate(x, leg, p):
     return v, grad
 
 
+#: event functions with a crossing direction d are shifted by -d x this (their units: m, m/s,
+#: rad): an interval that starts exactly on a surface (g = 0.0 at the last event's state) then
+#: does not report that start as the next crossing (brentq returns the bracket's end where g
+#: is exactly 0: a Kelvin-Voigt foot re-entering the ground and bouncing out 1 ms later
+#: reported the bounce at t0)
+EVENT_SHIFT = 1e-14
+
+
 def _event(fn, direction):
     """A terminal event function of solve_ivp with its crossing direction."""
-    fn.terminal = True
-    fn.direction = direction
-    return fn
+    def ev(t, x):
+        return fn(t, x) - direction * EVENT_SHIFT
+    ev.terminal = True
+    ev.direction = direction
+    return ev
 
 
 def _embed_jac(z, p):
@@ -84,20 +111,108 @@ def _embed_jac(z, p):
     return E
 
 
+class _Field:
+    """f and df/dy of the state y = (x, v_in1, v_in2) (the approach speeds only where the law
+    uses them, ``na`` = 2; else y = x): v_in' = 0, f reads v_in as held speeds."""
+
+    def __init__(self, f, na, params):
+        self.f, self.na, self.n, self.params = f, na, N + na, params
+        self.flags = [1, 1]
+
+    def _set(self, y):
+        if self.na:
+            self.f.set_discrete(self.flags[0], self.flags[1], 0.0, 0.0,
+                                (float(y[N]), float(y[N + 1])))
+
+    def __call__(self, t, y):
+        if not self.na:
+            return self.f(t, y)
+        self._set(y)
+        return np.concatenate([self.f(t, y[:N]), np.zeros(self.na)])
+
+    def jac(self, t, y):
+        if not self.na:
+            return self.f.jac(t, y)
+        self._set(y)
+        A = np.zeros((self.n, self.n))
+        x = np.ascontiguousarray(y[:N])
+        A[:N, :N] = self.f.jac(t, x)
+        for j in range(self.na):        # df/dv_in: a central difference (module docstring)
+            h = 1e-6 * max(1.0, abs(y[N + j]))
+            yp, ym = y.copy(), y.copy()
+            yp[N + j] += h
+            ym[N + j] -= h
+            self._set(yp)
+            fp = self.f(t, x)
+            self._set(ym)
+            A[:N, N + j] = (fp - self.f(t, x)) / (2 * h)
+        self._set(y)
+        return A
+
+    def set_flags(self, f1, f2):
+        self.flags[0], self.flags[1] = f1, f2      # in place: the caller holds the list
+        self.f.set_discrete(f1, f2, 0.0, 0.0)
+
+
+#: the one-sided limits f- and f+ are f at the event state moved across the surface, along
+#: grad h, to h = -/+ this (h the event function: m, m/s or rad). Moving along f by 1e-9 s
+#: instead (the first version) changed M by 0.2 at Kelvin-Voigt's gait, whose f varies by
+#: J f tau there (1e-7 s: by 19); 1e-11 s gave 2e-3: the limits must be taken at the point.
+LIMIT_OFFSET = 1e-12
+
+
+def _across(y, grad, h, side):
+    """y moved along grad (8,) to the event function's value side x LIMIT_OFFSET (h: its value
+    at y)."""
+    yy = y.copy()
+    yy[:N] += (side * LIMIT_OFFSET - h) * grad / (grad @ grad)
+    return yy
+
+
+def _saltation(F, y, grad_x, h, change):
+    """(S, y+) at a switching surface h = 0 with gradient ``grad_x`` (8,) at y (h: its value
+    at y, ~0): ``change()`` applies the discrete change (flags; returns the touch-down leg
+    whose approach speed resets, or None). S = D + (f+ - D f-) grad^T / (grad . f-), D the
+    reset's Jacobian (the identity but for a reset v_in_i = -v_i(x)); f- and f+ the one-sided
+    limits (`LIMIT_OFFSET`: f at the surface itself is neither side's). The side a state is
+    on before the event is the sign of -grad . f (the crossing direction)."""
+    n = F.n
+    fy = F(0.0, y)
+    d = 1.0 if grad_x @ fy[:N] > 0 else -1.0      # crossing upwards (h: - to +) or down
+    f_minus = F(0.0, _across(y, grad_x, h, -d))
+    grad = np.zeros(n)
+    grad[:N] = grad_x
+    leg = change()
+    D = np.eye(n)
+    y_plus = y.copy()
+    if leg is not None and F.na:
+        v, gv = _rate(y, leg, F.params)
+        y_plus[N + leg] = -v
+        D[N + leg, :] = 0.0
+        D[N + leg, :N] = -gv
+    f_plus = F(0.0, _across(y_plus, grad_x, h, d))
+    S = D + np.outer(f_plus - D @ f_minus, grad) / (grad @ f_minus)
+    return S, y_plus
+
+
 def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
-                  rtol: float = 1e-10, atol: float = 1e-12, phi_rtol: float = 1e-10,
-                  t_max: float = 2.5,
+                  contact=None, rtol: float = 1e-10, atol: float = 1e-12,
+                  phi_rtol: float = 1e-10, t_max: float = 2.5,
                   max_events: int = 12) -> dict:
     """One step of the touch-down map and its exact Jacobian (module docstring).
 
     Parameters
     ----------
-    z : array_like (6,)
-        Section point (`pdw.analysis.stepmap.section.SECTION`).
+    z : array_like (6,) or (7,)
+        Section point (`pdw.analysis.stepmap.section.section_names` of ``contact``: six
+        coordinates, seven with the approach-speed laws).
     params : Params
         Default `Params.paper_steady()`.
     variant : {"paper"}
         Only the paper variant.
+    contact : pdw.Contact, dict or str, optional
+        Contact laws (default the paper's); every normal law with Coulomb friction; LuGre
+        friction raises `pdw.InvalidInputError`.
     rtol, atol : float
         Radau tolerances of the trajectory x.
     phi_rtol : float
@@ -106,31 +221,68 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
     Returns
     -------
     dict
-        ``z`` (z' (6,)), ``M`` (6, 6) dP/dz, ``T`` (the step time [s]), ``events`` (list of
-        (t, kind, leg) of the flag switches and gates), ``saltations`` (their S_k), ``x`` (the
-        state at the touch-down, legs not relabelled), ``dx_dz`` (8, 6) and ``Phi`` (8, 8).
+        ``z`` (z' (nz,)), ``M`` (nz, nz) dP/dz, ``T`` (the step time [s]), ``events`` (list of
+        (t, kind, leg) of the flag switches and gates), ``saltations`` (their S_k, (n, n) with
+        n = 8, or 10 with approach speeds), ``x`` (the state at the touch-down, legs not
+        relabelled), ``dx_dz`` (n, nz) and ``Phi`` (n, n).
     """
     from scipy.integrate import solve_ivp
     if variant != "paper":
         raise InvalidInputError("variational step_jacobian: only variant='paper', got %r"
                                 % (variant,))
+    law = Contact.coerce(contact)
+    if law.friction != "coulomb":
+        raise InvalidInputError(
+            "variational step_jacobian: contact.friction=%r is not supported (LuGre's kernel "
+            "has a central-difference Jacobian and bristle states reset at touch-down): use "
+            "the finite-difference monodromy (monodromy='differences')" % law.friction)
     p = _section._params(params)
-    z = _section.check_z(z)
-    x0 = _section.embed(z, p)
-    flags = [1, 1]
-    x, Phi = x0.copy(), np.eye(N)
+    z = _section.check_z(z, contact=law)
+    x0, v_in0 = _section.start(z, p, law, variant)
+    na = 0 if v_in0 is None else 2
+    nz = len(z)
+    f = ode_function(p, variant, flags=(1, 1), contact=law,
+                     approach_speeds=v_in0 if na else (0.0, 0.0))
+    F = _Field(f, na, p)
+    n = F.n
+    y = np.concatenate([x0, v_in0]) if na else x0.copy()
+    E = np.zeros((n, nz))
+    E[:N, :6] = _embed_jac(z, p)
+    if na:
+        if z[6] > 0.0:
+            E[N, 6] = 1.0
+        v2, gv2 = _rate(x0, 1, p)
+        if -v2 > 0.0:
+            E[N + 1, :] = -gv2 @ E[:N, :]
+    Phi = np.eye(n)
     t0, events, salts = 0.0, [], []
-    f = ode_function(p, variant, flags=(1, 1))
+    flags = F.flags
 
     def aug_rhs(t, yy):
-        xx = yy[:N]
-        return np.concatenate([f(t, xx), (f.jac(t, xx) @ yy[N:].reshape(N, N)).ravel()])
+        yv = yy[:n]
+        return np.concatenate([F(t, yv), (F.jac(t, yv) @ yy[n:].reshape(n, n)).ravel()])
 
     armed = [False, True]       # a swing foot touches down only ahead of the other one
     gate_dir = [0.0, 0.0]       # after a gate crossing only the opposite one (not t0 again)
     # a support foot above the ground whose normal rate is not yet > 0: Eq. 18a lifts it off
     # only when v > 0 too, so until then it stays support (flag 1) with no penetration force
     pending = [False, False]
+    # the trailing foot may start above the ground, still sinking (v <= 0): a damped law that
+    # pulls no force (Kelvin-Voigt's clamp) let it rise before the section; the loop keeps it
+    # support until v > 0, so it starts pending
+    g1, v1 = _foot(y, 0, p)[0], _rate(y, 0, p)[0]
+    if g1 > 0.0:
+        if v1 > 0.0:
+            raise InvalidInputError("variational step_jacobian: the trailing foot starts above "
+                                    "the ground and rising (height %.3g m, rate %.3g m/s): "
+                                    "it lifts off at the section itself" % (g1, v1))
+        pending[0] = True
+
+    def switch(leg, on):
+        def change():
+            F.set_flags(*[on if i == leg else flags[i] for i in (0, 1)])
+            return leg if on else None
+        return change
 
     for _ in range(max_events):
         evs = []
@@ -149,9 +301,9 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
         for leg in (0, 1):          # a pending foot back into the ground: contact again
             evs.append(_event(lambda t, xx, leg=leg, on=pending[leg]:
                               _foot(xx, leg, p)[0] if on else 1.0, -1.0))
-        x_start = x.copy()
-        sol = solve_ivp(f, (t0, t_max), x, method="Radau", rtol=rtol, atol=atol, jac=f.jac,
-                        events=evs, dense_output=True)
+        y_start = y.copy()
+        sol = solve_ivp(F, (t0, t_max), y, method="Radau", rtol=rtol, atol=atol, jac=F.jac,
+                        events=evs)
         if sol.status == -1:
             raise InvalidInputError("variational step_jacobian: integration failed: %s"
                                     % sol.message)
@@ -160,87 +312,75 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
             raise InvalidInputError("variational step_jacobian: no touch-down by t_max = %g s"
                                     % t_max)
         t_ev, k_ev = min(hits)
-        x = sol.y_events[k_ev][0].copy()
+        y = sol.y_events[k_ev][0].copy()
         leg = k_ev % 2
-        # the variational equations along this interval's dense trajectory
-        ph = solve_ivp(aug_rhs, (t0, t_ev), np.concatenate([x_start, Phi.ravel()]),
+        # the variational equations along this interval
+        ph = solve_ivp(aug_rhs, (t0, t_ev), np.concatenate([y_start, Phi.ravel()]),
                        method="LSODA", rtol=phi_rtol, atol=phi_rtol * 1e-2)
         if ph.status != 0:
             raise InvalidInputError("variational step_jacobian: variational equations "
                                     "failed: %s" % ph.message)
-        Phi = ph.y[N:, -1].reshape(N, N)
+        Phi = ph.y[n:, -1].reshape(n, n)
+        t0 = t_ev
         if k_ev >= 4 or (k_ev < 2 and flags[leg] and pending[leg]):
             # a pending foot's normal rate through 0 (the lift-off, Eq. 18a: the flag-gated
             # forces stop) or its height back through 0 (the penetration force returns)
-            fx = f(t_ev, x)
-            tau = 1e-9
-            f_minus = f(t_ev, x - tau * fx)
             if k_ev < 2:
-                _, grad = _rate(x, leg, p)
-                flags[leg] = 0
+                h, grad = _rate(y, leg, p)
+                change = switch(leg, 0)
                 armed[leg] = False
-                f.set_discrete(flags[0], flags[1], 0.0, 0.0)
                 events.append((t_ev, "lift_off", leg + 1))
             else:
-                _, grad, _ = _foot(x, leg, p)
+                h, grad, _ = _foot(y, leg, p)
+                change = lambda: None   # noqa: E731
+                events.append((t_ev, "reentry", leg + 1))
             pending[leg] = False
-            f_plus = f(t_ev, x + tau * fx)
-            S = np.eye(N) + np.outer(f_plus - f_minus, grad) / (grad @ f_minus)
+            S, y = _saltation(F, y, grad, h, change)
             Phi = S @ Phi
             salts.append(S)
-            t0 = t_ev
             continue
         if k_ev >= 2:               # a gate of the force law: f jumps, the flags stay
             grad = np.zeros(N)
             grad[2 + leg] = 1.0
-            fx = f(t_ev, x)
-            tau = 1e-9
-            f_minus, f_plus = f(t_ev, x - tau * fx), f(t_ev, x + tau * fx)
-            S = np.eye(N) + np.outer(f_plus - f_minus, grad) / (grad @ f_minus)
+            S, y = _saltation(F, y, grad, y[2 + leg], lambda: None)
             Phi = S @ Phi
             events.append((t_ev, "gate", leg + 1))
-            gate_dir[leg] = 1.0 if x[6 + leg] < 0 else -1.0
+            gate_dir[leg] = 1.0 if y[6 + leg] < 0 else -1.0
             salts.append(S)
-            t0 = t_ev
             continue
         if not flags[leg] and not armed[leg]:       # armed: no flag switch, no saltation
             armed[leg] = True
-            t0 = t_ev
             continue
-        g, grad, xd = _foot(x, leg, p)
-        # one-sided limits: the contact force jumps where the penetration reaches 0 (Eq. 11's
-        # tangential spring-damper does not vanish with it), so f at the surface itself is
-        # neither side's
-        tau = 1e-9
-        fx = f(t_ev, x)
-        f_minus = f(t_ev, x - tau * fx)
+        h, grad, _ = _foot(y, leg, p)
         if not flags[leg] and leg == 0:
-            # leg 1's touch-down ahead of leg 2: the section
-            S = np.eye(N) - np.outer(f_minus, grad) / (grad @ f_minus)
-            R = np.zeros((6, N))
+            # leg 1's touch-down ahead of leg 2: the section (the projection S_T; the flags
+            # and leg 1's approach speed after it are the next step's)
+            f_minus = F(t_ev, _across(y, grad, h, 1.0))   # above the ground: before
+            g = np.zeros(n)
+            g[:N] = grad
+            S = np.eye(n) - np.outer(f_minus, g) / (g @ f_minus)
+            R = np.zeros((nz, n))
             for i, j in enumerate((3, 2, 4, 5, 7, 6)):
                 R[i, j] = 1.0
-            M = R @ S @ Phi @ _embed_jac(z, p)
-            return {"z": R @ x, "M": M, "T": t_ev, "events": events, "saltations": salts,
-                    "x": x, "dx_dz": S @ Phi @ _embed_jac(z, p), "Phi": Phi}
-        if flags[leg] and _rate(x, leg, p)[0] <= 0.0:
+            if na:
+                R[6, N + 1] = 1.0   # the trailing foot's approach speed: leg 2's held one
+            M = R @ S @ Phi @ E
+            return {"z": R @ y, "M": M, "T": t_ev, "events": events, "saltations": salts,
+                    "x": y[:N].copy(), "dx_dz": S @ Phi @ E, "Phi": Phi}
+        if flags[leg] and _rate(y, leg, p)[0] <= 0.0:
             # above the ground but not yet rising (Eq. 18a): the penetration force ends, the
             # flag stays 1 until v > 0
             pending[leg] = True
-            f_plus = f(t_ev, x + tau * fx)
-            S = np.eye(N) + np.outer(f_plus - f_minus, grad) / (grad @ f_minus)
+            events.append((t_ev, "rise", leg + 1))
+            S, y = _saltation(F, y, grad, h, lambda: None)
             Phi = S @ Phi
             salts.append(S)
-            t0 = t_ev
             continue
-        flags[leg] = 0 if flags[leg] else 1
+        on = 0 if flags[leg] else 1
+        S, y = _saltation(F, y, grad, h, switch(leg, on))
         armed[leg] = False
-        f.set_discrete(flags[0], flags[1], 0.0, 0.0)
-        f_plus = f(t_ev, x + tau * fx)
-        S = np.eye(N) + np.outer(f_plus - f_minus, grad) / (grad @ f_minus)
         Phi = S @ Phi
-        events.append((t_ev, "touch_down" if flags[leg] else "lift_off", leg + 1))
+        events.append((t_ev, "touch_down" if on else "lift_off", leg + 1))
         salts.append(S)
-        t0 = t_ev
     raise InvalidInputError("variational step_jacobian: more than %d flag switches in one step"
                             % max_events)

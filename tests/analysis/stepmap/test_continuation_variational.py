@@ -27,7 +27,7 @@ def test_step_and_exact_jacobian_match_the_compiled_map_and_its_differences(stea
     J, Pz, _ = LC.jacobian(z, P, **LC.TIGHT)
     assert np.max(np.abs(r["z"] - Pz)) < 1e-9
     assert r["T"] == pytest.approx(g.period, abs=1e-9)
-    assert [e[1] for e in r["events"]][0] == "lift_off"
+    assert [e[1] for e in r["events"] if e[1] not in ("rise", "reentry")][0] == "lift_off"
     assert np.max(np.abs(r["M"] - J)) < 1e-4 * max(1.0, np.abs(J).max())
     m = np.linalg.eigvals(r["M"])
     m = m[np.argsort(-np.abs(m))]
