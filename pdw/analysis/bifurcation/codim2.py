@@ -306,19 +306,26 @@ class AugmentedProblem:
         P_mu2 = (ims[b0 + 2] - ims[b0 + 5]) / h2
         return ds, dsig2, P_mu2
 
+    def _bordered(self, z, mu1, mu2):
+        """The base map at (z, mu1, mu2) and its bordered (sigma, v, w), or a failed Evaluation."""
+        ev = self._base_eval(z, mu1, mu2, True)
+        if not ev.ok:
+            return ev, Evaluation(False, ev.status)
+        try:
+            return ev, self._sigma(ev.M)
+        except np.linalg.LinAlgError:
+            return ev, Evaluation(False, "singular bordered matrix")
+
     def evaluate(self, x, mu2, jac=True) -> Evaluation:
         if self.kind == "end":
             return self._evaluate_end(x, mu2, jac)
         if self.second == "directional":
             return self._evaluate_directional(x, mu2, jac)
         z, mu1 = np.asarray(x[:-1], dtype=float), float(x[-1])
-        ev = self._base_eval(z, mu1, mu2, True)
-        if not ev.ok:
-            return Evaluation(False, ev.status)
-        try:
-            sigma, v, w = self._sigma(ev.M)
-        except np.linalg.LinAlgError:
-            return Evaluation(False, "singular bordered matrix")
+        ev, bordered = self._bordered(z, mu1, mu2)
+        if isinstance(bordered, Evaluation):
+            return bordered
+        sigma, v, w = bordered
         n = len(z)
         F = np.concatenate([ev.Pz - z, [self.kappa * sigma]])
         Mt = Pt = None
@@ -357,13 +364,10 @@ class AugmentedProblem:
 
     def _evaluate_directional(self, x, mu2, jac) -> Evaluation:
         z, mu1 = np.asarray(x[:-1], dtype=float), float(x[-1])
-        ev = self._base_eval(z, mu1, mu2, True)
-        if not ev.ok:
-            return Evaluation(False, ev.status)
-        try:
-            sigma, v, w = self._sigma(ev.M)
-        except np.linalg.LinAlgError:
-            return Evaluation(False, "singular bordered matrix")
+        ev, bordered = self._bordered(z, mu1, mu2)
+        if isinstance(bordered, Evaluation):
+            return bordered
+        sigma, v, w = bordered
         n = len(z)
         F = np.concatenate([ev.Pz - z, [self.kappa * sigma]])
         Mt = Pt = None
