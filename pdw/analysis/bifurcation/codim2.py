@@ -266,10 +266,10 @@ class AugmentedProblem:
         self.p1.base = self._with2(mu2)
         return self.p1.params_at(mu1)
 
-    def _directional(self, z, mu1, mu2, v, w):
+    def _directional(self, z, mu1, mu2, v, w, ev=None):
         """d sigma / d(z, mu1) (n + 1,), d sigma / d mu2 and dP / d mu2 from central
         differences of S(x) = w^T (P(z + e v^) - P(z - e v^)) / 2e |v| = w^T M v, all maps of
-        one batch (`images`): no monodromy but the base point's."""
+        one batch (`images`): no monodromy but the base point's (``ev``, unused here)."""
         n = len(z)
         nv = float(np.linalg.norm(v))
         vh, e = v / nv, self.h
@@ -319,8 +319,6 @@ class AugmentedProblem:
     def evaluate(self, x, mu2, jac=True) -> Evaluation:
         if self.kind == "end":
             return self._evaluate_end(x, mu2, jac)
-        if self.second == "directional":
-            return self._evaluate_directional(x, mu2, jac)
         z, mu1 = np.asarray(x[:-1], dtype=float), float(x[-1])
         ev, bordered = self._bordered(z, mu1, mu2)
         if isinstance(bordered, Evaluation):
@@ -330,50 +328,9 @@ class AugmentedProblem:
         F = np.concatenate([ev.Pz - z, [self.kappa * sigma]])
         Mt = Pt = None
         if jac:
-            # P_mu2 by a central difference in lambda2
-            up, down = self._mu2_offsets(mu2)
-            h2 = up - down
-            e_hi = self._base_eval(z, mu1, mu2 + up, True) if up else ev
-            e_lo = self._base_eval(z, mu1, mu2 + down, True) if down else ev
-            if not (e_hi.ok and e_lo.ok):
-                return Evaluation(False, "parameter derivative: %s"
-                                  % (e_hi.status if not e_hi.ok else e_lo.status))
-            P_mu2 = (e_hi.Pz - e_lo.Pz) / h2
-            dA_mu2 = (self._A(e_hi.M) - self._A(e_lo.M)) / h2
-            # d sigma / dz_k and d sigma / d mu1 from central differences of M
-            ds = np.zeros(n + 1)
-            for k in range(n + 1):
-                d = np.zeros(n + 1)
-                d[k] = self.h
-                lo = self._base_eval(z - d[:n], mu1 - d[n], mu2, True)
-                hi = self._base_eval(z + d[:n], mu1 + d[n], mu2, True)
-                if not (lo.ok and hi.ok):
-                    return Evaluation(False, "second derivative: %s"
-                                      % (hi.status if not hi.ok else lo.status))
-                ds[k] = -w @ ((self._A(hi.M) - self._A(lo.M)) / (2 * self.h)) @ v
-            J = np.zeros((n + 1, n + 1))
-            J[:n, :n] = ev.M - np.eye(n)
-            J[:n, n] = ev.P_lam
-            J[n, :] = self.kappa * ds
-            Mt = np.eye(n + 1) + J
-            Pt = np.concatenate([P_mu2, [-self.kappa * (w @ dA_mu2 @ v)]])
-        m = np.linalg.eigvals(ev.M)
-        info = dict(ev.info, base_multipliers=m[np.argsort(-np.abs(m))], sigma=sigma,
-                    value1=self.p1.value(mu1), M=ev.M)
-        return Evaluation(True, "ok", x + F, Mt, Pt, info, dict(ev.admissible))
-
-    def _evaluate_directional(self, x, mu2, jac) -> Evaluation:
-        z, mu1 = np.asarray(x[:-1], dtype=float), float(x[-1])
-        ev, bordered = self._bordered(z, mu1, mu2)
-        if isinstance(bordered, Evaluation):
-            return bordered
-        sigma, v, w = bordered
-        n = len(z)
-        F = np.concatenate([ev.Pz - z, [self.kappa * sigma]])
-        Mt = Pt = None
-        if jac:
+            second = self._directional if self.second == "directional" else self._by_monodromy
             try:
-                ds, dsig2, P_mu2 = self._directional(z, mu1, mu2, v, w)
+                ds, dsig2, P_mu2 = second(z, mu1, mu2, v, w, ev)
             except _Fail as err:
                 return Evaluation(False, str(err))
             J = np.zeros((n + 1, n + 1))
@@ -386,6 +343,31 @@ class AugmentedProblem:
         info = dict(ev.info, base_multipliers=m[np.argsort(-np.abs(m))], sigma=sigma,
                     value1=self.p1.value(mu1), M=ev.M)
         return Evaluation(True, "ok", x + F, Mt, Pt, info, dict(ev.admissible))
+
+    def _by_monodromy(self, z, mu1, mu2, v, w, ev):
+        """(d sigma/d(z, mu1), d sigma/d mu2, dP/d mu2) from central differences of M (the
+        monodromies of 2 (n + 2) more maps)."""
+        n = len(z)
+        # P_mu2 by a central difference in lambda2
+        up, down = self._mu2_offsets(mu2)
+        h2 = up - down
+        e_hi = self._base_eval(z, mu1, mu2 + up, True) if up else ev
+        e_lo = self._base_eval(z, mu1, mu2 + down, True) if down else ev
+        if not (e_hi.ok and e_lo.ok):
+            raise _Fail("parameter derivative: %s" % (e_hi.status if not e_hi.ok else e_lo.status))
+        P_mu2 = (e_hi.Pz - e_lo.Pz) / h2
+        dA_mu2 = (self._A(e_hi.M) - self._A(e_lo.M)) / h2
+        # d sigma / dz_k and d sigma / d mu1 from central differences of M
+        ds = np.zeros(n + 1)
+        for k in range(n + 1):
+            d = np.zeros(n + 1)
+            d[k] = self.h
+            lo = self._base_eval(z - d[:n], mu1 - d[n], mu2, True)
+            hi = self._base_eval(z + d[:n], mu1 + d[n], mu2, True)
+            if not (lo.ok and hi.ok):
+                raise _Fail("second derivative: %s" % (hi.status if not hi.ok else lo.status))
+            ds[k] = -w @ ((self._A(hi.M) - self._A(lo.M)) / (2 * self.h)) @ v
+        return ds, -(w @ dA_mu2 @ v), P_mu2
 
     def accept(self, pt) -> None:
         """Refresh the border vectors a, b at an accepted point (BifurcationKit's
