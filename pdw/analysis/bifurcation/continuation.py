@@ -210,6 +210,14 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
     TF.select(detect, events)
     prob = _problem(params, parameter, model, variant, period, params_of, log, options,
                     executor, workers, fd_step)
+    law = getattr(getattr(prob, "contact", None), "normal", None)
+    if model == "continuous" and params_of is None and law == "kelvin_voigt" \
+            and parameter in ("k_n", "d_n"):
+        # kelvin_voigt takes its k, d from the Contact (other units), never Params' k_n, d_n:
+        # the branch would vary nothing
+        raise InvalidInputError("parameter %r is not read by the kelvin_voigt law (its "
+                                "stiffness and damping are Contact.k [N/m] and Contact.d "
+                                "[N s/m]); continue in a parameter the law reads" % parameter)
     if monodromy not in ("differences", "exact"):
         raise InvalidInputError("monodromy must be 'differences' or 'exact', got %r"
                                 % (monodromy,))

@@ -192,3 +192,11 @@ def test_kelvin_voigt_period_doubling_located_at_109_745_and_stall_stop():
     assert pd.located and 109.70 < pd.value < 109.75
     assert np.min(np.abs(pd.multipliers + 1.0)) < 1e-3
     assert b.stop_reason.startswith("stalled") and len(b) < 30
+
+
+def test_a_parameter_kelvin_voigt_does_not_read_is_refused():
+    """Contact("kelvin_voigt") takes k, d from the Contact, never Params' k_n, d_n: continuing
+    in d_n varied nothing (the same multiplier -1.44936 at every d_n) and ended "reached stop"."""
+    with pytest.raises(pdw.InvalidInputError, match="not read by the kelvin_voigt law"):
+        continue_gait(pdw.Params.paper_steady(), "d_n", 110.2, step=0.1, max_points=3,
+                      options=dict(contact=pdw.Contact("kelvin_voigt")))
