@@ -81,7 +81,7 @@ def test_default_kelvin_voigt_walks_the_typical_gait_under_cdm():
     with warnings.catch_warnings():
         warnings.simplefilter("error", pdw.StepSizeWarning)
         r = pdw.simulate(params=pdw.Params.paper_steady(), contact=pdw.Contact("kelvin_voigt"),
-                         record_every=0)
+                         record=pdw.Record(every=0))
     assert r.status == "walked" and r.n_gait_steps >= 4
 
 
@@ -91,7 +91,8 @@ def test_a_stiff_kelvin_voigt_ground_gets_the_step_size_warning():
     limit is below the measured edge (5e-6 walks 0.3 s, 1e-5 diverges)."""
     c = pdw.Contact("kelvin_voigt", k=1e5, d=1e6)
     with pytest.warns(pdw.StepSizeWarning, match="kelvin_voigt"):
-        r = pdw.simulate(t_end=0.01, contact=c, on_failure="return", record_every=0)
+        r = pdw.simulate(t_end=0.01, contact=c, record=pdw.Record(every=0),
+                         limits=pdw.Limits(on_failure="return"))
     assert r.status == "diverged"
     with pytest.raises(pdw.StepSizeError):
         pdw.simulate(t_end=0.01, contact=c, integrator=pdw.Integrator(check_step="error"))

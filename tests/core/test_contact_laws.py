@@ -127,7 +127,7 @@ def test_every_method_runs_every_law(method):
     approach speed) under every law; a law changes the trajectory, the default does not."""
     P = pdw.Params.paper_steady()
     kw = dict(params=P, t_end=0.45, method=method, dt=5e-5 if method != "cdm" else 1e-4,
-              record_every=0, check_step="off")
+              integrator=pdw.Integrator(check_step="off"), record=pdw.Record(every=0))
     ref = pdw.simulate(**kw)
     assert np.array_equal(pdw.simulate(contact=Contact(), **kw).x_final, ref.x_final)
     for law, prm in (("hertz", {}), ("kelvin_voigt", dict(k=7.3e3, d=150.0)),
@@ -230,7 +230,8 @@ def test_flores_fixed_point_reproduces_itself_under_simulate():
 
     def returns(a0):
         r = pdw.simulate(x0, t_end=3.0, params=P, method="rodas4", flags0=(1, 1), contact=c,
-                         record_every=1, approach_speeds0=a0, **LC.TIGHT)
+                         integrator=pdw.Integrator(**LC.TIGHT), record=pdw.Record(every=1),
+                         approach_speeds0=a0)
         out = []
         for e in (e for e in r.events if e.kind == "touch_down"):
             i = int(np.searchsorted(r.t, e.t))

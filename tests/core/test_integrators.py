@@ -145,9 +145,10 @@ def test_convergence_order(name, flight_reference):
     errs = []
     for n in ns:
         h = T_FLIGHT / n
-        kw = dict(rtol=1.0, atol=1.0, h_max=h) if info.adaptive else {}
+        tol = dict(rtol=1.0, atol=1.0, h_max=h) if info.adaptive else {}
         r = simulate(x0=X0_FLIGHT, t_end=T_FLIGHT, dt=h, method=name, flags0=(0, 0),
-                     record_every=0, check_step="off", **kw)  # no ground: no contact limit
+                     integrator=pdw.Integrator(check_step="off", **tol),  # no ground: no contact limit
+                     record=pdw.Record(every=0))
         assert not r.events
         errs.append(np.abs(r.x_final - flight_reference).max())
     slope = np.polyfit(np.log(T_FLIGHT / np.array(ns)), np.log(errs), 1)[0]
@@ -214,8 +215,8 @@ GAIT_RUNS = [
     ("cdm", dict(dt=1e-5), 1e-2),          # measured 2.0e-3
     ("verlet", dict(dt=1e-6), 1.5e-3),     # measured 3.2e-4
     ("rk4", dict(dt=1e-6), 6e-5),          # measured 1.3e-5
-    ("dopri5", dict(dt=1e-5, rtol=1e-6, atol=1e-8), 1e-6),   # measured 2.0e-7
-    ("rodas4", dict(rtol=1e-7, atol=1e-9), 2.5e-6),          # measured 4.9e-7
+    ("dopri5", dict(dt=1e-5, integrator=pdw.Integrator(rtol=1e-6, atol=1e-8)), 1e-6),  # 2.0e-7
+    ("rodas4", dict(integrator=pdw.Integrator(rtol=1e-7, atol=1e-9)), 2.5e-6),        # 4.9e-7
 ]
 
 
@@ -228,7 +229,7 @@ def gait_reference():
 
 @pytest.mark.parametrize("name,kw,bound", GAIT_RUNS)
 def test_methods_agree_on_typical_gait(name, kw, bound, gait_reference):
-    r = simulate(method=name, record_every=0, **kw)
+    r = simulate(method=name, record=pdw.Record(every=0), **kw)
     assert r.walked
     ref = [(e.leg, e.kind) for e in gait_reference.events]
     assert [(e.leg, e.kind) for e in r.events] == ref and len(ref) == 12

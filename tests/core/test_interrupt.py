@@ -143,8 +143,8 @@ signal.signal(signal.SIGINT, signal.default_int_handler)
 print("start", flush=True)
 t0 = time.time()
 try:
-    pdw.simulate(method="rodas4", params=pdw.Params(v_s=1e-12), t_end=1.0, record_every=1,
-                 max_steps=10**9)
+    pdw.simulate(method="rodas4", params=pdw.Params(v_s=1e-12), t_end=1.0,
+                 integrator=pdw.Integrator(max_steps=10**9), record=pdw.Record(every=1))
 except KeyboardInterrupt as e:
     r = e.result
     print("INTERRUPTED", r.status, r.n_steps, len(r.t), r.t_final, flush=True)

@@ -106,12 +106,12 @@ def test_bristle_steady_state_and_transient_closed_form(v):
     np.testing.assert_allclose(sol.y[0], closed, rtol=1e-7, atol=1e-9 * abs(z_ss))
 
 
-def _walk(method="rodas4", dt=2e-5, t_end=1.6, contact=None, **kw):
+def _walk(method="rodas4", dt=2e-5, t_end=1.6, contact=None):
     contact = calibrate_lugre().contact if contact is None else contact
-    opts = dict(rtol=1e-8, atol=1e-10) if method in ("rodas4", "dopri5") else {}
-    opts.update(kw)
+    tol = dict(rtol=1e-8, atol=1e-10) if method in ("rodas4", "dopri5") else {}
     return pdw.simulate(params=pdw.Params.paper_steady(), t_end=t_end, dt=dt, method=method,
-                        contact=contact, record_every=1, check_step="off", **opts)
+                        contact=contact, integrator=pdw.Integrator(check_step="off", **tol),
+                        record=pdw.Record(every=1))
 
 
 def test_state_layout_and_reset_at_touch_down():
@@ -158,7 +158,8 @@ def test_every_integrator_walks_with_lugre_like_rodas4(method):
 
 def test_lugre_calibrated_walk_matches_the_paper_gait():
     """Calibrated to Eq. 10 (calibrate_lugre), LuGre walks the paper's gait to within 1 %."""
-    kw = dict(t_end=8.0, method="rodas4", rtol=1e-8, atol=1e-10, record_every=0)
+    kw = dict(t_end=8.0, method="rodas4", integrator=pdw.Integrator(rtol=1e-8, atol=1e-10),
+              record=pdw.Record(every=0))
     P = pdw.Params.paper_steady()
     ref = pdw.simulate(params=P, **kw)
     r = pdw.simulate(params=P, contact=calibrate_lugre(P).contact, **kw)
@@ -218,7 +219,7 @@ def test_x0_mechanical_or_full():
 ])
 def test_refused_with_reasons(kwargs, match):
     with pytest.raises(pdw.InvalidInputError, match=match):
-        pdw.simulate(t_end=0.01, record_every=1, **kwargs)
+        pdw.simulate(t_end=0.01, record=pdw.Record(every=1), **kwargs)
 
 
 def test_a_frictionless_preset_needs_lugre_coefficients():
@@ -262,8 +263,8 @@ def test_rodas4_with_lugre_is_not_held_back_by_its_jacobian():
     many (docs/contact_laws.md, "Integrators"). Step counts, not times: deterministic."""
     c = calibrate_lugre().contact
     P = pdw.Params.paper_steady()
-    kw = dict(params=P, t_end=0.6, rtol=1e-10, atol=1e-12, contact=c, record_every=0,
-              check_step="off")
+    kw = dict(params=P, t_end=0.6, integrator=pdw.Integrator(rtol=1e-10, atol=1e-12, check_step="off"),
+              contact=c, record=pdw.Record(every=0))
     ros = pdw.simulate(method="rodas4", **kw)
     dp = pdw.simulate(method="dopri5", **kw)
     assert ros.walked and dp.walked

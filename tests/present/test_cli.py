@@ -193,7 +193,7 @@ def test_a_run_that_raises_a_divergence_exits_3(tmp_path, capsys):
     (on_failure = "raise") ends with code 3 ("fell or diverged"), not 2 ("invalid input")."""
     scene = tmp_path / "div.toml"
     scene.write_text('[params]\nk_n = 1e8\n[integrator]\nmethod = "rk4"\ndt = 0.01\n'
-                     '[stop]\nt_end = 2.0\non_failure = "raise"\n')
+                     '[stop]\nt_end = 2.0\n[limits]\non_failure = "raise"\n')
     rc = cli.main(["run", str(scene)])
     err = capsys.readouterr().err
     assert rc == 3 and "diverged at t = " in err and "Traceback" not in err, err

@@ -1,4 +1,5 @@
-"""simulate(t_eval=..., dense_output=True): the interpolant between accepted steps."""
+"""simulate(record=Record(t_eval=..., dense_output=True)): the interpolant between accepted
+steps."""
 
 import numpy as np
 import pytest
@@ -11,13 +12,14 @@ from pdw.sim.buffers import RecordBuffer
 # no flag change within T
 X_FLIGHT = np.array([0.0, 1.5, -0.3, 0.25, 0.4, 0.5, 2.0, -1.5])
 T = 0.3
-KW = dict(flags0=(0, 0), check_step="off", fall_hip_height=0.1)
+KW = dict(flags0=(0, 0), limits=pdw.Limits(fall_hip_height=0.1))
 
 
 @pytest.fixture(scope="module")
 def reference():
-    r = pdw.simulate(X_FLIGHT, t_end=T, method="rodas4", rtol=1e-12, atol=1e-14, dt=1e-6,
-                     dense_output=True, **KW)
+    r = pdw.simulate(X_FLIGHT, t_end=T, method="rodas4", dt=1e-6,
+                     integrator=pdw.Integrator(rtol=1e-12, atol=1e-14, check_step="off"),
+                     record=pdw.Record(dense_output=True), **KW)
     assert r.events == [] and r.walked
     return r
 
@@ -51,7 +53,9 @@ def test_between_steps_converges_with_the_method_order(method, dts, reference):
     errs = []
     for dt in dts:
         t_mid = (np.arange(int(round(T / dt))) + 0.5) * dt      # midway between steps
-        r = pdw.simulate(X_FLIGHT, t_end=T, method=method, dt=dt, t_eval=t_mid, **KW)
+        r = pdw.simulate(X_FLIGHT, t_end=T, method=method, dt=dt,
+                         integrator=pdw.Integrator(check_step="off"),
+                         record=pdw.Record(t_eval=t_mid), **KW)
         errs.append(np.max(np.abs(r.x - reference.sol(t_mid))))
     observed = np.log2(np.array(errs[:-1]) / np.array(errs[1:]))
     assert np.all(observed > order - 0.4) and np.all(observed < order + 1.0), (errs, observed)
@@ -63,8 +67,9 @@ def test_adaptive_between_steps_is_as_accurate_as_at_steps(method, reference):
     a small factor of the error at the steps, and both fall with the tolerance."""
     mids, ats = [], []
     for rtol in (1e-5, 1e-7, 1e-9):
-        r = pdw.simulate(X_FLIGHT, t_end=T, method=method, rtol=rtol, atol=rtol * 1e-2, dt=1e-4,
-                         dense_output=True, **KW)
+        r = pdw.simulate(X_FLIGHT, t_end=T, method=method, dt=1e-4,
+                         integrator=pdw.Integrator(rtol=rtol, atol=rtol * 1e-2, check_step="off"),
+                         record=pdw.Record(dense_output=True), **KW)
         tm = 0.5 * (r.sol.t[1:] + r.sol.t[:-1])
         mids.append(np.max(np.abs(r.sol(tm) - reference.sol(tm))))
         ats.append(np.max(np.abs(r.x - reference.sol(r.t))))
@@ -97,8 +102,8 @@ def test_bad_t_eval_is_refused(bad):
 
 
 def test_t_eval_needs_every_step_recorded():
-    with pytest.raises(pdw.InvalidInputError, match="record_every"):
-        pdw.simulate(t_end=0.5, t_eval=[0.1], record_every=10)
+    with pytest.raises(pdw.InvalidInputError, match=r"record\.every"):
+        pdw.simulate(t_end=0.5, record=pdw.Record(t_eval=[0.1], every=10))
 
 
 @pytest.mark.parametrize("method", ["cdm", "rodas4"])
@@ -126,11 +131,11 @@ def test_t_eval_with_another_normal_law_is_the_recorded_run(method, contact):
     """t_eval at the recorded steps gives the recorded states and forces with every normal law:
     the approach speeds captured at the touch-downs are part of what the interpolant sees."""
     kw = dict(t_end=0.8, method=method, dt=2e-6 if method in ("rk4", "dopri5") else 1e-4,
-              check_step="off", contact=contact)
-    r = pdw.simulate(pdw.X0_PAPER, dense_output=True, **kw)
+              integrator=pdw.Integrator(check_step="off"), contact=contact)
+    r = pdw.simulate(pdw.X0_PAPER, record=pdw.Record(dense_output=True), **kw)
     assert sum(e.kind == "touch_down" and e.leg == 1 for e in r.events) >= 1
     pick = r.t[:: max(1, len(r.t) // 60)]
-    s = pdw.simulate(pdw.X0_PAPER, t_eval=pick, **kw)
+    s = pdw.simulate(pdw.X0_PAPER, record=pdw.Record(t_eval=pick), **kw)
     idx = np.searchsorted(r.t, pick, side="right") - 1
     np.testing.assert_array_equal(s.x, r.x[idx])
     np.testing.assert_allclose(s.Fn, r.Fn[idx], rtol=1e-12, atol=1e-9)
@@ -169,7 +174,7 @@ def test_a_well_formed_record_buffer_still_gives_the_same_run():
 def test_dense_output_arguments_are_strict(kw, field):
     """A complex t_eval was its real part; dense_output="yes" was True."""
     with pytest.raises(pdw.InvalidInputError, match=field):
-        pdw.simulate(t_end=0.02, method="rodas4", **kw)
+        pdw.simulate(t_end=0.02, method="rodas4", record=kw)     # the table, read by simulate
 
 
 @pytest.mark.parametrize("tq", ["0.01", 0.01 + 1j, np.full((2, 2), 0.01), float("nan"), 5.0])

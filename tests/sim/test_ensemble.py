@@ -40,7 +40,8 @@ def test_scalar_path_is_the_batch_bitwise():
     params = [pdw.Params.paper(d_hip=d) for d in np.linspace(0.005, 0.03, 13)]
     b = simulate_batch(x, t_end=T_END, params=params, threads=1,
                        integrator=pdw.Integrator(check_step="off"))
-    s = E.scalar_batch(x, t_end=T_END, params=params, threads=2, check_step="off")
+    s = E.scalar_batch(x, t_end=T_END, params=params, threads=2,
+                       integrator=pdw.Integrator(check_step="off"))
     assert s.engine == "scalar" and b.engine == "batch"
     assert {"walked", "fell"} <= set(b.status)
     _assert_identical(b, s)
@@ -93,8 +94,8 @@ def test_chunks_over_an_executor_are_the_unchunked_batch(pool):
                          integrator=pdw.Integrator(check_step="off"))
     with pool(2) as ex:
         b = simulate_batch(x, t_end=T_END, params=params, flags0=f0, threads=1,
-                           check_step="off", executor=ex, chunk_size=4, record=[2, 9],
-                           record_every=5)
+                           integrator=pdw.Integrator(check_step="off"), executor=ex,
+                           chunk_size=4, record=[2, 9], record_every=5)
     _assert_identical(ref, b)
     assert sorted(b.recorded) == [2, 9]
     for i in (2, 9):
@@ -115,8 +116,8 @@ def test_chunks_over_an_executor_are_the_unchunked_batch(pool):
 
 def test_recorded_subset_is_scalar_simulate():
     x = _states(6, seed=7)
-    b = simulate_batch(x, t_end=T_END, threads=1, check_step="off", record=[0, 3, 5],
-                       record_every=7)
+    b = simulate_batch(x, t_end=T_END, threads=1, integrator=pdw.Integrator(check_step="off"),
+                       record=[0, 3, 5], record_every=7)
     assert sorted(b.recorded) == [0, 3, 5]
     for i, r in b.recorded.items():
         s = pdw.simulate(x[i], t_end=T_END, integrator=pdw.Integrator(check_step="off"),
@@ -134,7 +135,8 @@ def test_recorded_subset_is_scalar_simulate():
     with pytest.raises(pdw.InvalidInputError, match="record"):
         simulate_batch(x, t_end=T_END, record=[6], integrator=pdw.Integrator(check_step="off"))
     with pytest.raises(pdw.InvalidInputError, match="record_every"):
-        simulate_batch(x, t_end=T_END, record=[1], record_every=0, check_step="off")
+        simulate_batch(x, t_end=T_END, record=[1], record_every=0,
+                       integrator=pdw.Integrator(check_step="off"))
 
 
 def test_end_of_run_checks_as_simulate():
@@ -196,6 +198,7 @@ x0 = [0.0, 0.4969, -0.0582, 0.0582, 0.5092, 0.0186, 3.3338, -1.0093]
 method = "%s"
 [scene.stop]
 t_end = 4.0
+[scene.limits]
 on_failure = "return"
 [[axes]]
 name = "k_hip"

@@ -148,7 +148,7 @@ def run_checked(**kw):
 def test_fixed_step_runs_return_a_valid_result_or_a_pdw_error(P, s, method, dt, variant, on_failure):
     x0, flags = s
     run_checked(x0=x0, flags0=flags, params=P, method=method, dt=dt, t_end=0.3, variant=variant,
-                on_failure=on_failure, record_every=1)
+                record=pdw.Record(every=1), limits=pdw.Limits(on_failure=on_failure))
 
 
 @settings(max_examples=n(40), **SETTINGS)
@@ -156,8 +156,9 @@ def test_fixed_step_runs_return_a_valid_result_or_a_pdw_error(P, s, method, dt, 
        variant=st.sampled_from(["paper", "consistent"]))
 def test_rodas4_runs_return_a_valid_result_or_a_pdw_error(P, s, rtol, variant):
     x0, flags = s
-    run_checked(x0=x0, flags0=flags, params=P, method="rodas4", rtol=rtol, atol=rtol * 1e-2,
-                dt=1e-4, t_end=0.3, variant=variant, on_failure="return", record_every=3)
+    run_checked(x0=x0, flags0=flags, params=P, method="rodas4",
+                integrator=pdw.Integrator(rtol=rtol, atol=rtol * 1e-2), dt=1e-4, t_end=0.3,
+                variant=variant, record=pdw.Record(every=3), limits=pdw.Limits(on_failure="return"))
 
 
 @pytest.mark.parametrize("method", ["rodas4", "dopri5"])
@@ -175,8 +176,9 @@ def test_dopri5_runs_return_a_valid_result_or_a_pdw_error(P, s):
     h = SL.step_limit(P, "dopri5").dt_max
     t_end = float(min(0.3, max(2e5 * h, 1e-3)))
     t_end = round(t_end / 1e-5) * 1e-5     # a multiple of dt (test_adaptive_runs_end_at_t_end)
-    run_checked(x0=x0, flags0=flags, params=P, method="dopri5", rtol=1e-5, atol=1e-7,
-                dt=1e-5, t_end=t_end, on_failure="return", record_every=0)
+    run_checked(x0=x0, flags0=flags, params=P, method="dopri5",
+                integrator=pdw.Integrator(rtol=1e-5, atol=1e-7), dt=1e-5, t_end=t_end,
+                record=pdw.Record(every=0), limits=pdw.Limits(on_failure="return"))
 
 
 @settings(max_examples=n(40), **SETTINGS)
@@ -212,8 +214,10 @@ def test_model_functions_are_finite(P, s, variant):
 def test_bad_numbers_raise_invalid_input_naming_the_field(field, value):
     if value is None and field in ("h_max", "fall_depth", "dt", "t_end"):
         return                          # None is their default (no limit, l/4, 1e-4, 3.5)
+    section = {"max_speed": "limits", "fall_depth": "limits"}.get(field, "integrator")
+    kw = {field: value} if field in ("dt", "t_end") else {section: {field: value}}  # the table
     with pytest.raises(InvalidInputError, match=field) as ei:
-        pdw.simulate(**{"t_end": 0.01, field: value})
+        pdw.simulate(**{"t_end": 0.01, **kw})
     assert isinstance(ei.value, PdwError)
 
 
@@ -396,17 +400,30 @@ SIM_ARGS = {
     "dt": st.sampled_from([1e-4, 1e-3, 1e-5]) | JUNK,
     "method": st.sampled_from(pdw.METHODS) | JUNK,
     "flags0": st.sampled_from([(0, 1), (1, 1), (1, 0), (0, 0)]) | JUNK,
-    "record_every": st.integers(0, 5) | JUNK,
-    "fall_hip_height": st.floats(0.0, 0.4) | JUNK,
-    "max_speed": st.sampled_from([1e3, 10.0]) | JUNK,
-    "rtol": st.sampled_from([1e-6, 1e-3]) | JUNK,
+    "record.every": st.integers(0, 5) | JUNK,
+    "limits.fall_hip_height": st.floats(0.0, 0.4) | JUNK,
+    "limits.max_speed": st.sampled_from([1e3, 10.0]) | JUNK,
+    "integrator.rtol": st.sampled_from([1e-6, 1e-3]) | JUNK,
     "x0": st.lists(st.floats(-0.5, 0.5), min_size=8, max_size=8).map(
         lambda v: (X0 + 0.2 * np.array(v)).tolist()) | JUNK,
 }
 
 
+def _tables(kw):
+    """Drawn arguments as the keywords of an entry point: a key ``section.field`` goes into the
+    option table ``section`` (a dict, read and checked by the entry point)."""
+    out: dict = {}
+    for key, value in kw.items():
+        if "." in key:
+            section, name = key.split(".")
+            out.setdefault(section, {})[name] = value
+        else:
+            out[key] = value
+    return out
+
+
 def _simulate(kw):
-    kw = {**kw, "check_step": "off", "on_failure": "return"}
+    kw = _tables({**kw, "integrator.check_step": "off", "limits.on_failure": "return"})
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -456,7 +473,8 @@ test_fuzz_scene, test_fuzz_scene_study = _twin("scene", _scene, st.fixed_diction
 STUDY_TOP = st.sampled_from(["name", "title", "bogus"])
 STUDY_SCENE = st.sampled_from(["preset", "variant", "x0", "flags0", "bogus"])
 STUDY_RUN = st.sampled_from(["steady", "period_tol", "mode", "fallback", "t_end", "bogus"])
-STUDY_STOP = st.sampled_from(["t_end", "max_speed", "on_failure"])
+STUDY_STOP = st.sampled_from(["t_end"])
+STUDY_LIMITS = st.sampled_from(["max_speed", "on_failure"])
 STUDY_INTEGRATOR = st.sampled_from(["method", "dt", "rtol", "atol"])
 AXIS_KEY = st.sampled_from(["values", "start", "stop", "num", "log"])
 
@@ -465,6 +483,7 @@ def _study(parts):
     text = (_toml(parts["top"]) + "\n[[axes]]\nname = \"k_n\"\n" + _toml(parts["axis"])
             + "\n[run]\n" + _toml(parts["run"]) + "\n[scene]\n" + _toml(parts["scene"])
             + "\n[scene.stop]\n" + _toml(parts["stop"])
+            + "\n[scene.limits]\n" + _toml(parts["limits"])
             + "\n[scene.integrator]\n" + _toml(parts["integrator"]) + "\n")
     try:
         s = parse_study(text)
@@ -485,7 +504,8 @@ def _pairs(keys):
 
 test_fuzz_study, test_fuzz_study_study = _twin("study", _study, st.fixed_dictionaries({
     "top": _pairs(STUDY_TOP), "run": _pairs(STUDY_RUN), "scene": _pairs(STUDY_SCENE),
-    "stop": _pairs(STUDY_STOP), "integrator": _pairs(STUDY_INTEGRATOR),
+    "stop": _pairs(STUDY_STOP), "limits": _pairs(STUDY_LIMITS),
+    "integrator": _pairs(STUDY_INTEGRATOR),
     "axis": st.lists(st.tuples(AXIS_KEY, TOML_VALUE), min_size=1, max_size=3,
                      unique_by=lambda t: t[0]),
 }))
@@ -500,8 +520,10 @@ def _long(case):
     p = pdw.Params.paper_steady(k_n=k_n, gamma=gamma)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        r = pdw.simulate(t_end=20.0, params=p, method=method, on_failure="return",
-                         record_every=50, record_energies=True, check_step="off", dt=1e-4)
+        r = pdw.simulate(t_end=20.0, params=p, method=method,
+                         integrator=pdw.Integrator(check_step="off"),
+                         record=pdw.Record(every=50, energies=True),
+                         limits=pdw.Limits(on_failure="return"), dt=1e-4)
     if r.status == "walked":
         assert r.n_gait_steps >= 3
         assert all(np.isfinite(v).all() for v in r.energies.values())
@@ -548,13 +570,14 @@ BATCH_ARGS = {
     "t_end": st.sampled_from([0.005, 0.02]) | JUNK,
     "dt": st.sampled_from([1e-4, 1e-3]) | JUNK,
     "flags0": st.sampled_from([(0, 1), (1, 1), [(0, 1), (1, 0)]]) | JUNK,
-    "fall_hip_height": st.floats(0.0, 0.4) | JUNK,
+    "limits.fall_hip_height": st.floats(0.0, 0.4) | JUNK,
     "lanes": st.integers(-1, 70) | JUNK,
     "threads": st.integers(0, 3) | JUNK,
     "vector": st.booleans() | JUNK,
-    "stop_steps": st.integers(0, 3) | JUNK,
-    "periodic_steps": st.integers(0, 3) | JUNK,
-    "max_speed": st.sampled_from([1e3, 10.0]) | JUNK,
+    "stop.steps": st.integers(0, 3) | JUNK,
+    "stop.periodic": st.booleans() | JUNK,
+    "stop.periodic_steps": st.integers(0, 3) | JUNK,
+    "limits.max_speed": st.sampled_from([1e3, 10.0]) | JUNK,
     "params": st.sampled_from([None, pdw.Params.paper(), [pdw.Params.paper()] * 2,
                                [pdw.Params.paper_steady(k_n=2e5), pdw.Params.paper()]]) | JUNK,
 }
@@ -562,7 +585,7 @@ BATCH_ARGS = {
 
 def _batch_public(case):
     x0, kw = case
-    kw = {**kw, "check_step": "off"}
+    kw = _tables({**kw, "integrator.check_step": "off"})
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -624,8 +647,8 @@ def _contact(case):
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                r = pdw.simulate(t_end=0.02, contact=c, check_step="off", on_failure="return",
-                                 record_every=0)
+                r = pdw.simulate(t_end=0.02, contact=c, integrator=pdw.Integrator(check_step="off"),
+                                 record=pdw.Record(every=0), limits=pdw.Limits(on_failure="return"))
         except pdw.InvalidInputError:
             return
         assert r.status in ("walked", "fell", "diverged") and np.isfinite(r.x_final).all()

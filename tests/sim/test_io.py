@@ -71,13 +71,15 @@ def _assert_round_trip(r, r2):
 def _fell_with_inf():
     x = X0.copy()
     x[1] = -1e308
-    return _quiet(x0=x, t_end=0.01, on_failure="return", record_energies=True)
+    return _quiet(x0=x, t_end=0.01, record=pdw.Record(energies=True),
+                  limits=pdw.Limits(on_failure="return"))
 
 
 def _diverged_nonfinite_energies():
     x = X0.copy()
     x[5] = 1e200
-    return _quiet(x0=x, t_end=0.01, on_failure="return", record_energies=True, max_speed=1e308)
+    return _quiet(x0=x, t_end=0.01, record=pdw.Record(energies=True),
+                  limits=pdw.Limits(on_failure="return", max_speed=1e308))
 
 
 def _standing():
@@ -98,7 +100,8 @@ RUNS = {
     "fell_inf_force": _fell_with_inf,
     "diverged_nonfinite_energies": _diverged_nonfinite_energies,
     "diverged_rodas4": lambda: _quiet(x0=np.r_[X0[:6], 1e160, X0[7]], t_end=0.01,
-                                      on_failure="return", method="rodas4", max_speed=1e308),
+                                      method="rodas4",
+                                      limits=pdw.Limits(on_failure="return", max_speed=1e308)),
     "no_steps": lambda: _standing(),
     "hertz": lambda: pdw.simulate(t_end=0.3, contact=pdw.Contact("hertz"),
                                   limits=pdw.Limits(on_failure="return")),
@@ -108,7 +111,7 @@ RUNS = {
     "lankarani": lambda: pdw.simulate(t_end=0.3, contact=pdw.Contact("lankarani_nikravesh",
                                                                      e=0.9)),
     "lugre": lambda: _quiet(t_end=0.3, method="rodas4", contact=pdw.Contact(friction="lugre")),
-    "lugre_dense": lambda: _quiet(t_end=0.2, method="rodas4", dense_output=True,
+    "lugre_dense": lambda: _quiet(t_end=0.2, method="rodas4", record=pdw.Record(dense_output=True),
                                   contact=pdw.Contact(friction="lugre", sigma1=10.0)),
     "dense_cdm": lambda: pdw.simulate(t_end=0.2, record=pdw.Record(dense_output=True)),
     "dense_rodas4_t_eval": lambda: pdw.simulate(t_end=0.3, method="rodas4",

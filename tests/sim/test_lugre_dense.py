@@ -27,10 +27,10 @@ def contact():
     return calibrate_lugre(P).contact
 
 
-def _kw(contact, method, **kw):
-    out = dict(params=P, method=method, dt=DT[method], contact=contact, check_step="off")
-    if method in ("dopri5", "rodas4"):
-        out.update(rtol=1e-8, atol=1e-10)
+def _kw(contact, method, rtol=1e-8, atol=1e-10, **kw):
+    tol = dict(rtol=rtol, atol=atol) if method in ("dopri5", "rodas4") else {}
+    out = dict(params=P, method=method, dt=DT[method], contact=contact,
+               integrator=pdw.Integrator(check_step="off", **tol))
     out.update(kw)
     return out
 
@@ -40,9 +40,11 @@ def landing(contact):
     """The state at T_LAND (both feet in support) and a reference over the window: rk4 at
     dt = 1e-7 (its own error is below 1e-12), every step recorded."""
     x0 = pdw.simulate(t_end=T_LAND, **_kw(contact, "rodas4", rtol=1e-9, atol=1e-11,
-                                           record_every=0)).x_final
-    kw = dict(params=P, contact=contact, flags0=(1, 1), check_step="off")
-    ref = pdw.simulate(x0, t_end=T_WIN, method="rk4", dt=1e-7, dense_output=True, **kw)
+                                           record=pdw.Record(every=0))).x_final
+    kw = dict(params=P, contact=contact, flags0=(1, 1))
+    ref = pdw.simulate(x0, t_end=T_WIN, method="rk4", dt=1e-7,
+                       integrator=pdw.Integrator(check_step="off"),
+                       record=pdw.Record(dense_output=True), **kw)
     assert ref.events == [] and ref.walked and np.all(ref.flags == 1)
     return x0, kw, ref
 
@@ -54,7 +56,7 @@ def test_t_eval_at_the_recorded_steps_is_the_recorded_state(method, contact):
     landing foot's z is reset, the interpolant holds the swing value up to the touch-down."""
     z1 = 3e-6                           # leg 1 swings from the start: its z stays until the reset
     kw = _kw(contact, method, t_end=T_WALK, x0=np.r_[pdw.X0_PAPER, z1, 0.0])
-    r = pdw.simulate(dense_output=True, **kw)
+    r = pdw.simulate(record=pdw.Record(dense_output=True), **kw)
     assert r.x.shape[1] == len(NAMES) and r.sol.nx == len(NAMES)
     td = [e for e in r.events if e.kind == "touch_down" and e.leg == 1]
     assert len(td) == 1
@@ -63,7 +65,7 @@ def test_t_eval_at_the_recorded_steps_is_the_recorded_state(method, contact):
     assert r.x[i - 1, 8] == z1 and r.x[i, 8] == 0.0
     pick = np.union1d(r.t[:: max(1, len(r.t) // 60)], r.t[i - 2:i + 3])
     pick = pick[pick <= T_WALK]             # n dt may round past t_end
-    s = pdw.simulate(t_eval=pick, record_energies=True, **kw)
+    s = pdw.simulate(record=pdw.Record(t_eval=pick, energies=True), **kw)
     idx = np.searchsorted(r.t, pick, side="right") - 1
     np.testing.assert_array_equal(s.t, pick)
     np.testing.assert_array_equal(s.x, r.x[idx])
@@ -90,7 +92,9 @@ def test_between_steps_converges_with_the_method_order(method, dts, landing):
     errs = []
     for dt in dts:
         t_mid = (np.arange(int(round(T_WIN / dt))) + 0.5) * dt
-        r = pdw.simulate(x0, t_end=T_WIN, method=method, dt=dt, t_eval=t_mid, **kw)
+        r = pdw.simulate(x0, t_end=T_WIN, method=method, dt=dt,
+                         integrator=pdw.Integrator(check_step="off"),
+                         record=pdw.Record(t_eval=t_mid), **kw)
         d = np.abs(r.x - ref.sol(t_mid))
         errs.append((d[:, :NX].max(), d[:, NX:].max()))
     errs = np.array(errs)
@@ -103,8 +107,9 @@ def test_adaptive_between_steps_is_as_accurate_as_at_steps(method, landing):
     x0, kw, ref = landing
     mids, ats = [], []
     for rtol in (1e-5, 1e-7, 1e-9):
-        r = pdw.simulate(x0, t_end=T_WIN, method=method, rtol=rtol, atol=rtol * 1e-2, dt=1e-6,
-                         dense_output=True, **kw)
+        r = pdw.simulate(x0, t_end=T_WIN, method=method, dt=1e-6,
+                         integrator=pdw.Integrator(rtol=rtol, atol=rtol * 1e-2, check_step="off"),
+                         record=pdw.Record(dense_output=True), **kw)
         tm = 0.5 * (r.sol.t[1:] + r.sol.t[:-1])
         dm, da = np.abs(r.sol(tm) - ref.sol(tm)), np.abs(r.x - ref.sol(r.t))
         mids.append((dm[:, :NX].max(), dm[:, NX:].max()))
@@ -192,16 +197,17 @@ def test_interpolant_order_on_the_lugre_state(landing):
 def test_record_buffer_shared_by_lugre_and_the_default_law(method, contact):
     """One buffer, reused by a LuGre run and a default run in either order, gives the arrays of
     fresh runs, as views into the same memory (nothing reallocated when the width changes)."""
-    kw = dict(params=P, t_end=0.2, method=method, dt=2e-5, check_step="off")
-    if method == "rodas4":
-        kw.update(rtol=1e-8, atol=1e-10)
+    tol = dict(rtol=1e-8, atol=1e-10) if method == "rodas4" else {}
+    kw = dict(params=P, t_end=0.2, method=method, dt=2e-5,
+              integrator=pdw.Integrator(check_step="off", **tol))
     fresh = {law: pdw.simulate(contact=c, **kw) for law, c in (("lugre", contact),
                                                                ("default", None))}
     for first, second in (("lugre", "default"), ("default", "lugre")):
         buf = pdw.RecordBuffer(12000)
         store = buf._states
         for law in (first, second, first):
-            r = pdw.simulate(contact=contact if law == "lugre" else None, out=buf, **kw)
+            r = pdw.simulate(contact=contact if law == "lugre" else None,
+                             record=pdw.Record(out=buf), **kw)
             for name in ("t", "x", "flags", "Fn", "Ft"):
                 np.testing.assert_array_equal(getattr(r, name), getattr(fresh[law], name))
             assert r.x.shape[1] == (len(NAMES) if law == "lugre" else NX)
@@ -238,7 +244,8 @@ def test_features_without_tangential_is_lugre_alone(contact):
     """Without ``tangential`` (the spring-damper of Eqs. 7, 11) the run is the LuGre kernel with
     k_t = d_t = 0, and the tangential force is LuGre's, -(sigma0 z + sigma1 dz/dt + sigma2 v)
     F_n, recomputed here from the recorded states; with it (the control), it is not."""
-    kw = dict(params=P, t_end=0.4, dt=2e-5, method="rk4", contact=contact, check_step="off")
+    kw = dict(params=P, t_end=0.4, dt=2e-5, method="rk4", contact=contact,
+              integrator=pdw.Integrator(check_step="off"))
     a = pdw.simulate(features=_without("tangential"), **kw)
     b = pdw.simulate(**dict(kw, params=P.replace(k_t=0.0, d_t=0.0)))
     assert a.contact == contact and a.x.shape[1] == len(NAMES)
@@ -258,7 +265,7 @@ def test_features_without_tangential_is_lugre_alone(contact):
     np.testing.assert_allclose(a.Ft, lugre_force(a), rtol=1e-12, atol=1e-12)
     assert np.abs(full.Ft - lugre_force(full)).max() > 1.0
     # t_eval with features: the recorded steps, exactly
-    s = pdw.simulate(features=_without("tangential"), t_eval=a.t[::500], **kw)
+    s = pdw.simulate(features=_without("tangential"), record=pdw.Record(t_eval=a.t[::500]), **kw)
     np.testing.assert_array_equal(s.x, a.x[::500])
 
 
@@ -266,7 +273,8 @@ def test_features_without_tangential_is_lugre_alone(contact):
 def test_features_of_the_walker_and_the_normal_law_under_lugre(absent, contact):
     """The elements outside the friction law mean what they mean under the default law: their
     parameters zeroed (`Params.without`) on the LuGre kernel."""
-    kw = dict(t_end=0.2, dt=2e-5, method="rk4", contact=contact, check_step="off")
+    kw = dict(t_end=0.2, dt=2e-5, method="rk4", contact=contact,
+              integrator=pdw.Integrator(check_step="off"))
     a = pdw.simulate(params=P, features=_without(*absent), **kw)
     b = pdw.simulate(params=P.without(_without(*absent)), **kw)
     np.testing.assert_array_equal(a.x, b.x)
@@ -281,7 +289,7 @@ def test_features_without_friction_drops_the_bristles(normal, contact):
     c = (contact if normal == "hunt_crossley" else
          pdw.Contact("flores", friction="lugre", e=0.18, sigma1=contact.sigma1))
     plain = pdw.Contact(normal, e=c.e)
-    kw = dict(params=P, t_end=0.3, dt=2e-5, method="rk4", check_step="off")
+    kw = dict(params=P, t_end=0.3, dt=2e-5, method="rk4", integrator=pdw.Integrator(check_step="off"))
     a = pdw.simulate(contact=c, features=_without("friction"), **kw)
     b = pdw.simulate(contact=plain, features=_without("friction"), **kw)
     assert a.contact == plain and a.x.shape[1] == NX and a.state_names == pdw.STATE
@@ -294,7 +302,8 @@ def test_features_without_friction_drops_the_bristles(normal, contact):
     assert (none.Fn > 0).any() and not none.Ft.any()
     # the step-size check is the normal law's (no bristle damping to limit the step)
     with pytest.warns(pdw.StepSizeWarning):
-        pdw.simulate(params=P, t_end=0.01, dt=2e-4, contact=c, check_step="warn")
+        pdw.simulate(params=P, t_end=0.01, dt=2e-4, contact=c,
+                     integrator=pdw.Integrator(check_step="warn"))
     pdw.simulate(params=P, t_end=0.01, dt=2e-4, contact=c, features=_without("friction"),
                  integrator=pdw.Integrator(check_step="error"))
 

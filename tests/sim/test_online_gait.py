@@ -68,8 +68,9 @@ RUNS = [
 def test_online_descriptors_follow_the_definitions(kw):
     kw = dict(kw)
     x0 = kw.pop("x0", pdw.X0_PAPER)
-    r = pdw.simulate(x0, dt=1e-4, record_every=1, record_forces=False, check_step="off",
-                     on_failure="return", **kw)
+    r = pdw.simulate(x0, dt=1e-4, integrator=pdw.Integrator(check_step="off"),
+                     record=pdw.Record(every=1, forces=False), limits=pdw.Limits(on_failure="return"),
+                     **kw)
     ref = _reference_steps(r, kw["params"])
     assert len(ref["L"]) >= 3, r.status
     on = r.gait
@@ -83,7 +84,7 @@ def test_online_descriptors_follow_the_definitions(kw):
 
 
 @pytest.mark.parametrize("method, kw", [("cdm", dict(dt=1e-4)), ("rodas4", dict(rtol=1e-7, atol=1e-9)),
-                                        ("rk4", dict(dt=2e-6))])
+                                        ("rk4", dict(dt=2e-6))])     # the fields of pdw.Integrator
 @pytest.mark.parametrize("variant", pdw.VARIANTS)
 def test_online_descriptors_are_the_offline_ones(method, kw, variant):
     """`pdw.steps` from the events (offline) and the compiled loop's ring (online), bit for
@@ -93,7 +94,8 @@ def test_online_descriptors_are_the_offline_ones(method, kw, variant):
         if method == "rk4":
             t_end = 1.6
         r = pdw.simulate(x0, t_end=t_end, params=params, method=method, variant=variant,
-                         record_every=0, on_failure="return", check_step="off", **kw)
+                         integrator=pdw.Integrator(check_step="off", **kw), record=pdw.Record(every=0),
+                         limits=pdw.Limits(on_failure="return"))
         off = pdw.steps(r.events)
         assert len(off) >= 1
         assert len(r.gait) == len(off) == r.n_gait_steps

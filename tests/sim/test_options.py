@@ -2,7 +2,6 @@
 Scene holding the same objects, outcomes, and simulate_batch's progress and repr."""
 import dataclasses
 import io
-import warnings
 
 import numpy as np
 import pytest
@@ -61,8 +60,7 @@ def test_a_value_given_twice_must_agree():
         pdw.simulate(t_end=0.01, stop=Stop(t_end=0.02))
     with pytest.raises(pdw.InvalidInputError, match="give it once"):
         pdw.simulate(t_end=0.01, method="rk4", integrator=Integrator(method="cdm"))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DeprecationWarning)
+    with pytest.warns(DeprecationWarning, match=r"simulate\(record_every=\.\.\.\) is deprecated"):
         with pytest.raises(pdw.InvalidInputError, match="record_every"):
             pdw.simulate(t_end=0.01, record=Record(), record_every=2)
     # given once, either way, the same run
@@ -77,8 +75,7 @@ def test_unknown_keyword_is_an_error_naming_it():
 
 
 def test_an_old_keyword_with_a_bad_value_names_the_keyword_written():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DeprecationWarning)
+    with pytest.warns(DeprecationWarning, match=r"simulate\(stop_steps=\.\.\.\) is deprecated"):
         with pytest.raises(pdw.InvalidInputError, match=r"'stop_steps' \(now 'stop.steps'\)"):
             pdw.simulate(t_end=0.01, stop_steps=-1)
 
@@ -216,7 +213,7 @@ def test_c_options_names_the_fields_of_pdw_run_opts():
 
 @pytest.mark.parametrize("fn", [pdw.simulate_batch, pdw.simulate_many])
 def test_ensembles_refuse_recording_keywords_instead_of_ignoring_them(fn):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DeprecationWarning)
+    name = fn.__name__
+    with pytest.warns(DeprecationWarning, match=r"%s\(record_forces=\.\.\.\) is deprecated" % name):
         with pytest.raises(pdw.InvalidInputError, match="records no samples"):
             fn(X2, 0.1, record_forces=False)

@@ -131,11 +131,11 @@ def test_a_gait_that_does_not_converge_is_not_stopped():
 @pytest.mark.parametrize("method, kw", [
     ("cdm", dict(dt=1e-4)), ("verlet", dict(dt=2e-6)), ("rk4", dict(dt=2e-6)),
     ("dopri5", dict(dt=1e-5)), ("rodas4", dict(rtol=1e-6, atol=1e-8)),
-])
+])      # the fields of pdw.Integrator
 def test_every_method_stops_after_n_steps(method, kw):
     assert method in METHODS
-    r = pdw.simulate(t_end=3.0, params=STEADY, method=method, record_every=1, stop_steps=2,
-                     **kw)
+    r = pdw.simulate(t_end=3.0, params=STEADY, method=method, integrator=pdw.Integrator(**kw),
+                     record=pdw.Record(every=1), stop=pdw.Stop(steps=2))
     assert r.status == "walked" and r.stop_reason == "steps" and r.n_gait_steps == 2
     td = [e for e in r.events if e.kind == "touch_down"]
     assert r.t_final == td[-1].t and r.t_final < 1.6         # the 3rd touch-down ends step 2
@@ -153,31 +153,32 @@ def test_every_method_stops_when_periodic(method):
 
 def test_stop_conditions_need_valid_settings():
     with pytest.raises(pdw.InvalidInputError, match="periodic_steps"):
-        pdw.simulate(t_end=0.1, periodic_steps=1)
+        pdw.simulate(t_end=0.1, stop=pdw.Stop(periodic=True, periodic_steps=1))
     with pytest.raises(pdw.InvalidInputError, match="periodic_steps"):
-        pdw.simulate(t_end=0.1, periodic_steps=_layout.STEP_RING + 1)
-    with pytest.raises(pdw.InvalidInputError, match="stop_steps"):
-        pdw.simulate(t_end=0.1, stop_steps=-1)
+        pdw.simulate(t_end=0.1,
+                     stop=pdw.Stop(periodic=True, periodic_steps=_layout.STEP_RING + 1))
+    with pytest.raises(pdw.InvalidInputError, match=r"stop\.steps"):
+        pdw.simulate(t_end=0.1, stop=pdw.Stop(steps=-1))
     with pytest.raises(pdw.InvalidInputError, match="periodic_tol"):
-        pdw.simulate(t_end=0.1, periodic_steps=3, periodic_tol=0.0)
+        pdw.simulate(t_end=0.1, stop=pdw.Stop(periodic=True, periodic_steps=3, periodic_tol=0.0))
 
 
 # ------------------------------------------------------------------ recording options
 
 def test_recording_options_do_what_they_say():
     base = dict(t_end=1.0, params=STEADY)
-    full = pdw.simulate(record_every=1, record_forces=True, record_energies=True, **base)
+    full = pdw.simulate(record=pdw.Record(every=1, forces=True, energies=True), **base)
     assert len(full.t) == 10001 and full.Fn.shape == (10001, 2)
     e = pdw.energies(full.x, full.params)
     for name in ("T", "V_gravity", "V_hip", "E"):
         np.testing.assert_allclose(full.energies[name], e[name], rtol=1e-12, atol=1e-12)
-    every = pdw.simulate(record_every=7, record_forces=False, **base)
+    every = pdw.simulate(record=pdw.Record(every=7, forces=False), **base)
     assert np.array_equal(every.t, full.t[::7]) and np.array_equal(every.x, full.x[::7])
     assert every.Fn.shape == (0, 2) and every.energies is None
-    ev = pdw.simulate(record_every=0, record_forces=False, **base)
+    ev = pdw.simulate(record=pdw.Record(every=0, forces=False), **base)
     assert len(ev.t) == 0 and ev.events == full.events
-    with pytest.raises(pdw.InvalidInputError, match="record_energies"):
-        pdw.simulate(record_every=0, record_energies=True, **base)
+    with pytest.raises(pdw.InvalidInputError, match=r"record\.energies"):
+        pdw.simulate(record=pdw.Record(every=0, energies=True), **base)
 
 
 def test_switched_off_forces_use_the_specialized_kernel_and_equal_zeroed_parameters():

@@ -142,8 +142,8 @@ def test_divergence_stops_with_time_state_and_reason():
     (dict(variant="papr"), "variant"),
     (dict(method="euler"), "method"),
     (dict(flags0=(1, 2)), "flags0"),
-    (dict(record_every=-1), "record_every"),
-    (dict(on_failure="ignore"), "on_failure"),
+    (dict(record=dict(every=-1)), r"record\.every"),            # a table, read by simulate
+    (dict(limits=dict(on_failure="ignore")), r"limits\.on_failure"),
 ])
 def test_bad_input_raises_a_clear_error(kwargs, field):
     with pytest.raises(pdw.InvalidInputError, match=field):
@@ -188,5 +188,5 @@ def test_fall_hip_height_must_be_a_finite_number(value):
 
 @pytest.mark.parametrize("value", [math.nan, None, 2 ** 70, 1.5, -1, "1", True])
 def test_record_every_errors_name_the_field(value):
-    with pytest.raises(pdw.InvalidInputError, match="record_every"):
-        pdw.simulate(t_end=0.01, record_every=value)
+    with pytest.raises(pdw.InvalidInputError, match=r"record\.every"):
+        pdw.simulate(t_end=0.01, record=pdw.Record(every=value))

@@ -31,7 +31,7 @@ def test_full_recording_takes_the_memory_of_its_samples_and_no_copy(t_end):
     """A fixed-step run allocates its samples once, exactly (no doubling past them, no copy
     of the trajectory to check it): the peak is the samples recorded plus a few kB, so it is
     linear in t_end. (It was 1.6x the samples for 3.5 s: the runaway check stacked a copy.)"""
-    r, held, peak = _peak(t_end=t_end, record_every=1)
+    r, held, peak = _peak(t_end=t_end, record=pdw.Record(every=1))
     samples = len(r.t) * SAMPLE
     assert r.status == "walked" and len(r.t) == round(t_end / 1e-4) + 1
     assert samples <= held and peak <= 1.02 * samples + 64e3, (samples, held, peak)
@@ -40,7 +40,7 @@ def test_full_recording_takes_the_memory_of_its_samples_and_no_copy(t_end):
 def test_an_adaptive_run_keeps_the_memory_of_its_samples_only():
     """An adaptive run's records grow geometrically and are trimmed once: what the result
     holds is its samples (RECORD_CHUNK = 65,536 would be 7 MB; rodas4 takes ~1,900 steps)."""
-    r, held, _ = _peak(method="rodas4", params=pdw.Params.paper_steady(), record_every=1)
+    r, held, _ = _peak(method="rodas4", params=pdw.Params.paper_steady(), record=pdw.Record(every=1))
     samples = len(r.t) * SAMPLE
     assert len(r.t) < _core.RECORD_CHUNK // 8
     assert held <= 1.05 * samples + 64e3, (samples, held)

@@ -67,12 +67,12 @@ def test_each_velocity_is_checked_against_max_speed(k, method):
     x0 = np.array(pdw.X0_PAPER, float)
     x0[4 + k] = 5.0
     assert np.abs(np.delete(x0[4:], k)).max() < 4.0
-    kw = dict(t_end=5 * DT, dt=DT / 50 if method == "rk4" else DT, method=method, record_every=1,
-              check_step="off", on_failure="return")
-    r = pdw.simulate(x0, max_speed=4.0, **kw)
+    kw = dict(t_end=5 * DT, dt=DT / 50 if method == "rk4" else DT, method=method,
+              integrator=pdw.Integrator(check_step="off"), record=pdw.Record(every=1))
+    r = pdw.simulate(x0, limits=pdw.Limits(max_speed=4.0, on_failure="return"), **kw)
     assert r.status == "diverged" and r.failure["reason"] == REASON["speed"], (k, r.status)
     assert r.failure["t"] == 0.0
-    ok = pdw.simulate(x0, max_speed=6.0, **kw)
+    ok = pdw.simulate(x0, limits=pdw.Limits(max_speed=6.0, on_failure="return"), **kw)
     assert ok.failure is None or ok.failure["reason"] != REASON["speed"]
 
 
@@ -131,7 +131,8 @@ def test_cdm_blowup_with_stiff_ground_is_not_walked():
     -118 rad after no step (only a StepSizeWarning)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pdw.StepSizeWarning)
-        r = pdw.simulate(dt=1e-3, params=pdw.Params(k_n=1e9), on_failure="return")
+        r = pdw.simulate(dt=1e-3, params=pdw.Params(k_n=1e9),
+                         limits=pdw.Limits(on_failure="return"))
         assert r.status == "diverged" and not r.walked
         assert "runaway" in r.failure["reason"]
         assert r.failure["t"] < r.t_final
@@ -224,7 +225,7 @@ def test_an_unestimable_step_limit_is_a_step_size_warning():
     p = pdw.Params(v_s=1e-160)
     with pytest.warns(pdw.StepSizeWarning):
         try:
-            pdw.simulate(params=p, t_end=1e-3, dt=1e-4, on_failure="return")
+            pdw.simulate(params=p, t_end=1e-3, dt=1e-4, limits=pdw.Limits(on_failure="return"))
         except np.linalg.LinAlgError:               # pragma: no cover - the finding
             pytest.fail("LinAlgError from the step check")
 

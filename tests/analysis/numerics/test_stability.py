@@ -58,21 +58,23 @@ def test_diverged_error_carries_time_state_reason_and_partial_result():
 _X_HIGH = np.array(pdw.X0_PAPER)
 _X_HIGH[1] = 10.0
 _RUNAWAY = dict(x0=_X_HIGH, dt=1e-3, t_end=1.0, params=pdw.Params(d_hip=500.0), flags0=(0, 0),
-                max_speed=1e300, fall_hip_height=-1e300, fall_depth=1e300, check_step="off")
+                integrator=pdw.Integrator(check_step="off"))
+_RUNAWAY_LIMITS = dict(max_speed=1e300, fall_hip_height=-1e300, fall_depth=1e300)
 
 
 @pytest.mark.parametrize("method", ["verlet", "rk4"])
 def test_non_finite_state_is_caught_within_the_step(method):
     """The compiled loop (pdw_check_state) stops at the first step whose new state is not
     finite, and keeps the last finite one: no NaN or inf reaches the result."""
-    r = pdw.simulate(method=method, on_failure="return", **_RUNAWAY)
+    r = pdw.simulate(method=method, limits=pdw.Limits(on_failure="return", **_RUNAWAY_LIMITS),
+                     **_RUNAWAY)
     assert r.status == "diverged"
     assert "non-finite" in r.failure["reason"]
     assert np.isfinite(r.failure["x"]).all() and r.failure["t"] < 0.05
     _finite_result(r)
     assert r.t[-1] == r.failure["t"] and np.array_equal(r.x[-1], r.failure["x"])
     with pytest.raises(DivergedError, match="non-finite") as ei:
-        pdw.simulate(method=method, **_RUNAWAY)
+        pdw.simulate(method=method, limits=pdw.Limits(**_RUNAWAY_LIMITS), **_RUNAWAY)
     assert ei.value.t == r.failure["t"]
     np.testing.assert_array_equal(ei.value.x, r.failure["x"])
 
@@ -162,7 +164,7 @@ def _no_warning(**kw):
 
 def test_paper_dt_does_not_warn():
     """The paper's own dt = 1e-4 with cdm, at the paper's parameters (it walks there)."""
-    r = _no_warning(record_every=0)
+    r = _no_warning(record=pdw.Record(every=0))
     assert r.walked
     for method in SL.FIXED_STEP:
         for P in (pdw.Params.paper(), pdw.Params.paper_steady()):
@@ -189,8 +191,8 @@ def test_check_step_error_refuses_and_off_is_silent():
         pdw.simulate(dt=3 * lim.dt_max, params=P, method="rk4",
                      integrator=pdw.Integrator(check_step="error"))
     assert ei.value.limit == lim.dt_max and ei.value.force == lim.force == "d_n"
-    _no_warning(dt=3 * lim.dt_max, params=P, method="rk4", check_step="off", on_failure="return",
-                record_every=0)
+    _no_warning(dt=3 * lim.dt_max, params=P, method="rk4", integrator=pdw.Integrator(check_step="off"),
+                record=pdw.Record(every=0), limits=pdw.Limits(on_failure="return"))
     with pytest.raises(InvalidInputError, match="check_step"):
         pdw.simulate(integrator=pdw.Integrator(check_step="yes"))
 

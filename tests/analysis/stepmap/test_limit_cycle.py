@@ -22,8 +22,8 @@ def gait():
 @pytest.fixture(scope="module")
 def long_run():
     """20 s from the paper's x0 with rodas4 at the Newton tolerances, every step recorded."""
-    return pdw.simulate(t_end=20, params=P, method="rodas4", record_every=1, record_forces=False,
-                        **LC.TIGHT)
+    return pdw.simulate(t_end=20, params=P, method="rodas4", integrator=pdw.Integrator(**LC.TIGHT),
+                        record=pdw.Record(every=1, forces=False))
 
 
 def test_section_embedding_round_trip():

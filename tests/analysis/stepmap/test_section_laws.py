@@ -58,10 +58,11 @@ def _touch_downs(r, contact, speeds0=None):
     return out
 
 
-def _run(z, contact, t_end, **opts):
+def _run(z, contact, t_end, **tolerances):
     x0, a0 = S.start(z, P, contact)
     r = pdw.simulate(x0, t_end=t_end, params=P, method="rodas4", flags0=(1, 1), contact=contact,
-                     record_every=1, approach_speeds0=a0, **opts)
+                     integrator=pdw.Integrator(**tolerances), record=pdw.Record(every=1),
+                     approach_speeds0=a0)
     return r, a0
 
 

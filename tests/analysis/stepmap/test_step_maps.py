@@ -113,7 +113,7 @@ def test_batchable_is_what_the_engine_takes_bitwise():
 
 @pytest.mark.parametrize("method", ["rodas4", "cdm"])
 def test_stop_touch_down_ends_at_the_event(method):
-    """simulate(stop_touch_down=k) stops at leg k's first touch-down with the event's state:
+    """simulate(stop=Stop(touch_down=k)) stops at leg k's first touch-down with the event's state:
     the sample a full recorded run has at that event; the batch says the same."""
     x0 = pdw.X0_PAPER
     full = pdw.simulate(x0, t_end=1.0, method=method, record=pdw.Record(events=True))
@@ -130,7 +130,10 @@ def test_stop_touch_down_ends_at_the_event(method):
 
 @pytest.mark.parametrize("bad", [3, -1, 1.5, "1", True])
 def test_stop_touch_down_is_checked(bad):
-    with pytest.raises(pdw.InvalidInputError, match="stop_touch_down"):
-        pdw.simulate(pdw.X0_PAPER, t_end=0.1, stop_touch_down=bad)
-    with pytest.raises(pdw.InvalidInputError, match="stop_touch_down"):
-        pdw.simulate_batch(np.array([pdw.X0_PAPER]), t_end=0.1, stop_touch_down=bad)
+    """Checked by the option object, and by each entry point given the table as a dict."""
+    with pytest.raises(pdw.InvalidInputError, match=r"stop\.touch_down"):
+        pdw.Stop(touch_down=bad)
+    with pytest.raises(pdw.InvalidInputError, match=r"stop\.touch_down"):
+        pdw.simulate(pdw.X0_PAPER, t_end=0.1, stop={"touch_down": bad})
+    with pytest.raises(pdw.InvalidInputError, match=r"stop\.touch_down"):
+        pdw.simulate_batch(np.array([pdw.X0_PAPER]), t_end=0.1, stop={"touch_down": bad})
