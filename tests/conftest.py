@@ -24,10 +24,43 @@ QUICK_FILES = {"test_params.py", "test_simulation.py", "test_gait.py", "test_sce
                "test_ode_function.py", "test_cli.py", "test_paths.py", "test_architecture.py"}
 
 
+#: Deprecations are errors in the tests: a test uses today's spelling (``integrator=
+#: pdw.Integrator(rtol=...)``, ``record=pdw.Record(every=...)``, ``[limits]`` in a scene, the
+#: new import paths), and one that checks a spelling of before on purpose says so with
+#: ``pytest.warns(DeprecationWarning, match=...)`` -- which captures the warning, so it is no
+#: error there. Why a hook and not ``filterwarnings = ["error::DeprecationWarning:pdw.*"]`` in
+#: pyproject.toml: a deprecation of pdw is reported at its caller's line (``stacklevel``), so its
+#: module is the test's (or another pdw module's), never ``pdw.sim.options``; and one global
+#: entry would also fail the files below. Every DeprecationWarning is an error, a third party's
+#: too (none is raised today): a dependency that deprecates what pdw calls is to be fixed, not
+#: hidden. A test may still ignore one on purpose with ``warnings.catch_warnings()``.
+#: The hook's mark goes first among the test's own marks, so a test's own
+#: ``@pytest.mark.filterwarnings`` still wins.
+DEPRECATION_ERRORS = "error::DeprecationWarning"
+#: Test files still calling the spellings of before without asserting the warning (path under
+#: tests/ -> why). Each is owned by a helper of this round and migrated after the merge; then
+#: its line goes.
+STILL_LEGACY = {
+    "core/test_terrain.py": "old keywords of simulate; migrated after the terra3 merge (#22)",
+    "core/test_switching.py": "old keywords of simulate; migrated after the round's merges",
+    "sim/test_batch.py": "old keywords of simulate_batch; migrated after the lanes2 merge (#23)",
+    "sim/test_batch_inputs.py": "old keywords of simulate_batch; after the lanes2 merge (#23)",
+    "sim/test_batch_lanes.py": "old keywords of simulate_batch; after the lanes2 merge (#23)",
+    "sim/test_batch_paths.py": "old keywords of simulate_batch; after the lanes2 merge (#23)",
+}
+TESTS = pathlib.Path(__file__).resolve().parent
+
+
 def pytest_collection_modifyitems(config, items):
     for item in items:
         if item.path.name in QUICK_FILES:
             item.add_marker(pytest.mark.quick)
+        try:
+            rel = item.path.resolve().relative_to(TESTS).as_posix()
+        except ValueError:              # not under tests/ (a doctest of a module, say)
+            continue
+        if rel not in STILL_LEGACY:
+            item.add_marker(pytest.mark.filterwarnings(DEPRECATION_ERRORS), append=False)
 
 
 @pytest.fixture(scope="session")
