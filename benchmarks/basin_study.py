@@ -61,17 +61,20 @@ def main():
                   for k in range(len(flat))])
 
     def one(k):
-        return pdw.simulate(X[k], t_end=T_END, params=p, flags0=(1, 1), record_every=0,
-                            record_forces=False, record_events=False, periodic_steps=4,
-                            on_failure="return", check_step="off")
+        return pdw.simulate(X[k], t_end=T_END, params=p, flags0=(1, 1),
+                            integrator=pdw.Integrator(check_step="off"),
+                            record=pdw.Record(every=0, forces=False, events=False),
+                            stop=pdw.Stop(periodic=True, periodic_steps=4),
+                            limits=pdw.Limits(on_failure="return"))
 
     def scalar():
         with ThreadPoolExecutor(THREADS) as ex:
             return list(ex.map(one, range(len(flat))))
 
     def batch():
-        return pdw.simulate_batch(X, t_end=T_END, params=p, flags0=(1, 1), periodic_steps=4,
-                                  threads=THREADS, check_step="off")
+        return pdw.simulate_batch(X, t_end=T_END, params=p, flags0=(1, 1),
+                                  stop=pdw.Stop(periodic=True, periodic_steps=4),
+                                  threads=THREADS, integrator=pdw.Integrator(check_step="off"))
     # the sample, scalar and batch interleaved (ROUNDS rounds, medians)
     times = {"scalar": [], "batch": []}
     for _ in range(ROUNDS):

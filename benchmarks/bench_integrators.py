@@ -4,6 +4,7 @@ import time
 
 import numpy as np
 
+from pdw.sim.options import Integrator, Record
 from pdw.sim.simulation import simulate
 
 
@@ -14,7 +15,8 @@ def best(f, n):
         r = f()
         ts.append(time.perf_counter() - t)
     return r, min(ts)
-ref = simulate(method="rodas4", rtol=1e-12, atol=1e-14, record_every=0, event_tol=1e-12)
+ref = simulate(method="rodas4", integrator=Integrator(rtol=1e-12, atol=1e-14, event_tol=1e-12),
+               record=Record(every=0))
 evr = np.array([e.t for e in ref.events])
 runs = [("cdm", dict(dt=1e-4)), ("cdm", dict(dt=1e-6)), ("verlet", dict(dt=1e-6)), ("rk4", dict(dt=1e-6)),
         ("dopri5", dict(dt=1e-5, rtol=1e-6, atol=1e-8)), ("dopri5", dict(dt=1e-5, rtol=1e-9, atol=1e-11))] + \
@@ -23,7 +25,8 @@ print("| method | options | wall [ms] | f evals | Jacobians | steps (rejected) |
 print("|---|---|---|---|---|---|---|---|")
 for m, kw in runs:
     n = 7 if m == "rodas4" or kw.get("dt", 0) >= 1e-4 else 2
-    r, w = best(lambda m=m, kw=kw: simulate(method=m, record_every=0, **kw), n)
+    r, w = best(lambda m=m, kw=kw: simulate(method=m, integrator=Integrator(**kw),
+                                            record=Record(every=0)), n)
     ev = np.array([e.t for e in r.events])
     eve = "%.1e" % np.abs(ev-evr).max() if len(ev)==len(evr) else "n/a"
     st = r.stats

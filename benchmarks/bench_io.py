@@ -44,13 +44,14 @@ for fn in (lambda: f(0.0, X), lambda: f.jac(0.0, X), lambda: pdw.rhs(X)):
 FRESH = r"""
 import time, sys, pdw
 mode = sys.argv[1]
-kw = {"record_every": 0} if mode == "none" else {}
 out = pdw.RecordBuffer(35002) if mode == "out" else None
 if out is not None:
     out.x[:] = 0; out.t[:] = 0; out.flags[:] = 0; out.contact[:] = 0   # allocated before timing
+opts = dict(integrator=pdw.Integrator(check_step="off"),
+            record=pdw.Record(every=0 if mode == "none" else 1, out=out))
 ts = []
 for _ in range(4):
-    t0 = time.perf_counter(); pdw.simulate(check_step="off", out=out, **kw)
+    t0 = time.perf_counter(); pdw.simulate(**opts)
     ts.append(time.perf_counter() - t0)
 print(*ts)
 """

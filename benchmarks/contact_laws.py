@@ -45,10 +45,14 @@ P = pdw.Params.paper_steady()
 FIG = ROOT / "docs" / "figures" / "contact_laws_stance.png"
 
 
-def sim(contact, **kw):
-    kw.setdefault("on_failure", "return")
-    kw.setdefault("check_step", "off")
-    return pdw.simulate(params=P, contact=contact, **kw)
+def sim(contact, *, rtol=1e-6, atol=1e-8, h_max=None, record_every=1, record_forces=True, **kw):
+    """`pdw.simulate` at P under ``contact``, a divergence returned, no step-size check; the
+    tolerances and recording as fields of pdw.Integrator and pdw.Record (their defaults)."""
+    return pdw.simulate(params=P, contact=contact,
+                        integrator=pdw.Integrator(rtol=rtol, atol=atol, h_max=h_max,
+                                                  check_step="off"),
+                        record=pdw.Record(every=record_every, forces=record_forces),
+                        limits=pdw.Limits(on_failure="return"), **kw)
 
 
 def gait_and_forces(contact):

@@ -80,8 +80,10 @@ def main():
                 continue
             x0, f0 = state[law]
             r = pdw.simulate(x0, params=P, variant="consistent", contact=c, t_end=16.0,
-                             method="rodas4", rtol=1e-9, atol=1e-11, record_every=0,
-                             periodic_steps=4, periodic_tol=1e-5, flags0=f0, on_failure="return")
+                             method="rodas4", integrator=pdw.Integrator(rtol=1e-9, atol=1e-11),
+                             record=pdw.Record(every=0),
+                             stop=pdw.Stop(periodic=True, periodic_steps=4, periodic_tol=1e-5),
+                             limits=pdw.Limits(on_failure="return"), flags0=f0)
             prm = ", ".join("%s=%.4g" % (n, v) for n, v in c.as_dict().items()
                             if n not in ("normal", "friction"))
             if r.n_gait_steps < 4 or not r.walked:

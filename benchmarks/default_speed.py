@@ -26,10 +26,12 @@ def best(f, n):
 if __name__ == "__main__":
     pdw.simulate(t_end=0.1)
     P = pdw.Params.paper_steady()
-    a = best(lambda: pdw.simulate(record_every=0), 30)
-    b = best(lambda: pdw.simulate(params=P, method="rodas4", rtol=1e-8, atol=1e-10,
-                                  record_every=0), 8)
-    c = best(lambda: pdw.simulate(params=P, method="rk4", dt=2e-5, record_every=0,
-                                  check_step="off"), 3)
+    a = best(lambda: pdw.simulate(record=pdw.Record(every=0)), 30)
+    b = best(lambda: pdw.simulate(params=P, method="rodas4",
+                                  integrator=pdw.Integrator(rtol=1e-8, atol=1e-10),
+                                  record=pdw.Record(every=0)), 8)
+    c = best(lambda: pdw.simulate(params=P, method="rk4", dt=2e-5,
+                                  integrator=pdw.Integrator(check_step="off"),
+                                  record=pdw.Record(every=0)), 3)
     print("%s paper cdm %.4f s  rodas4 %.4f s  rk4 %.4f s  load %.2f"
           % (pdw.__file__, a, b, c, os.getloadavg()[0]))

@@ -4,8 +4,8 @@ the same binaries and inputs whatever else the machine does.
 
 Regions (each counted alone; the import of pdw and numpy and each region's warm-up are not):
 
-* ``paper_run``           the paper's typical gait, `pdw.simulate(record_every=0)` (warm)
-* ``paper_run_recorded``  the same with full recording (``record_every=1``, warm)
+* ``paper_run``           the paper's typical gait, `pdw.simulate(record=Record(every=0))` (warm)
+* ``paper_run_recorded``  the same with full recording (``Record(every=1)``, warm)
 * ``first_call``          the first `pdw.simulate()` of a fresh process after ``import pdw``:
                           the default step-size check included
 * ``batch_cdm_64``        `pdw.simulate_batch` of 64 walkers, 0.5 s, cdm (one thread)
@@ -70,13 +70,14 @@ def _child(which):
         return
     P = pdw.Params.paper()
     X = pdw.X0_PAPER + 1e-3 * np.random.default_rng(1).standard_normal((64, len(pdw.STATE)))
-    pdw.simulate(params=P, record_every=0)                      # warm-ups, not counted
-    pdw.simulate(params=P, record_every=1)
+    bare, full = pdw.Record(every=0), pdw.Record(every=1)        # made outside the regions
+    pdw.simulate(params=P, record=bare)                          # warm-ups, not counted
+    pdw.simulate(params=P, record=full)
     pdw.simulate_batch(X[:2], t_end=0.01, method="cdm", threads=1)
     pdw.simulate_batch(X[:2], t_end=0.01, method="rodas4", threads=1)
     jobs = {
-        "paper_run": lambda: pdw.simulate(params=P, record_every=0),
-        "paper_run_recorded": lambda: pdw.simulate(params=P, record_every=1),
+        "paper_run": lambda: pdw.simulate(params=P, record=bare),
+        "paper_run_recorded": lambda: pdw.simulate(params=P, record=full),
         "batch_cdm_64": lambda: pdw.simulate_batch(X, t_end=0.5, method="cdm", threads=1),
         "batch_rodas4_64": lambda: pdw.simulate_batch(X, t_end=0.5, method="rodas4", threads=1),
         "find_gait": lambda: pdw.find_gait(pdw.Params.paper_steady(), workers=1),

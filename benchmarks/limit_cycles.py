@@ -61,7 +61,7 @@ def fixed_points(lines):
         ]
     # consistent variant: the restart resets the trailing foot's anchor; compare with a run
     r = pdw.simulate(t_end=25, params=P, variant="consistent", method="rodas4",
-                     record_every=1, record_forces=False, **LC.TIGHT)
+                     integrator=pdw.Integrator(**LC.TIGHT), record=pdw.Record(every=1, forces=False))
     e = [e for e in r.events if e.kind == "touch_down"][-1]
     i = int(np.argmin(np.abs(r.t - e.t)))
     z = LC.section_coordinates(r.x[i], e.leg)
@@ -71,8 +71,8 @@ def fixed_points(lines):
               "%.6f s and L %.6f m (map's fixed point: %.6f s, %.6f m): the anchor reset of the "
               "trailing foot at each restart" % (np.max(np.abs(z - g.details["z"])), st["cycle"],
                                                  st["L"], g.period, g.step_length)]
-    r = pdw.simulate(t_end=25, params=P, method="rodas4", record_every=1, record_forces=False,
-                     **LC.TIGHT)
+    r = pdw.simulate(t_end=25, params=P, method="rodas4", integrator=pdw.Integrator(**LC.TIGHT),
+                     record=pdw.Record(every=1, forces=False))
     e = [e for e in r.events if e.kind == "touch_down"][-1]
     i = int(np.argmin(np.abs(r.t - e.t)))
     z = LC.section_coordinates(r.x[i], e.leg)

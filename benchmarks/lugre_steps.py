@@ -20,7 +20,8 @@ for label, c in (("calibrated sigma1 = %.2f" % cal.sigma1, cal),
     for m in ("cdm", "verlet", "rk4"):
         row = []
         for dt in (1e-4, 5e-5, 2e-5, 1e-5):
-            r = pdw.simulate(params=P, t_end=3.0, dt=dt, method=m, contact=c, record_every=0,
-                             on_failure="return", check_step="off")
+            r = pdw.simulate(params=P, t_end=3.0, dt=dt, method=m, contact=c,
+                             integrator=pdw.Integrator(check_step="off"),
+                             record=pdw.Record(every=0), limits=pdw.Limits(on_failure="return"))
             row.append("%g: %s (%d steps)" % (dt, r.status, r.n_gait_steps))
         print("%-26s %-7s %s" % (label, m, "; ".join(row)))

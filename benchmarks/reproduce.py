@@ -28,7 +28,8 @@ def long():
         "preset", "variant", "status", "t_end", "steps", "L", "P", "v", "DS [ms]", "spread L"))
     for preset in ("paper", "paper_steady"):
         for variant in pdw.VARIANTS:
-            r = pdw.simulate(t_end=20.0, params=pdw.Params.preset(preset), variant=variant, record_every=0)
+            r = pdw.simulate(t_end=20.0, params=pdw.Params.preset(preset), variant=variant,
+                             record=pdw.Record(every=0))
             st = pdw.steps(r)
             sd = st.steady(4)
             print("%-13s %-11s %-8s %8.3f %6d %8.4f %8.4f %8.4f %9.1f %10.2g" % (
@@ -49,9 +50,9 @@ def disturbed():
     for preset in ("paper", "paper_steady"):
         for variant in pdw.VARIANTS:
             typ = pdw.steps(pdw.simulate(t_end=20.0, params=pdw.Params.preset(preset), variant=variant,
-                                         record_every=0)).steady(4)
+                                         record=pdw.Record(every=0))).steady(4)
             r = pdw.simulate(pdw.X0_DISTURBED, t_end=20.0, params=pdw.Params.preset(preset),
-                             variant=variant, flags0=(1, 0), record_every=0)
+                             variant=variant, flags0=(1, 0), record=pdw.Record(every=0))
             st = pdw.steps(r)
             sd = st.steady(4)
             print("%-13s %-11s %s" % (preset, variant, r.summary()))

@@ -52,8 +52,9 @@ def stride(gait, variant):
     """Two steps of the continuous model from its fixed point, every accepted step recorded."""
     p = gait.params
     return pdw.simulate(gait.state, t_end=2 * gait.period + 1e-6, params=p, variant=variant,
-                        method="rodas4", flags0=(1, 1), record_every=1, record_forces=False,
-                        rtol=1e-10, atol=1e-12)
+                        method="rodas4", flags0=(1, 1),
+                        integrator=pdw.Integrator(rtol=1e-10, atol=1e-12),
+                        record=pdw.Record(every=1, forces=False))
 
 
 def rigid_limit():

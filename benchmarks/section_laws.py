@@ -37,7 +37,8 @@ def returns(g, c, t_end=2.4):
     z = g.details["z"]
     x0, a0 = S.start(z, P, c)
     r = pdw.simulate(x0, t_end=t_end, params=P, method="rodas4", flags0=(1, 1), contact=c,
-                     record_every=1, approach_speeds0=a0, **LC.TIGHT)
+                     integrator=pdw.Integrator(**LC.TIGHT), record=pdw.Record(every=1),
+                     approach_speeds0=a0)
     d = []
     for e in (e for e in r.events if e.kind == "touch_down"):
         i = int(np.searchsorted(r.t, e.t))
@@ -49,8 +50,9 @@ def returns(g, c, t_end=2.4):
 def walk(c, t_end=30.0, last=30):
     """(min, max) of the step length L [m] over the ``last`` steps of a walk from the paper's
     start (rodas4, rtol 1e-8), or the run's status if it did not walk."""
-    r = pdw.simulate(params=P, t_end=t_end, method="rodas4", rtol=1e-8, atol=1e-10, contact=c,
-                     record_every=0)
+    r = pdw.simulate(params=P, t_end=t_end, method="rodas4",
+                     integrator=pdw.Integrator(rtol=1e-8, atol=1e-10), record=pdw.Record(every=0),
+                     contact=c)
     if not r.walked:
         return r.status
     L = pdw.steps(r).to_dataframe()["L"].to_numpy()[-last:]

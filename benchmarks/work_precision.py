@@ -76,7 +76,8 @@ def run_pdw(prob, method, t_end, **kw):
     if "rtol" in kw:                 # the default event_tol, 1e-9 s, would floor the tight runs
         kw.setdefault("event_tol", min(1e-9, kw["rtol"]))
     r = pdw.simulate(x0=prob["x0"], t_end=t_end, params=prob["params"], variant=prob["variant"],
-                     method=method, record_every=0, record_forces=False, on_failure="return", **kw)
+                     method=method, integrator=pdw.Integrator(**kw),
+                     record=pdw.Record(every=0, forces=False), limits=pdw.Limits(on_failure="return"))
     return dict(x=r.x_final, events=r.events, status=r.status, t_final=r.t_final,
                 rhs=r.stats["rhs"], jac=r.stats["jacobians"], steps=r.stats["steps"],
                 rejected=r.stats["rejected"])
