@@ -3,6 +3,7 @@ import pathlib
 import re
 import subprocess
 import sys
+import warnings
 
 import numpy as np
 import pytest
@@ -17,7 +18,7 @@ PUBLIC_BEFORE_LAYERS = [
     "STATE", "VARIANTS", "INPUT_HASH", "simulate", "Result", "Event", "METHODS", "X0_PAPER",
     "X0_DISTURBED", "steps", "Steps", "PdwError", "SimulationError", "DivergedError",
     "SingularSystemError", "FellError", "InvalidInputError", "hybrid", "Gait", "Scene", "run",
-    "limit_cycle", "cell_mapping", "find_gait", "sweep", "StepSizeWarning", "StepSizeError",
+    "limit_cycle", "cell_mapping", "find_gait", "sweep", "StepSizeWarning", "StepSizeError", "PdwDeprecationWarning",
 ]
 
 
@@ -181,12 +182,16 @@ def test_old_keyword_warns_and_maps_to_its_field(old):
 
 
 def test_an_unasserted_deprecation_is_an_error_in_the_tests():
-    """tests/conftest.py makes a DeprecationWarning that a test does not assert an error (here
-    an old keyword, which warns and runs outside the tests); the files it still exempts
-    exist, and this file is not one of them."""
+    """tests/conftest.py makes a deprecation of pdw that a test does not assert an error (here
+    an old keyword, which warns and runs outside the tests), not a third party's
+    DeprecationWarning; the files it still exempts exist, and this file is not one of them."""
     import conftest
-    with pytest.raises(DeprecationWarning, match=r"simulate\(record_every=\.\.\.\) is deprecated"):
+    with pytest.raises(pdw.PdwDeprecationWarning,
+                       match=r"simulate\(record_every=\.\.\.\) is deprecated"):
         pdw.simulate(t_end=0.01, record_every=0)
+    with warnings.catch_warnings(record=True) as rec:      # a dependency's: a warning, no error
+        warnings.warn("numpy.foo is deprecated", DeprecationWarning, stacklevel=1)
+    assert [w.category for w in rec] == [DeprecationWarning]
     with pytest.warns(DeprecationWarning, match=r"write record=pdw\.Record\(every=\.\.\.\)"):
         assert len(pdw.simulate(t_end=0.01, record_every=0).t) == 0
     assert all((conftest.TESTS / path).is_file() for path in conftest.STILL_LEGACY)

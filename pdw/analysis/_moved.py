@@ -17,6 +17,8 @@ import sys
 import types
 import warnings
 
+from ..core.errors import PdwDeprecationWarning
+
 #: old dotted path -> new dotted path of every module that moved into a subpackage
 MOVED = {f"pdw.analysis.{old}": f"pdw.analysis.{package}.{old}" for old, package in (
     # the one-step (touch-down Poincare) map of the continuous walker and its gaits
@@ -78,7 +80,7 @@ class AliasFinder(importlib.abc.MetaPathFinder, importlib.abc.Loader):
     def create_module(self, spec):
         new = MOVED[spec.name]
         warnings.warn(f"{spec.name} moved to {new}; import it from there (the old path goes "
-                      "in the next release)", DeprecationWarning, stacklevel=_caller_stacklevel())
+                      "in the next release)", PdwDeprecationWarning, stacklevel=_caller_stacklevel())
         module = importlib.import_module(new)
         spec.loader_state = module.__spec__       # the import system overwrites __spec__
         return module

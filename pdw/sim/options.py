@@ -31,7 +31,7 @@ import numpy as np
 
 from ..core import _layout
 from ..core.checks import MAX_COUNT, unmasked
-from ..core.errors import InvalidInputError
+from ..core.errors import InvalidInputError, PdwDeprecationWarning
 from ..core.ground import Ground
 from ..core.integrators import METHODS
 
@@ -566,7 +566,7 @@ def resolve(fn: str, positional: tuple, legacy: dict, objects: dict, stacklevel:
     for name, value in zip(order, positional):
         warnings.warn("%s: passing %s by position is deprecated; write %s(x0, t_end, dt, %s)"
                       % (fn, name, fn, new_spelling(name) if name in LEGACY else name + "=..."),
-                      DeprecationWarning, stacklevel=stacklevel)
+                      PdwDeprecationWarning, stacklevel=stacklevel)
         if name in LEGACY:
             if name in legacy:
                 raise InvalidInputError("%s got %s both by position and by keyword" % (fn, name))
@@ -579,7 +579,7 @@ def resolve(fn: str, positional: tuple, legacy: dict, objects: dict, stacklevel:
             raise InvalidInputError("%s got an unexpected keyword argument %r" % (fn, old))
         if not any(old == n for n in order[:len(positional)]):
             warnings.warn("%s(%s=...) is deprecated; write %s" % (fn, old, new_spelling(old)),
-                          DeprecationWarning, stacklevel=stacklevel)
+                          PdwDeprecationWarning, stacklevel=stacklevel)
         section = LEGACY[old][0]
         if objects.get(section) is not None:
             raise InvalidInputError("%s got both %s= and the old keyword %s= (its field %s.%s): "

@@ -89,7 +89,7 @@ from dataclasses import dataclass
 
 from ..core import _layout, _toml
 from ..core.contact import Contact
-from ..core.errors import InvalidInputError
+from ..core.errors import InvalidInputError, PdwDeprecationWarning
 from ..core.ground import Ground
 from ..core.params import X0_PAPER, Params
 from . import options as _options
@@ -351,7 +351,7 @@ class Scene(_Section):
 
 def _warn_moved(moved):
     warnings.warn("scene [stop] keys %s moved to [limits] (pdw.Limits); [stop] reads them for "
-                  "one more release" % ", ".join(sorted(moved)), DeprecationWarning, stacklevel=4)
+                  "one more release" % ", ".join(sorted(moved)), PdwDeprecationWarning, stacklevel=4)
 
 
 def _move_limits(stop, limits):
