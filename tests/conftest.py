@@ -37,15 +37,8 @@ QUICK_FILES = {"test_params.py", "test_simulation.py", "test_gait.py", "test_sce
 DEPRECATION_ERRORS = "error::pdw.PdwDeprecationWarning"
 #: Test files still calling the spellings of before without asserting the warning (path under
 #: tests/ -> why). Each is owned by a helper of this round and migrated after the merge; then
-#: its line goes.
-STILL_LEGACY = {
-    "core/test_terrain.py": "old keywords of simulate; migrated after the terra3 merge (#22)",
-    "core/test_switching.py": "old keywords of simulate; migrated after the round's merges",
-    "sim/test_batch.py": "old keywords of simulate_batch; migrated after the lanes2 merge (#23)",
-    "sim/test_batch_inputs.py": "old keywords of simulate_batch; after the lanes2 merge (#23)",
-    "sim/test_batch_lanes.py": "old keywords of simulate_batch; after the lanes2 merge (#23)",
-    "sim/test_batch_paths.py": "old keywords of simulate_batch; after the lanes2 merge (#23)",
-}
+#: its line goes. Empty: every test file writes the option objects.
+STILL_LEGACY: dict[str, str] = {}
 TESTS = pathlib.Path(__file__).resolve().parent
 
 

@@ -181,10 +181,12 @@ def test_lane_loops_switch_crafted_states_as_the_scalar_loop(method, monkeypatch
     cases = _crafted(np.random.default_rng(7), 48)
     X = np.array([c[0] for c in cases])
     F = np.array([c[1] for c in cases])
-    kw = dict(t_end=6 * DT, dt=DT, method=method, variant="paper", check_step="off")
+    kw = dict(t_end=6 * DT, dt=DT, method=method, variant="paper",
+              integrator=pdw.Integrator(check_step="off"))
     if method == "rodas4":
-        kw.update(rtol=1e-6, atol=1e-8)
-    ref = [pdw.simulate(x, flags0=tuple(f), record_every=0, on_failure="return", **kw)
+        kw.update(integrator=pdw.Integrator(check_step="off", rtol=1e-6, atol=1e-8))
+    ref = [pdw.simulate(x, flags0=tuple(f), record=pdw.Record(every=0),
+                        limits=pdw.Limits(on_failure="return"), **kw)
            for x, f in zip(X, F)]
     assert sum(r.event_counts["touch_down"] + r.event_counts["lift_off"] for r in ref) >= 20
     for isa in [n for n in _batch.ISAS if _batch.isa_supported(n)]:

@@ -9,7 +9,8 @@ import pdw
 from pdw import Ground
 
 P = pdw.Params.paper_steady()
-TIGHT = dict(method="rodas4", rtol=1e-11, atol=1e-13, event_tol=1e-12, record_every=0)
+TIGHT = dict(method="rodas4", integrator=pdw.Integrator(rtol=1e-11, atol=1e-13, event_tol=1e-12),
+             record=pdw.Record(every=0))
 
 
 def _plane_frame(x, d):
@@ -35,7 +36,7 @@ def test_flat_ground_is_todays_model_bitwise(method):
 def test_shaped_kernel_on_a_level_plane_is_the_flat_model():
     """The shaped-ground kernel itself (a plane of slope 0) reproduces the flat kernel: cdm to
     rounding, rodas4 (whose Jacobian is then a central difference) to its tolerance."""
-    kw = dict(t_end=1.5, params=P, record_every=0)
+    kw = dict(t_end=1.5, params=P, record=pdw.Record(every=0))
     a = pdw.simulate(**kw)
     b = pdw.simulate(ground=Ground.plane(0.0), **kw)
     assert np.abs(a.x_final - b.x_final).max() < 1e-12
@@ -79,7 +80,7 @@ def test_a_height_offset_changes_nothing_but_the_height(c):
 
 def test_a_patch_everywhere_is_the_changed_parameter():
     """Per-foot patched parameters = the parameter changed (same shaped kernel, same arithmetic)."""
-    kw = dict(t_end=2.0, record_every=0)
+    kw = dict(t_end=2.0, record=pdw.Record(every=0))
     a = pdw.simulate(params=P.replace(k_n=2e5, mu_s=0.6), ground=Ground.plane(0.0), **kw)
     b = pdw.simulate(params=P, ground=Ground.plane(0.0).with_patches(
         [dict(s_a=-10.0, s_b=40.0, k_n=2e5, mu_s=0.6)]), **kw)
@@ -247,7 +248,8 @@ def test_tilted_plane_with_other_contact_laws(contact):
     """Every contact law runs on the shaped ground unchanged (surface-frame kinematics); LuGre's
     bristle states ride along (its Jacobian: central differences)."""
     d = 0.01
-    kw = dict(t_end=2.0, contact=contact, **dict(TIGHT, rtol=1e-10, atol=1e-12))
+    kw = dict(t_end=2.0, contact=contact,
+              **dict(TIGHT, integrator=TIGHT["integrator"].replace(rtol=1e-10, atol=1e-12)))
     ref = pdw.simulate(pdw.X0_PAPER, params=P.replace(gamma=P.gamma + d), **kw)
     g = pdw.simulate(_plane_frame(np.array(pdw.X0_PAPER), d), params=P, ground=Ground.plane(d), **kw)
     assert ref.status == g.status == "walked" and ref.n_gait_steps == g.n_gait_steps >= 2

@@ -18,9 +18,10 @@ def _states(n, seed=0):
     return x
 
 
-def _scalar(x, params, **kw):
-    return pdw.simulate(x, t_end=T_END, params=params, record_every=1, record_forces=False,
-                        on_failure="return", check_step="off", **kw)
+def _scalar(x, params, integrator=None, **kw):
+    integrator = (integrator or pdw.Integrator()).replace(check_step="off")
+    return pdw.simulate(x, t_end=T_END, params=params, record=pdw.Record(every=1, forces=False),
+                        limits=pdw.Limits(on_failure="return"), integrator=integrator, **kw)
 
 
 def _assert_same(b, i, r, rtol=1e-12):
@@ -69,7 +70,7 @@ def test_per_walker_params_and_stop_steps():
     b = simulate_batch(x, t_end=T_END, params=params, lanes=4, threads=1, vector=False,
                        integrator=pdw.Integrator(check_step="off"), stop=pdw.Stop(steps=2))
     for i in range(6):
-        _assert_same(b, i, _scalar(x[i], params[i], stop_steps=2))
+        _assert_same(b, i, _scalar(x[i], params[i], stop=pdw.Stop(steps=2)))
     assert len(set(np.round(b.x_final[:, 6], 9))) > 1      # the parameters did act
 
 
@@ -193,7 +194,8 @@ def test_rodas4_lanes_are_the_scalar_runs_bitwise(n, lanes, threads):
                        integrator=pdw.Integrator(rtol=1e-6, atol=1e-8))
     statuses = set()
     for i in range(n):
-        r = _scalar(x[i], pdw.Params.paper(), method="rodas4", rtol=1e-6, atol=1e-8)
+        r = _scalar(x[i], pdw.Params.paper(), method="rodas4",
+                    integrator=pdw.Integrator(rtol=1e-6, atol=1e-8))
         _assert_bitwise(b, i, r)
         statuses.add(r.status)
     if n > 1:
@@ -206,7 +208,8 @@ def test_rodas4_per_walker_params_tolerances_and_stop_conditions():
     x = _states(5, seed=5)
     x[:, 6] = pdw.X0_PAPER[6]
     params = [pdw.Params.paper(d_hip=d) for d in np.linspace(0.005, 0.03, 5)]
-    kw = dict(rtol=1e-5, atol=1e-7, h_max=2e-3, event_tol=1e-8, stop_steps=1)
+    kw = dict(integrator=pdw.Integrator(rtol=1e-5, atol=1e-7, h_max=2e-3, event_tol=1e-8),
+              stop=pdw.Stop(steps=1))
     b = simulate_batch(x, t_end=T_END, params=params, method="rodas4", lanes=2, threads=1, **kw)
     for i in range(5):
         _assert_bitwise(b, i, _scalar(x[i], params[i], method="rodas4", **kw))
@@ -219,7 +222,8 @@ def test_rodas4_step_budget_is_per_walker():
     b = simulate_batch(x, t_end=T_END, method="rodas4", lanes=2, threads=1,
                        integrator=pdw.Integrator(max_steps=50))
     for i in range(3):
-        r = _scalar(x[i], pdw.Params.paper(), method="rodas4", max_steps=50)
+        r = _scalar(x[i], pdw.Params.paper(), method="rodas4",
+                    integrator=pdw.Integrator(max_steps=50))
         _assert_bitwise(b, i, r)
     assert "diverged" in set(b.status)
 
@@ -276,7 +280,7 @@ def test_every_rodas4_lane_loop_is_bitwise_the_scalar_run(isa, variant, n, lanes
     Every walker is bit for bit `simulate(method="rodas4")`, and the lanes did the work."""
     monkeypatch.setenv(ISA_ENV, isa)
     x = _states(n, seed=9)
-    kw = dict(rtol=1e-6, atol=1e-8, variant=variant)
+    kw = dict(integrator=pdw.Integrator(rtol=1e-6, atol=1e-8), variant=variant)
     _batch.lane_steps(reset=True)
     b = simulate_batch(x, t_end=T_END, method="rodas4", lanes=lanes, threads=threads, **kw)
     in_lanes = _batch.lane_steps(reset=True)
@@ -310,7 +314,7 @@ def test_cdm_lanes_do_the_work():
 def test_vector_trig_is_lane_independent_per_isa(isa, method, monkeypatch):
     monkeypatch.setenv(ISA_ENV, isa)
     x = _states(11, seed=9)
-    kw = dict(t_end=0.6, method=method, vector=True, check_step="off")
+    kw = dict(t_end=0.6, method=method, vector=True, integrator=pdw.Integrator(check_step="off"))
     ref = simulate_batch(x, lanes=1, threads=1, **kw)
     for lanes, threads in ((3, 1), (8, 1), (16, 1), (4, 2)):
         b = simulate_batch(x, lanes=lanes, threads=threads, **kw)
@@ -325,7 +329,7 @@ def test_rodas4_vector_trig_agrees_in_outcome():
     scalar ones at all depends on the build: `make sanitize`'s instrumented build leaves the
     loop unvectorized, calls libm's sin/cos in it and gets libm's bits.)"""
     x = _states(16, seed=4)
-    kw = dict(rtol=1e-6, atol=1e-8)
+    kw = dict(integrator=pdw.Integrator(rtol=1e-6, atol=1e-8))
     b = simulate_batch(x, t_end=T_END, method="rodas4", lanes=8, threads=1, vector=True, **kw)
     for i in range(16):
         r = _scalar(x[i], pdw.Params.paper(), method="rodas4", **kw)

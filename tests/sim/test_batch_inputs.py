@@ -64,6 +64,8 @@ BATCH_CASES = [
 def test_simulate_batch_refuses_malformed_input_naming_the_field(kw, field):
     kw = {"t_end": 0.01, **kw}
     x0 = kw.pop("x0", X2)
+    if "fall_hip_height" in kw:         # the [limits] table, read and checked by simulate_batch
+        kw["limits"] = {"fall_hip_height": kw.pop("fall_hip_height")}
     with pytest.raises(pdw.InvalidInputError, match=field.replace("(", r"\(")):
         simulate_batch(x0, **kw)
 

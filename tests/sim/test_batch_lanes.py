@@ -27,8 +27,9 @@ def _states(n, seed):
 
 def _assert_bitwise(b, i, x, method):
     """Walker i of batch b is bit for bit the scalar run from x."""
-    r = pdw.simulate(x, t_end=T_END, method=method, record_every=1, record_forces=False,
-                     on_failure="return", check_step="off", **KW[method])
+    r = pdw.simulate(x, t_end=T_END, method=method, record=pdw.Record(every=1, forces=False),
+                     limits=pdw.Limits(on_failure="return"),
+                     integrator=pdw.Integrator(check_step="off", **KW[method]))
     assert b.status[i] == r.status, i
     assert b.n_steps[i] == r.n_steps, i
     assert b.t_final[i] == r.t_final, i
@@ -49,7 +50,7 @@ def test_small_blocks_run_the_scalar_loop_bitwise(isa, method, n, lanes, monkeyp
     x = _states(n, seed=5)
     _batch.lane_steps(reset=True)
     b = simulate_batch(x, t_end=T_END, method=method, lanes=lanes, threads=1,
-                       check_step="off", **KW[method])
+                       integrator=pdw.Integrator(check_step="off", **KW[method]))
     assert _batch.lane_steps(reset=True) == 0
     assert {"walked", "fell"} <= set(b.status) or n < 5
     for i in range(n):
@@ -61,8 +62,8 @@ def test_three_walkers_take_the_lanes(method):
     """One walker more than PDW_BATCH_SERIAL: the lanes again, still bitwise."""
     x = _states(3, seed=5)
     _batch.lane_steps(reset=True)
-    b = simulate_batch(x, t_end=T_END, method=method, lanes=8, threads=1, check_step="off",
-                       **KW[method])
+    b = simulate_batch(x, t_end=T_END, method=method, lanes=8, threads=1,
+                       integrator=pdw.Integrator(check_step="off", **KW[method]))
     assert _batch.lane_steps(reset=True) > 0
     for i in range(3):
         _assert_bitwise(b, i, x[i], method)
@@ -73,7 +74,8 @@ def test_vector_trig_stays_in_the_lanes():
     runs the lanes (libmvec's sin/cos), not the scalar loop."""
     x = _states(1, seed=5)
     _batch.lane_steps(reset=True)
-    simulate_batch(x, t_end=T_END, lanes=8, threads=1, vector=True, check_step="off")
+    simulate_batch(x, t_end=T_END, lanes=8, threads=1, vector=True,
+                   integrator=pdw.Integrator(check_step="off"))
     assert _batch.lane_steps(reset=True) > 0
 
 
@@ -96,7 +98,7 @@ def test_a_cancelled_token_stops_every_lane_loop(method, isa, n, lanes, monkeypa
     with pytest.raises(KeyboardInterrupt) as e:
         interrupt.call_with_token(token, functools.partial(
             simulate_batch, x, t_end=20.0, method=method, lanes=lanes, threads=1,
-            check_step="off", **KW.get(method, {})))
+            integrator=pdw.Integrator(check_step="off", **KW.get(method, {}))))
     res = e.value.result
     assert np.all(res.t_final < 2.0), res.t_final
     assert np.all(np.isfinite(res.x_final))
@@ -114,11 +116,14 @@ def test_per_walker_friction_constants_follow_each_walker(isa, monkeypatch):
     params = [pdw.Params.paper(v_s=1e-4 * (1 + 0.5 * i), v_d=1e-3 * (1 + 0.7 * i),
                                mu_s=0.5 + 0.05 * i) for i in range(n)]
     _batch.lane_steps(reset=True)
-    b = simulate_batch(x, t_end=T_END, params=params, lanes=4, threads=1, check_step="off")
+    b = simulate_batch(x, t_end=T_END, params=params, lanes=4, threads=1,
+                       integrator=pdw.Integrator(check_step="off"))
     assert _batch.lane_steps(reset=True) > 0
     for i in range(n):
-        r = pdw.simulate(x[i], t_end=T_END, params=params[i], record_every=1,
-                         record_forces=False, on_failure="return", check_step="off")
+        r = pdw.simulate(x[i], t_end=T_END, params=params[i],
+                         record=pdw.Record(every=1, forces=False),
+                         limits=pdw.Limits(on_failure="return"),
+                         integrator=pdw.Integrator(check_step="off"))
         assert b.status[i] == r.status, i
         assert b.n_steps[i] == r.n_steps, i
         assert np.array_equal(b.x_final[i], r.x_final), (i, b.x_final[i] - r.x_final)

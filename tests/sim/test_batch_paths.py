@@ -36,8 +36,10 @@ X = _states(16, seed=5)
 @pytest.fixture(scope="module", params=list(METHODS))
 def scalar_runs(request):
     method = request.param
-    runs = [pdw.simulate(x, t_end=T_END, method=method, record_every=0, on_failure="return",
-                         check_step="off", **METHODS[method]) for x in X]
+    runs = [pdw.simulate(x, t_end=T_END, method=method, record=pdw.Record(every=0),
+                         limits=pdw.Limits(on_failure="return"),
+                         integrator=pdw.Integrator(check_step="off", **METHODS[method]))
+            for x in X]
     assert {r.status for r in runs} == {"walked", "fell"}
     return method, runs
 
@@ -48,7 +50,7 @@ def test_every_isa_and_trig_path_has_the_scalar_outcomes(isa, vector, scalar_run
     method, runs = scalar_runs
     monkeypatch.setenv(ISA_ENV, isa)
     b = simulate_batch(X, t_end=T_END, method=method, lanes=8, threads=1, vector=vector,
-                       check_step="off", **METHODS[method])
+                       integrator=pdw.Integrator(check_step="off", **METHODS[method]))
     tol = VECTOR_TOL[method] if vector else 0.0
     for i, r in enumerate(runs):
         assert b.status[i] == r.status, (i, b.status[i], r.status)
