@@ -90,6 +90,8 @@ def test_branch_file_round_trip_keeps_the_contact_axis(tmp_path, kv):
     np.testing.assert_array_equal(b.values, kv.values)
     assert b.problem.axis == "contact.d" and b.problem.contact == KV
     assert b.problem.contact_at(b.problem.coord(102.5)).d == 102.5
+    ext = b.extend(104.0, max_points=2, workers=2)           # on, in contact.d
+    assert ext.parameter == "contact.d" and ext.values[0] == kv.values[-1] < ext.values[1]
     ax = b.plot()
     assert ax.get_xlabel() == "contact.d [N s/m]"
     plt.close("all")

@@ -45,3 +45,25 @@ def test_exact_monodromy_refuses_lugre_with_the_reason():
     with pytest.raises(pdw.InvalidInputError, match="Coulomb friction"):
         continue_gait(P0, "gamma", 0.03, monodromy="exact",
                       options=dict(contact=pdw.Contact(friction="lugre")))
+
+
+@pytest.mark.slow
+def test_a_fold_curve_with_both_parameters_contact_ones():
+    """The fold of paper_steady(d_hip = 0.014) in d_n (2.54e6, docs/continuation.md) followed in
+    the contact's own parameters, "contact.d" and then "contact.k" (the default law: they are
+    d_n and k_n): the same curve as in (d_n, k_n), point for point at k = 1.02e5 (to 1e-6), and
+    the curve's axes carry the law's units."""
+    from pdw.analysis.bifurcation.codim2 import continue_bifurcation
+    P = pdw.Params.paper_steady(d_hip=0.014)
+    curves = []
+    for p1, p2 in (("d_n", "k_n"), ("contact.d", "contact.k")):
+        b = continue_gait(P, p1, 1e8, log=True, max_points=30, workers=2)
+        fold = b.of_kind("fold")[0]
+        curves.append(continue_bifurcation(fold, p2, 1.02e5, fd_step=1e-4, max_points=10,
+                                           at=[1.02e5]))
+    a, c = curves
+    assert c.parameters == ("contact.d", "contact.k")
+    assert c.units == ("N s/m^2.5", "N/m^1.5")
+    assert "reached stop" in a.stop_reason and "reached stop" in c.stop_reason
+    assert abs(c.values[-1, 0] / a.values[-1, 0] - 1.0) < 1e-6
+    assert c.values[-1, 1] == a.values[-1, 1] == 1.02e5
