@@ -59,8 +59,8 @@ def test_a_fold_curve_with_both_parameters_contact_ones():
     for p1, p2 in (("d_n", "k_n"), ("contact.d", "contact.k")):
         b = continue_gait(P, p1, 1e8, log=True, max_points=30, workers=2)
         fold = b.of_kind("fold")[0]
-        curves.append(continue_bifurcation(fold, p2, 1.02e5, fd_step=1e-4, max_points=10,
-                                           at=[1.02e5]))
+        curves.append(continue_bifurcation(fold, p2, 1.02e5, step=500.0, fd_step=1e-4,
+                                           max_points=12, at=[1.02e5]))
     a, c = curves
     assert c.parameters == ("contact.d", "contact.k")
     assert c.units == ("N s/m^2.5", "N/m^1.5")
