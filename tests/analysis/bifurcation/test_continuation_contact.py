@@ -120,3 +120,18 @@ def test_a_continuation_spec_takes_a_contact_parameter():
         continue_spec.check_spec(dict(spec, stop=-1.0), "s.toml")
     with pytest.raises(pdw.InvalidInputError, match="couple"):
         continue_spec.check_spec(dict(spec, couple={"k_n": 1.0}), "s.toml")
+
+
+def test_a_user_event_along_a_contact_branch(kv):
+    """events=[Event("step_length", L)] on the Kelvin-Voigt contact.d branch: located between
+    its first two points; independently, find_gait with Contact(d = the located value) has
+    that step length (to 1e-7 m)."""
+    from pdw.analysis.bifurcation.testfunctions import Event
+    L = 0.5 * (kv.step_length[0] + kv.step_length[1])
+    b = continue_gait(P0, "contact.d", 104.0, step=2.0, max_points=2, locate_tol=1e-9,
+                      options=dict(contact=KV), workers=2, events=[Event("step_length", L)])
+    (ev,) = b.of_kind("event")
+    assert ev.located and kv.values[0] < ev.value < kv.values[1]
+    g = pdw.find_gait(P0, contact=KV.with_axis("contact.d", ev.value), guess=kv.z[0],
+                      workers=2)
+    assert abs(g.step_length - L) < 1e-7
