@@ -10,7 +10,7 @@ docs/figures/; `make bench` runs the issue's two codim-2 speed benchmarks, codim
     python benchmarks/continuation.py rigid_paper  # the same in the paper variant: its end
     python benchmarks/continuation.py fig11     # Fig. 11 (k_n): continuation vs the sweep
     python benchmarks/continuation.py simplest_limit  # simplest walker's doubling, m_l/m_h -> 0
-    python benchmarks/continuation.py kelvin_voigt    # Kelvin-Voigt's d_n branch (docs/contact_laws.md)
+    python benchmarks/continuation.py kelvin_voigt    # Kelvin-Voigt's contact.d branch (docs/contact_laws.md)
     python benchmarks/continuation.py codim2    # compass doubling curve in (slope, c): CPU time
     python benchmarks/continuation.py goswami   # compass regions in (slope, b/a), (slope, m_H/m)
     python benchmarks/continuation.py region_hip  # paper walker (hybrid): region in (k_hip, d_hip)
@@ -267,24 +267,28 @@ def part_simplest_limit():
 def part_kelvin_voigt():
     from pdw.analysis.numerics.calibration import calibrate
     P0 = pdw.Params.paper_steady()
-    kv = calibrate(P0).contacts["kelvin_voigt"]
-    say("== Kelvin-Voigt (k = %.6g, d = %.6g): continued in d_n down to 10 ==" % (kv.k, kv.d))
-    b = continue_gait(P0.replace(k_n=kv.k, d_n=kv.d), "d_n", 10.0, step=5.0, max_points=40,
-                      options=dict(contact=pdw.Contact("kelvin_voigt")), workers=2)
+    kv = calibrate(P0).contacts["kelvin_voigt"]       # k = W / sink, d from the drop test
+    say("== Kelvin-Voigt (k = %.6g, d = %.6g): continued in contact.d down to 10 =="
+        % (kv.k, kv.d))
+    b = continue_gait(P0, "contact.d", 10.0, step=5.0, max_points=40,
+                      options=dict(contact=kv), workers=2)
     _branch_line(b)
     for f in b.bifurcations:
         say("  " + f.describe())
-    say("== the same from d_n = 109.5 up, step 0.1 (the period doubling, located) ==")
-    b = continue_gait(P0.replace(k_n=kv.k, d_n=109.5), "d_n", 110.2, step=0.1, max_points=30,
-                      options=dict(contact=pdw.Contact("kelvin_voigt")), workers=2)
-    _branch_line(b)
-    for f in b.bifurcations:
-        say("  " + f.describe())
-        say("    multipliers %s; finite-difference cross-check (fd_step x10): %.3g %s"
-            % (np.round(f.multipliers[:3], 5), f.details.get("fd_check", np.nan),
-               f.details.get("fd_check_note", "")))
-    for v, m in zip(b.values, b.multipliers):
-        say("  d_n = %.6f  multipliers %s" % (v, np.round(m[:3], 4)))
+    for mono in ("differences", "exact"):
+        say("== the same from contact.d = 109.5 up, step 0.1, monodromy=%r (the period "
+            "doubling, located) ==" % mono)
+        b = continue_gait(P0, "contact.d", 110.2, step=0.1, max_points=30,
+                          options=dict(contact=kv.with_axis("contact.d", 109.5)), workers=2,
+                          monodromy=mono)
+        _branch_line(b)
+        for f in b.bifurcations:
+            say("  " + f.describe())
+            say("    multipliers %s; cross-check (%s): %.3g %s"
+                % (np.round(f.multipliers[:3], 5), f.details.get("fd_check_kind", ""),
+                   f.details.get("fd_check", np.nan), f.details.get("fd_check_note", "")))
+        for v, m in zip(b.values, b.multipliers):
+            say("  contact.d = %.6f  multipliers %s" % (v, np.round(m[:3], 4)))
 
 
 def part_codim2(rounds=3):

@@ -84,6 +84,8 @@ LUGRE_PARAMETERS = {
 #: LuGre's defaults for sigma0, sigma1, sigma2 (Canudas de Wit et al. 1995's values for a unit
 #: normal force); mu_s, mu_c, v_s default to the paper's law (``lugre_stribeck``).
 LUGRE_DEFAULTS = {"sigma0": 1e5, "sigma1": math.sqrt(1e5), "sigma2": 0.0}
+#: the prefix of a contact parameter as a continuation parameter (``"contact.d"``, `Contact.axes`)
+AXIS_PREFIX = "contact."
 _LG_P = {"sigma0": "sigma0", "sigma1": "sigma1", "sigma2": "sigma2", "mu_s": "lg_mu_s",
          "mu_c": "lg_mu_c", "v_s": "lg_v_s"}
 
@@ -296,6 +298,48 @@ class Contact:
             p[_P["e_n"]] = self.e if damped else 1.0
             p[_P["v_in_min"]] = 0.01 if self.v_in_min is None else self.v_in_min
         return p
+
+    # --- continuation axes: the contact's parameters as continuation parameters --------------
+
+    def axes(self) -> tuple:
+        """The parameters of this contact a continuation can follow, as ``"contact.<name>"``
+        (`pdw.continue_gait`): the normal law's (``LAW_PARAMETERS``) and, under LuGre
+        friction, LuGre's six (``LUGRE_PARAMETERS``)."""
+        names = LAW_PARAMETERS[self.normal]
+        if self.friction == "lugre":
+            names = names + tuple(LUGRE_PARAMETERS)
+        return tuple(AXIS_PREFIX + n for n in names)
+
+    def _axis(self, axis: str) -> str:
+        if not (isinstance(axis, str) and axis in self.axes()):
+            raise InvalidInputError("%r is not a parameter of the contact (%s normal law, %s "
+                                    "friction); allowed: %s" % (axis, self.normal, self.friction,
+                                                                ", ".join(self.axes())))
+        return axis[len(AXIS_PREFIX):]
+
+    def axis_value(self, axis: str, params: Params) -> float:
+        """The value of the contact parameter ``axis`` (``"contact.<name>"``) a run with
+        ``params`` uses: the Contact's own, else its default (k: ``params.k_n``; d:
+        ``params.d_n``; v_in_min: 0.01 m/s; LuGre's: `lugre_parameters`)."""
+        name = self._axis(axis)
+        v = getattr(self, name)
+        if v is not None:
+            return float(v)
+        if name in LUGRE_PARAMETERS:
+            return float(self.lugre_parameters(params)[name])
+        return float({"k": params.k_n, "d": params.d_n, "v_in_min": 0.01}[name])
+
+    def axis_unit(self, axis: str) -> str:
+        """The unit of the contact parameter ``axis`` under this contact's laws (e.g.
+        ``"N s/m"`` for kelvin_voigt's d, ``"N s/m^2.5"`` for hunt_crossley's)."""
+        name = self._axis(axis)
+        return LUGRE_PARAMETERS[name][2] if name in LUGRE_PARAMETERS else UNITS[self.normal][name]
+
+    def with_axis(self, axis: str, value: float) -> "Contact":
+        """This contact with the parameter ``axis`` (``"contact.<name>"``) set to ``value``
+        (checked as the constructor checks it: `pdw.InvalidInputError` when out of range)."""
+        name = self._axis(axis)
+        return Contact(**{**self.as_dict(), name: value})
 
     def as_dict(self) -> dict:
         """The fields that are set (for scenes and reports)."""

@@ -8,7 +8,8 @@ The spec (docs/continuation.md; examples in pdw/examples/continuations/, run by
     model = "hybrid"                  # or "continuous"
     preset = "compass"                # compass | simplest | paper | paper_steady
     variant = "paper"                 # continuous model's contact variant
-    parameter = "gamma"
+    parameter = "gamma"               # a Params field, or (continuous) a parameter of the
+                                      # [contact] laws, e.g. "contact.d" (pdw.Contact.axes)
     stop = 0.0925                     # continue until here
     start = 0.0524                    # optional: the parameter's value at the start
 
@@ -56,7 +57,7 @@ from .. import examples
 from ..analysis.bifurcation.branch import _jsonable
 from ..analysis.bifurcation.continuation import continue_gait, follow_cascade
 from ..core import _toml
-from ..core.contact import Contact
+from ..core.contact import AXIS_PREFIX, Contact
 from ..core.errors import InvalidInputError
 from . import continue_spec, deps
 
@@ -93,7 +94,14 @@ def run_spec(spec, out=None, progress=False, *, figures=True):
     depth = int(kw.pop("cascade", 0))
     if spec.get("contact"):
         kw["options"] = {**kw.get("options", {}), "contact": Contact.coerce(spec["contact"])}
-    start = spec.get("start", getattr(params, par, None))
+    if par.startswith(AXIS_PREFIX):          # a contact parameter: the start is the contact's
+        law = Contact.coerce(spec.get("contact"))
+        if spec.get("start") is not None:
+            law = law.with_axis(par, spec["start"])
+        kw["options"] = {**kw.get("options", {}), "contact": law}
+        start = law.axis_value(par, params)
+    else:
+        start = spec.get("start", getattr(params, par, None))
     params_of = None
     if couple:
         p0 = params.replace(**{par: start})
@@ -102,7 +110,8 @@ def run_spec(spec, out=None, progress=False, *, figures=True):
         def params_of(v, p0=p0, v0=v0, couple=couple):
             return p0.replace(**{par: v}, **{f: getattr(p0, f) * (v / v0) ** e
                                              for f, e in couple.items()})
-    params = params.replace(**{par: start}) if start is not None else params
+    if start is not None and not par.startswith(AXIS_PREFIX):
+        params = params.replace(**{par: start})
     common = dict(model=spec.get("model", "continuous"), variant=spec.get("variant", "paper"),
                   params_of=params_of, value=start, progress=progress, **kw)
     t0 = time.perf_counter()

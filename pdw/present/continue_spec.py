@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 
 from ..core import _layout, checks, paths
-from ..core.contact import Contact
+from ..core.contact import AXIS_PREFIX, Contact
 from ..core.errors import InvalidInputError
 from ..core.params import Params
 
@@ -100,10 +100,34 @@ def check_spec(spec: dict, where: str = "spec") -> dict:
     model = checks.choice("%s: model" % where, spec.setdefault("model", "continuous"), MODELS)
     name = checks.choice("%s: preset" % where, spec.setdefault("preset", "paper_steady"), PRESETS)
     checks.choice("%s: variant" % where, spec.setdefault("variant", "paper"), _layout.VARIANTS)
+    # [contact]: the continuous model's contact laws (before the parameter: it may be one of
+    # the contact's, "contact.<name>")
+    law = Contact()
+    if "contact" in spec:
+        if model != "continuous":
+            raise InvalidInputError("%s: [contact] is a section of the continuous model's specs; "
+                                    "model = %r has rigid ground" % (where, model))
+        try:
+            law = Contact.coerce(_table(where, spec, "contact"))
+        except InvalidInputError as e:
+            raise InvalidInputError("%s: [contact] %s" % (where, e)) from None
+        spec["contact"] = law.as_dict()
     par = spec["parameter"]
-    if not isinstance(par, str) or par not in Params.__dataclass_fields__:
-        raise InvalidInputError("%s: parameter must be a Params field (%s), got %r"
-                                % (where, ", ".join(Params.__dataclass_fields__), par))
+    axis = isinstance(par, str) and par.startswith(AXIS_PREFIX)
+    if axis and model != "continuous":
+        raise InvalidInputError("%s: parameter %r: model = %r has rigid ground, no contact "
+                                "law; allowed: a Params field (%s)"
+                                % (where, par, model, ", ".join(Params.__dataclass_fields__)))
+    if axis and par not in law.axes():
+        raise InvalidInputError("%s: parameter %r is not a parameter of the [contact] laws "
+                                "(%s normal, %s friction); allowed: %s, or a Params field"
+                                % (where, par, law.normal, law.friction, ", ".join(law.axes())))
+    if not axis and (not isinstance(par, str) or par not in Params.__dataclass_fields__):
+        raise InvalidInputError("%s: parameter must be a Params field (%s)%s, got %r"
+                                % (where, ", ".join(Params.__dataclass_fields__),
+                                   " or a parameter of the [contact] laws (%s)"
+                                   % ", ".join(law.axes()) if model == "continuous" else "",
+                                   par))
     # the walker: the preset with [params]
     spec["params"] = overrides = _table(where, spec, "params")
     _unknown(where, overrides, Params.__dataclass_fields__, "[params] ")
@@ -116,14 +140,14 @@ def check_spec(spec: dict, where: str = "spec") -> dict:
     # start and stop: values of the parameter
     start = spec.get("start")
     if start is None:
-        start = getattr(params, par)
+        start = law.axis_value(par, params) if axis else getattr(params, par)
     else:
         start = spec["start"] = checks.number("%s: start" % where, start)
     stop = spec["stop"] = checks.number("%s: stop" % where, spec["stop"])
     for key, v in (("start", start), ("stop", stop)):
         try:
-            params.replace(**{par: v})
-        except ValueError as e:
+            law.with_axis(par, v) if axis else params.replace(**{par: v})
+        except (ValueError, InvalidInputError) as e:
             raise InvalidInputError("%s: %s = %r is not a valid %s: %s"
                                     % (where, key, v, par, e)) from None
     if stop == start:
@@ -131,6 +155,9 @@ def check_spec(spec: dict, where: str = "spec") -> dict:
                                 % (where, start, par, stop))
     # [couple]: other fields as powers of the parameter
     spec["couple"] = couple = _table(where, spec, "couple")
+    if couple and axis:
+        raise InvalidInputError("%s: [couple] scales Params fields with a Params parameter; "
+                                "the parameter %r is the contact's" % (where, par))
     _unknown(where, couple, set(Params.__dataclass_fields__) - {par},
              "[couple] (fields other than the parameter %r) " % par)
     for k, expo in couple.items():
@@ -180,15 +207,6 @@ def check_spec(spec: dict, where: str = "spec") -> dict:
     if cont.get("period", 1) > 1 and model == "hybrid":
         raise InvalidInputError("%speriod = %d: a hybrid period-n start needs a switched "
                                 "branch; use cascade = N" % (w, cont["period"]))
-    # [contact]: the continuous model's contact laws
-    if "contact" in spec:
-        if model != "continuous":
-            raise InvalidInputError("%s: [contact] is a section of the continuous model's specs; "
-                                    "model = %r has rigid ground" % (where, model))
-        try:
-            spec["contact"] = Contact.coerce(_table(where, spec, "contact")).as_dict()
-        except InvalidInputError as e:
-            raise InvalidInputError("%s: [contact] %s" % (where, e)) from None
     # [plot]
     spec["plot"] = plot = _table(where, spec, "plot")
     _unknown(where, plot, PLOT_KEYS, "[plot] ")

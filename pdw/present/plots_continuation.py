@@ -33,9 +33,11 @@ def _unit(parameter):
     return f.metadata.get("unit", "") if f is not None else ""
 
 
-def x_axis_label(parameter, x_scale=1.0):
-    """'gamma [deg]' (x_scale 180/pi on gamma), 'd_n [N s/m^2.5]', 'k_n [N/m^1.5 x 1e-05]'."""
-    u = _unit(parameter)
+def x_axis_label(parameter, x_scale=1.0, unit=None):
+    """'gamma [deg]' (x_scale 180/pi on gamma), 'd_n [N s/m^2.5]', 'k_n [N/m^1.5 x 1e-05]',
+    'contact.d [N s/m]' (``unit``: the branch's own, e.g. a contact parameter's, whose unit
+    depends on the law; default the `Params` field's)."""
+    u = unit or _unit(parameter)
     if u == "rad" and abs(x_scale - 180 / np.pi) < 1e-9:
         return "%s [deg]" % parameter
     if x_scale != 1.0:
@@ -153,7 +155,9 @@ def plot_branches(branches, ax=None, y="step_length", x_scale=1.0, x_label=None,
         if br.settings.get("log"):
             ax.set_xscale("log")
     ax._pdw_branches = j0 + len(branches)
-    ax.set_xlabel(x_label or (x_axis_label(branches[0].parameter, x_scale) if branches else ""))
+    ax.set_xlabel(x_label or (x_axis_label(branches[0].parameter, x_scale,
+                                           branches[0].settings.get("unit"))
+                               if branches else ""))
     ax.set_ylabel(y_axis_label(y, branches[0].model if branches else ""))
     if title:
         ax.set_title(title)
@@ -178,8 +182,9 @@ def plot_curves(curves, ax=None, x_scale=1.0, y_scale=1.0, labels=None, title=No
         ax.plot(cv.values[:, 1] * x_scale, cv.values[:, 0] * y_scale, "-", color="C%d" % j,
                 lw=1.6, label=name)
     if curves:
-        ax.set_xlabel(x_axis_label(curves[0].parameters[1], x_scale))
-        ax.set_ylabel(x_axis_label(curves[0].parameters[0], y_scale))
+        units = getattr(curves[0], "units", ("", ""))
+        ax.set_xlabel(x_axis_label(curves[0].parameters[1], x_scale, units[1]))
+        ax.set_ylabel(x_axis_label(curves[0].parameters[0], y_scale, units[0]))
     if title:
         ax.set_title(title)
     ax.legend(fontsize=8)

@@ -47,9 +47,10 @@ from typing import Any
 
 import numpy as np
 
+from ...core.contact import Contact
 from ...core.errors import InvalidInputError
 from ...core.params import Params
-from ..stepmap.gait_maps import Evaluation
+from ..stepmap.gait_maps import Evaluation, check_parameter, parameter_unit
 from .branch import Bifurcation
 
 #: the bifurcation kinds a curve can follow, and the sign s of A = M + s I ("end": the
@@ -111,10 +112,9 @@ class AugmentedProblem:
         #: weight of sigma in the residual (`continue_bifurcation`'s ``sigma_tol``): Newton's
         #: max |F| < tol then means |sigma| < sigma_tol
         self.kappa = 1.0
-        if params_of is None and parameter2 not in Params.__dataclass_fields__:
-            raise InvalidInputError("parameter must be a Params field (%s) or come with "
-                                    "params_of, got %r"
-                                    % (", ".join(Params.__dataclass_fields__), parameter2))
+        #: the second parameter's contact axis ("contact.<name>") or None (a Params field)
+        self.axis2 = check_parameter(parameter2, params_of, getattr(prob, "contact", None),
+                                     getattr(prob, "CONTACT_AXES", False), prob.model)
         if params_of is not None and not callable(params_of):
             raise InvalidInputError("params_of must be a callable (params, value) -> Params, "
                                     "got %s" % type(params_of).__name__)
@@ -131,6 +131,8 @@ class AugmentedProblem:
         self.p2 = copy.copy(prob)
         self.p2.parameter, self.p2.log = parameter2, False
         self.base = prob.base
+        self.contact = getattr(prob, "contact", None)      # the base contact
+        self.unit = parameter_unit(parameter2, self.contact)
         self.kind, self.s = kind, SIGNS[kind]
         self.parameter, self.parameter1 = parameter2, prob.parameter
         self.model = prob.model
@@ -142,8 +144,12 @@ class AugmentedProblem:
         self.lam_step = 1e-6
         self.opts = dict(getattr(prob, "opts", {}))
         self._of = params_of
-        self.start2 = float(value) if value is not None else float(getattr(prob.base,
-                                                                           parameter2))
+        if value is not None:
+            self.start2 = float(value)
+        elif self.axis2 is not None:
+            self.start2 = Contact.coerce(self.contact).axis_value(self.axis2, self.base)
+        else:
+            self.start2 = float(getattr(prob.base, parameter2))
         ev = self._base_eval(np.asarray(z, dtype=float), mu1, self.start2)
         if not ev.ok:
             raise InvalidInputError("the bifurcation's gait does not evaluate: %s" % ev.status)
@@ -209,14 +215,24 @@ class AugmentedProblem:
         return float(value)
 
     def _with2(self, mu2):
-        """The base parameters at ``mu2`` of the second parameter (a field, or ``params_of``)."""
+        """The base (Params, contact) at ``mu2`` of the second parameter (a field, a contact
+        parameter, or ``params_of``)."""
+        if self.axis2 is not None:
+            try:
+                return self.base, Contact.coerce(self.contact).with_axis(self.axis2, float(mu2))
+            except InvalidInputError as e:
+                raise InvalidInputError("%s = %r: %s" % (self.parameter, mu2, e)) from None
         if self._of is None:
-            return self.base.replace(**{self.parameter: float(mu2)})
+            return self.base.replace(**{self.parameter: float(mu2)}), self.contact
         P = self._of(self.base, float(mu2))
         if not isinstance(P, Params):
             raise InvalidInputError("params_of must return a pdw.Params, got %s"
                                     % type(P).__name__)
-        return P
+        return P, self.contact
+
+    def _set2(self, mu2):
+        """Move the base problem's model to ``mu2`` of the second parameter."""
+        self.p1.base, self.p1.contact = self._with2(mu2)
 
     def _mu2_offsets(self, mu2):
         """(up, down) of the difference in mu2: central, or one-sided at the edge of its
@@ -231,12 +247,12 @@ class AugmentedProblem:
         return out[0], out[1]
 
     def params_at(self, mu2, mu1):
-        self.p1.base = self._with2(mu2)
+        self._set2(mu2)
         return self.p1.params_at(mu1)
 
     def _base_eval(self, z, mu1, mu2, jac=True) -> Evaluation:
         try:
-            self.p1.base = self._with2(mu2)
+            self._set2(mu2)
         except (ValueError, InvalidInputError) as e:
             return Evaluation(False, "invalid parameter: %s = %r: %s" % (self.parameter, mu2, e))
         n0 = self.p1.n_maps
@@ -263,8 +279,9 @@ class AugmentedProblem:
         return vs[-1], vs[:n], ws[:n]
 
     def _at(self, mu1, mu2):
-        self.p1.base = self._with2(mu2)
-        return self.p1.params_at(mu1)
+        """The (Params, contact) of the base problem at (mu1, mu2) (`images`' models)."""
+        self._set2(mu2)
+        return self.p1.point_at(mu1)
 
     def _directional(self, z, mu1, mu2, v, w, ev=None):
         """d sigma / d(z, mu1) (n + 1,), d sigma / d mu2 and dP / d mu2 from central
@@ -290,7 +307,7 @@ class AugmentedProblem:
         for off in (up, down):
             P = self._at(mu1, mu2 + off)
             pts += [(z + e * vh, P), (z - e * vh, P), (z, P)]
-        self.p1.base = self._with2(mu2)
+        self._set2(mu2)
         ims = self.p1.images(pts)
         self.n_maps += len(pts) * self.period
         if any(im is None for im in ims):
@@ -416,6 +433,8 @@ class BifurcationCurve:
     branch: Any = field(repr=False)
     wall_time: float = 0.0
     n_maps: int = 0
+    #: the units of the two parameters ("" when unknown, e.g. a ``params_of`` name)
+    units: tuple = ("", "")
 
     def __len__(self):
         return len(self.values)
@@ -454,8 +473,9 @@ def continue_bifurcation(bifurcation: Bifurcation, parameter: str, stop: float, 
         carries its problem: model, period, options). An end is followed as the curve where
         its admissibility function is 0 (the edge of the gait's existence as modelled).
     parameter : str
-        The second parameter (a `pdw.Params` field other than the branch's, or any name with
-        ``params_of``).
+        The second parameter (a `pdw.Params` field other than the branch's, a parameter of
+        the continuous model's contact law ``"contact.<name>"`` (`pdw.Contact.axes`), or any
+        name with ``params_of``); either parameter may be a contact one.
     stop : float
         Continue until ``parameter`` reaches ``stop`` (or ``max_points``, or the curve ends).
     step : float, optional
@@ -527,4 +547,6 @@ def continue_bifurcation(bifurcation: Bifurcation, parameter: str, stop: float, 
                             values=vals, z=b.z[:, :-1].copy(), multipliers=np.array(mult),
                             step_length=b.step_length, period=b.period,
                             stop_reason=b.stop_reason, branch=b,
-                            wall_time=time.perf_counter() - t0, n_maps=aug.n_maps)
+                            wall_time=time.perf_counter() - t0, n_maps=aug.n_maps,
+                            units=(getattr(prob, "unit", ""),
+                                   parameter_unit(parameter, aug.contact)))

@@ -48,6 +48,7 @@ from typing import Callable, Literal, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ...core.contact import AXIS_PREFIX, Contact
 from ...core.errors import InvalidInputError
 from ...core.params import Params
 from ...core.progress import Progress, progress_bar
@@ -86,7 +87,7 @@ def _problem(params, parameter, model, variant, period, params_of, log, options,
     raise InvalidInputError("model must be one of %s, got %r" % (", ".join(MODELS), model))
 
 
-def _start_z(prob, params, start, variant, period):
+def _start_z(prob, params, start, variant, period, mu=None):
     if isinstance(start, Gait):
         z = start.details.get("z") if start.details else None
         return prob.section(start.state) if z is None else prob.section(z)
@@ -99,6 +100,8 @@ def _start_z(prob, params, start, variant, period):
                                     % period)
         return prob.section(g.state)
     contact = prob.opts.get("contact")
+    if mu is not None and prob.axis is not None:     # a contact axis: the contact at the start
+        params, contact = prob.point_at(mu)
     g = LC.find_gait(params, variant, period=period,
                      **({} if contact is None else dict(contact=contact)))
     return np.asarray(g.details["z"], dtype=float)
@@ -128,7 +131,13 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
     params : Params
         The walker at the start (``parameter`` at its value there, or ``value``).
     parameter : str
-        A `Params` field, or any name when ``params_of`` is given.
+        A `Params` field; with the continuous model also a parameter of the contact law,
+        ``"contact.<name>"`` (`pdw.Contact.axes`: ``contact.k``, ``contact.d`` (hunt_crossley,
+        kelvin_voigt), ``contact.e``, ``contact.v_in_min`` (lankarani_nikravesh, flores),
+        LuGre's ``contact.sigma0`` ... ``contact.v_s``), applied to ``options["contact"]``
+        (default the paper's law: its k, d start at ``Params.k_n``, ``d_n``); or any name when
+        ``params_of`` is given. Another name is a `pdw.InvalidInputError` listing the allowed
+        ones.
     stop : float
         Continue until the parameter reaches ``stop`` (or the family ends, or ``max_points``).
     model : {"continuous", "hybrid"}
@@ -188,8 +197,9 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
         ``"event"``, label UZ).
     monodromy : {"differences", "exact"}
         The continuous model's M: central differences (default), or exact from the variational
-        equations with saltation matrices (``pdw.analysis.stepmap.variational``; default laws, paper
-        variant, period 1; 25-40x the CPU time per point).
+        equations with saltation matrices (``pdw.analysis.stepmap.variational``; every normal
+        law with Coulomb friction (``options["contact"]``), paper variant, period 1; 25-40x
+        the CPU time per point).
     stall_points, stall_length : int, float
         The continuation stops as *stalled* when the last ``stall_points`` steps together
         advanced less than ``stall_length`` in arclength (scaled coordinates: the requested
@@ -210,36 +220,28 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
     TF.select(detect, events)
     prob = _problem(params, parameter, model, variant, period, params_of, log, options,
                     executor, workers, fd_step)
-    law = getattr(getattr(prob, "contact", None), "normal", None)
-    if model == "continuous" and params_of is None and law == "kelvin_voigt" \
-            and parameter in ("k_n", "d_n"):
-        # kelvin_voigt takes its k, d from the Contact (other units), never Params' k_n, d_n:
-        # the branch would vary nothing
-        raise InvalidInputError("parameter %r is not read by the kelvin_voigt law (its "
-                                "stiffness and damping are Contact.k [N/m] and Contact.d "
-                                "[N s/m]); continue in a parameter the law reads" % parameter)
+    _check_read(prob, parameter, params_of)
     if monodromy not in ("differences", "exact"):
         raise InvalidInputError("monodromy must be 'differences' or 'exact', got %r"
                                 % (monodromy,))
     if monodromy == "exact" and model == "continuous":
-        if (getattr(prob, "contact", None) is not None or variant != "paper"
-                or prob.period != 1):
-            raise InvalidInputError("monodromy='exact' of the continuous model needs the "
-                                    "default laws, variant 'paper' and period 1 "
+        if not prob.exact_available:
+            raise InvalidInputError("monodromy='exact' of the continuous model needs Coulomb "
+                                    "friction (any normal law), variant 'paper' and period 1 "
                                     "(pdw.analysis.stepmap.variational)")
         prob.monodromy = "exact"
     if value is None:
         if isinstance(start, Gait) and start.details and "value" in start.details:
             value = start.details["value"]
         elif params_of is None:
-            value = getattr(params, parameter)
+            value = prob.start_value()
         else:
             raise InvalidInputError("value= (the start's %s) is needed with params_of"
                                     % parameter)
     if prob.coord(float(stop)) == prob.coord(float(value)):
         raise InvalidInputError("stop must differ from the start value %r, got %r"
                                 % (value, stop))
-    z0 = _start_z(prob, params, start, variant, period)
+    z0 = _start_z(prob, params, start, variant, period, prob.coord(float(value)))
     details = start.details if isinstance(start, Gait) and start.details else {}
     tol = tol if tol is not None else (1e-10 if model == "hybrid" else 1e-8)
     return run_continuation(prob, z0, value, stop, method=method, max_points=max_points,
@@ -250,6 +252,25 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
                                           monodromy=monodromy), t0=t0,
                             at=at, progress=progress, events=events,
                             stall_points=stall_points, stall_length=stall_length)
+
+
+def _check_read(prob, parameter, params_of):
+    """Refuse k_n / d_n where the contact law never reads them (the branch would vary
+    nothing): a Contact with its own k or d (kelvin_voigt always: other units), hertz's d
+    (none); point at the contact axis instead."""
+    c = getattr(prob, "contact", None)
+    if c is None or params_of is not None or parameter not in ("k_n", "d_n"):
+        return
+    name = parameter[0]
+    c = Contact.coerce(c)
+    if getattr(c, name) is None and not (name == "d" and c.normal == "hertz"):
+        return
+    hint = ("continue in %r (%s)" % (AXIS_PREFIX + name, c.axis_unit(AXIS_PREFIX + name))
+            if AXIS_PREFIX + name in c.axes() else "the law has no damping")
+    raise InvalidInputError("parameter %r is not read by the %s law (its %s is the "
+                            "Contact's, never Params.%s): %s" % (
+                                parameter, c.normal,
+                                "stiffness" if name == "k" else "damping", parameter, hint))
 
 
 def run_continuation(prob, z0, value, stop, *, method="pseudo_arclength", max_points=200,
@@ -416,7 +437,8 @@ def _branch(eng, pts, bifs, stop_reason, prob, wall, settings) -> Branch:
         step_size=np.array([p.ds for p in pts]),
         newton_iterations=np.array([p.iters for p in pts]),
         bifurcations=bifs, stop_reason=stop_reason, n_maps=prob.n_maps, wall_time=wall,
-        settings={**settings, "scale": eng.scale, "mu0": eng.mu0}, problem=prob,
+        settings={**settings, "scale": eng.scale, "mu0": eng.mu0,
+                  "unit": getattr(prob, "unit", "")}, problem=prob,
         switcher=switch_branch, extender=extend_branch)
 
 
@@ -445,7 +467,6 @@ def load_branch(path: str | os.PathLike) -> Branch:
     if pr is not None and not pr.get("params_of"):
         opts = dict(pr["options"])
         if isinstance(opts.get("contact"), dict):
-            from ...core.contact import Contact
             opts["contact"] = Contact(**opts["contact"])
         opts.pop("t_hint", None)
         prob = _problem(Params(**pr["params"]), pr["parameter"], pr["model"], pr["variant"],

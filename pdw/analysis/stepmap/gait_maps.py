@@ -31,7 +31,9 @@ import os
 import numpy as np
 
 from ...core import _hybrid  # type: ignore[attr-defined]  # compiled, no stub
+from ...core.contact import Contact
 from ...core.errors import InvalidInputError
+from ...core.interrupt import thread_map
 from ...core.model import parameter_vector
 from ...core.params import Params
 from ..gait_types import Gait
@@ -39,6 +41,7 @@ from ..rigid import hybrid as H
 from . import poincare as _poincare
 from . import section as _section
 from . import step_maps as _maps
+from .gait_axes import check_parameter, multiplier_gap, parameter_unit  # noqa: F401
 
 
 class Evaluation:
@@ -54,7 +57,13 @@ class Evaluation:
 
 
 class _Problem:
-    """Common part: the parameter, its coordinate (linear or log) and ``params_of``."""
+    """Common part: the parameter, its coordinate (linear or log) and ``params_of``.
+
+    The parameter is a `Params` field, or (continuous model) a parameter of the contact law
+    ``"contact.<name>"`` (`pdw.Contact.axes`: ``contact.k``, ``contact.d``, ``contact.e``, ...,
+    LuGre's ``contact.sigma0``, ...): a point's model is then ``point_at(mu)`` = (the base
+    `Params`, the base `Contact` with that field set), and every map of that point runs with
+    that contact."""
 
     dim = 0
     model = ""
@@ -64,13 +73,17 @@ class _Problem:
     #: max(|mu_0|, |mu_stop - mu_0|), set by the continuation)
     lam_rel = 1e-6
 
-    def __init__(self, params, parameter, params_of=None, period=1, log=False, lam_step=1e-6):
+    #: whether the model has a contact law whose parameters can be continued
+    CONTACT_AXES = False
+
+    def __init__(self, params, parameter, params_of=None, period=1, log=False, lam_step=1e-6,
+                 contact=None):
         if not isinstance(params, Params):
             raise InvalidInputError("params must be a pdw.Params, got %s" % type(params).__name__)
-        if params_of is None and parameter not in Params.__dataclass_fields__:
-            raise InvalidInputError("parameter must be a Params field (%s) or come with "
-                                    "params_of, got %r"
-                                    % (", ".join(Params.__dataclass_fields__), parameter))
+        #: the base contact (None: the default laws); a contact axis moves one of its fields
+        self.contact = contact
+        self.axis = check_parameter(parameter, params_of, contact, self.CONTACT_AXES,
+                                    self.model)
         if int(period) < 1:
             raise InvalidInputError("period must be an integer >= 1, got %r" % (period,))
         self.base, self.parameter, self.period = params, parameter, int(period)
@@ -89,6 +102,32 @@ class _Problem:
                                     % (self.parameter, value))
         return float(math.log(value)) if self.log else float(value)
 
+    def contact_at(self, mu):
+        """The contact at the parameter coordinate ``mu``: the base contact, or with the contact
+        axis's field at its value there (`pdw.InvalidInputError` when out of range)."""
+        if self.axis is None:
+            return self.contact
+        v = self.value(mu)
+        try:
+            return Contact.coerce(self.contact).with_axis(self.axis, v)
+        except InvalidInputError as e:
+            raise InvalidInputError("%s = %r: %s" % (self.parameter, v, e)) from None
+
+    def point_at(self, mu):
+        """(Params, contact) at ``mu``: the model of one point of the branch."""
+        return self.params_at(mu), self.contact_at(mu)
+
+    def start_value(self) -> float:
+        """The parameter's value in the base model (a Params field, or the contact's)."""
+        if self.axis is not None:
+            return Contact.coerce(self.contact).axis_value(self.axis, self.base)
+        return float(getattr(self.base, self.parameter))
+
+    @property
+    def unit(self) -> str:
+        """The parameter's unit ("" when unknown, e.g. a ``params_of`` name)."""
+        return parameter_unit(self.parameter, self.contact)
+
     def lam_offsets(self, mu):
         """Offsets (+, -) of the parameter difference: central, or one-sided at the edge of
         the parameter's allowed range (e.g. k_hip -> 0)."""
@@ -96,7 +135,7 @@ class _Problem:
         up, down = h, -h
         for s in (h, -h):
             try:
-                self.params_at(mu + s)
+                self.point_at(mu + s)
             except InvalidInputError:
                 if s > 0:
                     up = 0.0
@@ -110,6 +149,8 @@ class _Problem:
         raise NotImplementedError
 
     def params_at(self, mu) -> Params:
+        if self.axis is not None:
+            return self.base
         v = self.value(mu)
         try:
             return self._of(v) if self._of is not None else self.base.replace(
@@ -161,6 +202,7 @@ class HybridProblem(_Problem):
     def images(self, points):
         out = []
         for z, P in points:
+            P = P[0] if isinstance(P, tuple) else P       # (Params, contact): rigid ground
             o = self._steps(parameter_vector(P), np.asarray(z, dtype=float), False)
             out.append(None if isinstance(o, str) else o[0][list(H._SECTION)])
         return out
@@ -217,6 +259,7 @@ class ContinuousProblem(_Problem):
 
     dim = 6
     model = "continuous"
+    CONTACT_AXES = True
     lam_rel = 1e-4          # the map is reproducible to ~1e-10
     #: admissibility: the double support must last (> 0; else the feet are never both down and
     #: the section's event order changes), and the swing phase too
@@ -227,10 +270,11 @@ class ContinuousProblem(_Problem):
 
     def __init__(self, params, parameter, params_of=None, period=1, log=False, variant="paper",
                  method="rodas4", options=None, fd_step=1e-5, executor=None, workers=None, **kw):
-        super().__init__(params, parameter, params_of, period, log, **kw)
+        opts = {**_poincare.TIGHT, **(options or {})}
+        super().__init__(params, parameter, params_of, period, log, contact=opts.get("contact"),
+                         **kw)
         self.variant, self.method = variant, method
-        self.opts = {**_poincare.TIGHT, **(options or {})}
-        self.contact = self.opts.get("contact")
+        self.opts = opts
         self.dim = len(_section.section_names(self.contact))
         self.fd_step = float(fd_step)
         self.executor = executor
@@ -249,35 +293,55 @@ class ContinuousProblem(_Problem):
         # the tasks travel to process pools / Dask workers without the executor itself
         return {**self.__dict__, "executor": None}
 
-    def _run(self, tasks):
-        fn = _ContinuousTask(self)
+    def _options(self, contact):
+        """The step map's options for a point whose contact is ``contact``."""
+        opts = {**self.opts, "t_hint": self.t_hint}
+        if contact is not None or "contact" in opts:
+            opts["contact"] = contact
+        return opts
+
+    def _compose_all(self, zs, models):
+        """``[(P^n(z) or None, steps)]`` of every z with its (Params, contact): through
+        `step_maps.compose_points` (the ensemble engine where it takes them) when they share
+        one contact, else each on its own (a contact axis: its points' laws differ; the
+        engine does not run non-default laws anyway); Ctrl-C stops every thread."""
+        contacts = [c for _, c in models]
         if self.executor is not None:
-            return list(self.executor.map(fn, tasks))
+            return list(self.executor.map(
+                lambda i: _maps._compose(zs[i], self.period, models[i][0], self.variant,
+                                         self.method, self._options(contacts[i])),
+                range(len(zs))))
+        if all(c == contacts[0] for c in contacts):
+            return _maps.compose_points(zs, self.period, [P for P, _ in models], self.variant,
+                                        self.method, self._options(contacts[0]), self.workers)
+        return thread_map(
+            lambda i: _maps._compose(zs[i], self.period, models[i][0], self.variant,
+                                     self.method, self._options(contacts[i])),
+            range(len(zs)), min(self.workers, len(zs)))
+
+    def _run(self, tasks):
+        if self.executor is not None:
+            return list(self.executor.map(_ContinuousTask(self), tasks))
         # the finite differences through the ensemble engine where it takes them (the same
         # numbers), the rest on threads; Ctrl-C stops every thread
-        return _maps.compose_points([t[0] for t in tasks], self.period,
-                                 [self.params_at(mu) for _, mu in tasks], self.variant,
-                                 self.method, {**self.opts, "t_hint": self.t_hint}, self.workers)
+        return self._compose_all([np.asarray(t[0], dtype=float) for t in tasks],
+                                 [self.point_at(mu) for _, mu in tasks])
 
     def images(self, points):
+        """P^n(z) of every (z, model), model a `Params` (with the base contact) or a
+        (Params, contact) pair (`point_at`)."""
         if not points:
             return []
         zs = [np.asarray(z, dtype=float) for z, _ in points]
-        ps = [P for _, P in points]
-        if self.executor is not None:
-            outs = list(self.executor.map(
-                lambda zp: _maps._compose(zp[0], self.period, zp[1], self.variant, self.method,
-                                       {**self.opts, "t_hint": self.t_hint}), zip(zs, ps)))
-        else:
-            outs = _maps.compose_points(zs, self.period, ps, self.variant, self.method,
-                                     {**self.opts, "t_hint": self.t_hint}, self.workers)
+        models = [P if isinstance(P, tuple) else (P, self.contact) for _, P in points]
+        outs = self._compose_all(zs, models)
         self.n_maps += self.period * len(points)
         return [o[0] for o in outs]
 
     def evaluate(self, z, mu, jac=True) -> Evaluation:
         z = np.asarray(z, dtype=float)
         try:
-            self.params_at(mu)
+            P, contact = self.point_at(mu)
         except InvalidInputError as e:
             return Evaluation(False, "invalid parameter: %s" % e)
         tasks = [(z, mu)]
@@ -307,7 +371,7 @@ class ContinuousProblem(_Problem):
             if exact:
                 from . import variational
                 try:
-                    M = variational.step_jacobian(z, self.params_at(mu), **{
+                    M = variational.step_jacobian(z, P, contact=contact, **{
                         k: self.opts[k] for k in ("rtol", "atol") if k in self.opts})["M"]
                 except InvalidInputError as e:
                     return Evaluation(False, "exact monodromy: %s" % e)
@@ -319,7 +383,7 @@ class ContinuousProblem(_Problem):
         info = {"period": float(sum(s["period"] for s in steps)),
                 "step_length": float(np.mean([s["step_length"] for s in steps])),
                 "double_support": float(np.mean([s["double_support"] for s in steps])),
-                "state": _section.embed(z, self.params_at(mu), self.contact),
+                "state": _section.embed(z, P, contact),
                 "n_events": int(sum(s["n_events"] for s in steps)),
                 "orbit": np.array([z] + [s["z"] for s in steps[:-1]])}
         if self.ref_events is None:
@@ -333,28 +397,38 @@ class ContinuousProblem(_Problem):
     CHECK_FACTOR = 10.0
     #: multipliers of the two steps differing by more than this are reported
     CHECK_TOL = 1e-3
+    #: multipliers smaller than this in modulus are not compared (`multiplier_gap`)
+    CHECK_FLOOR = 0.1
+
+    @property
+    def exact_available(self) -> bool:
+        """Whether `pdw.analysis.stepmap.variational` gives this problem's exact monodromy:
+        the paper variant, period 1 and Coulomb friction (every normal law; not LuGre)."""
+        return (self.variant == "paper" and self.period == 1
+                and Contact.coerce(self.contact).friction == "coulomb")
 
     def crosscheck(self, z, mu, multipliers):
-        """The multipliers again, exactly (`pdw.analysis.stepmap.variational`: default laws, paper
-        variant, period 1) or else from central differences with ``CHECK_FACTOR`` x
+        """The multipliers again, exactly (`pdw.analysis.stepmap.variational`: paper variant,
+        period 1, every normal law with Coulomb friction, `exact_available`) or else from
+        central differences with ``CHECK_FACTOR`` x
         ``fd_step``: (largest difference to ``multipliers``, note or ""). A difference above
         ``CHECK_TOL`` means the step map has a kink within a few difference steps of z (the
         finite-difference multipliers then depend on the step), and the note says so;
         ``last_check`` says which check ran."""
         z = np.asarray(z, dtype=float)
-        if (self.contact is None and self.variant == "paper" and self.period == 1
-                and self.monodromy != "exact"):
+        if self.exact_available and self.monodromy != "exact":
             # the exact monodromy (pdw.analysis.stepmap.variational) where it exists
             from . import variational
             try:
-                Mx = variational.step_jacobian(z, self.params_at(mu), **{
+                P, contact = self.point_at(mu)
+                Mx = variational.step_jacobian(z, P, contact=contact, **{
                     k: self.opts[k] for k in ("rtol", "atol") if k in self.opts})["M"]
             except InvalidInputError as e:
                 return np.inf, "the exact monodromy failed (%s): not checked" % e
             m = np.linalg.eigvals(Mx)
             m = m[np.argsort(-np.abs(m))]
             ref = np.asarray(multipliers)
-            diff = float(np.max(np.abs(np.sort_complex(m) - np.sort_complex(ref))))
+            diff = multiplier_gap(m, ref, self.CHECK_FLOOR)
             self.last_check = "variational"
             if diff > self.CHECK_TOL:
                 return diff, ("the finite-difference multipliers (fd_step %g) differ from the "
@@ -376,7 +450,7 @@ class ContinuousProblem(_Problem):
         m = np.linalg.eigvals(M)
         m = m[np.argsort(-np.abs(m))]
         ref = np.asarray(multipliers)
-        diff = float(np.max(np.abs(np.sort_complex(m) - np.sort_complex(ref))))
+        diff = multiplier_gap(m, ref, self.CHECK_FLOOR)
         if diff > self.CHECK_TOL:
             return diff, ("finite-difference multipliers depend on the step: fd_step %g and "
                           "%g differ by %.3g (largest %s against %s): a kink of the step map "
@@ -386,15 +460,18 @@ class ContinuousProblem(_Problem):
         return diff, ""
 
     def gait(self, z, mu, ev, multipliers) -> Gait:
+        P, contact = self.point_at(mu)
         return Gait(state=ev.info["state"], period=ev.info["period"],
                     step_length=ev.info["step_length"], double_support=ev.info["double_support"],
-                    multipliers=multipliers, model="continuous", params=self.params_at(mu),
+                    multipliers=multipliers, model="continuous", params=P,
                     details={"z": np.array(z), "period_n": self.period, "jacobian": ev.M,
                              "jacobian_kind": ("exact (variational equations + saltation)"
                                                if self.monodromy == "exact" else
                                                "central differences, fd_step %g"
                                                % self.fd_step),
-                             "variant": self.variant, "options": dict(self.opts),
+                             "variant": self.variant,
+                             "options": {**self.opts, **({} if contact is None
+                                                         else {"contact": contact})},
                              "section_names": _section.section_names(self.contact)})
 
 
@@ -408,6 +485,6 @@ class _ContinuousTask:
     def __call__(self, task):
         z, mu = task
         pr = self.prob
-        opts = {**pr.opts, "t_hint": pr.t_hint}
-        return _maps._compose(np.asarray(z), pr.period, pr.params_at(mu), pr.variant, pr.method,
-                           opts)
+        P, contact = pr.point_at(mu)
+        return _maps._compose(np.asarray(z), pr.period, P, pr.variant, pr.method,
+                              pr._options(contact))

@@ -175,23 +175,64 @@ def test_simplest_walker_limit_of_the_period_doubling():
     assert abs(limit - 0.0150884) < 5e-8
 
 
-@pytest.mark.slow
-def test_kelvin_voigt_period_doubling_located_at_109_745_and_stall_stop():
-    """The Kelvin-Voigt ground's doubling (docs/contact_laws.md): from d_n = 109.5 with steps
-    of 0.1 it is located at 109.745 (the multiplier -1 to 1e-3; long walks: period 1 at 109.70,
-    period 2 at 109.75), the finite-difference cross-check flags the kink next to it, and the
-    branch beyond stops as stalled instead of crawling to max_points."""
-    from pdw.analysis.numerics.calibration import calibrate
+def _kelvin_voigt(d):
+    """Kelvin-Voigt at the calibrated stiffness k = W / delta_s (the Hunt-Crossley static sink
+    under the weight, pdw.analysis.numerics.calibration: 7318.12 N/m) and damping d [N s/m]."""
     P0 = pdw.Params.paper_steady()
-    kv = calibrate(P0).contacts["kelvin_voigt"]
-    with pytest.warns(UserWarning, match="depend on the step"):
-        b = continue_gait(P0.replace(k_n=kv.k, d_n=109.5), "d_n", 110.2, step=0.1,
-                          max_points=30, options=dict(contact=pdw.Contact("kelvin_voigt")),
-                          workers=2)
+    return pdw.Contact("kelvin_voigt", k=P0.weight / (P0.weight / P0.k_n) ** (2.0 / 3.0), d=d)
+
+
+def _exact_flip(z, d):
+    """Newton's method on P(z) - z with the exact step Jacobian (variational equations, no
+    finite differences, no continuation) at damping d: (z*, the flip multiplier)."""
+    from pdw.analysis.stepmap import variational as V
+    P0, c = pdw.Params.paper_steady(), _kelvin_voigt(d)
+    for _ in range(12):
+        r = V.step_jacobian(z, P0, contact=c)
+        if np.max(np.abs(r["z"] - z)) < 1e-10:
+            break
+        z = z - np.linalg.solve(r["M"] - np.eye(len(z)), r["z"] - z)
+    assert np.max(np.abs(r["z"] - z)) < 1e-9
+    return z, float(np.min(np.real(np.linalg.eigvals(r["M"]))))
+
+
+@pytest.mark.slow
+def test_kelvin_voigt_period_doubling_in_contact_d_and_stall_stop():
+    """The Kelvin-Voigt ground's doubling (docs/contact_laws.md), continued in the Contact's
+    own damping "contact.d" from 109.5 with steps of 0.1: with finite differences it is located
+    at 109.74536 (the multiplier -1 to 1e-3), the cross-check against the exact monodromy
+    flags the kink next to it, and the branch beyond stops as stalled at 109.886. Independent
+    check (Newton with the exact Jacobian): the flip multiplier passes -1 between 109.7495
+    (-0.99982) and 109.7498 (-1.00003), so the finite-difference location is 0.0044 low;
+    long walks: period 1 at 109.745 and 109.747 (the alternation decays), period 2 at 109.752."""
+    P0 = pdw.Params.paper_steady()
+    with pytest.warns(UserWarning, match="kink of the step map"):
+        b = continue_gait(P0, "contact.d", 110.2, step=0.1, max_points=30,
+                          options=dict(contact=_kelvin_voigt(109.5)), workers=2)
     (pd,) = b.of_kind("period_doubling")
-    assert pd.located and 109.70 < pd.value < 109.75
+    assert pd.located and 109.744 < pd.value < 109.747
     assert np.min(np.abs(pd.multipliers + 1.0)) < 1e-3
     assert b.stop_reason.startswith("stalled") and len(b) < 30
+    z, lo = _exact_flip(b.z[0], 109.7495)
+    _, hi = _exact_flip(z, 109.7498)
+    assert -1.0 < lo < -0.9995 and -1.0005 < hi < -1.0
+
+
+@pytest.mark.slow
+def test_kelvin_voigt_period_doubling_with_the_exact_monodromy():
+    """The same continuation with monodromy="exact" passes the kink: the doubling at 109.74972,
+    inside the independent bracket [109.7495, 109.7498] (test above), and the branch reaches
+    its stop (no stall: the exact multipliers are smooth, -1.11 at 109.85, where the
+    finite-difference ones jumped to -1.41)."""
+    with pytest.warns(UserWarning, match="depend on the step"):   # the cross-check: FD
+        b = continue_gait(pdw.Params.paper_steady(), "contact.d", 110.2, step=0.1,
+                          max_points=30, options=dict(contact=_kelvin_voigt(109.5)),
+                          workers=2, monodromy="exact")
+    (pd,) = b.of_kind("period_doubling")
+    assert pd.located and 109.7495 < pd.value < 109.7498
+    assert b.stop_reason.startswith("reached stop")
+    i = np.argmin(np.abs(b.values - 109.85))
+    assert abs(np.min(np.real(b.multipliers[i])) + 1.11) < 0.01
 
 
 def test_a_parameter_kelvin_voigt_does_not_read_is_refused():
