@@ -4,7 +4,7 @@
  * the time loops (pdw_terrain.c) and the hybrid loop can reuse it.
  *
  * Height: cells k = 0..n-1 on knots s_0 < ... < s_n, each row (layout GROUND_CELL)
- *     [s_k, 1/w_k, a_0 .. a_5],   h(s) = sum_j a_j u^j,  u = (s - s_k)/w_k in [0, 1],
+ *     [s_k, 1/w_k, a_0 .. a_5],   h(s) = sum_j a_j d^j,  d = s - s_k in [0, w_k],
  * a piecewise quintic (C2 where the shape is). The cell is found in O(1): lut[j] is the cell
  * containing s_min + j/lut_inv, then a short forward scan.
  * Patches: rows [s_a, s_b, v_1 .. v_f] (NaN: field not set), field i sets p[field[i]]; within
@@ -83,13 +83,15 @@ static inline int pdw_ground_cell_level(const pdw_ground *g, long k)
 static inline void pdw_ground_eval_cell(const pdw_ground *g, long k, double s, double *out)
 {
     const double *c = g->cells + k*PDW_NGCELL;
-    const double iw = c[PDW_GCELL_INV_W], u = (s - c[PDW_GCELL_S]) * iw;
+    const double d = s - c[PDW_GCELL_S];
     const double *a = c + PDW_GCELL_A0;
-    /* Estrin's scheme: short dependency chains (the time loops wait on these values) */
-    const double u2 = u*u, u4 = u2*u2;
-    out[0] = (a[0] + a[1]*u) + u2*(a[2] + a[3]*u) + u4*(a[4] + a[5]*u);
-    out[1] = ((a[1] + 2.0*a[2]*u) + u2*(3.0*a[3] + 4.0*a[4]*u) + u4*(5.0*a[5])) * iw;
-    out[2] = ((2.0*a[2] + 6.0*a[3]*u) + u2*(12.0*a[4] + 20.0*a[5]*u)) * (iw * iw);
+    /* Estrin's scheme in d itself: short dependency chains (the time loops wait on h', and no
+     * scaling u = d/w sits before it or after it); the derivative's coefficients (2 a_2, ...)
+     * need only the cell, not s */
+    const double d2 = d*d, d4 = d2*d2;
+    out[0] = (a[0] + a[1]*d) + d2*(a[2] + a[3]*d) + d4*(a[4] + a[5]*d);
+    out[1] = (a[1] + 2.0*a[2]*d) + d2*(3.0*a[3] + 4.0*a[4]*d) + d4*(5.0*a[5]);
+    out[2] = (2.0*a[2] + 6.0*a[3]*d) + d2*(12.0*a[4] + 20.0*a[5]*d);
 }
 
 /* h, h', h'' at s into out[0..2]. */
