@@ -116,32 +116,34 @@ static inline int pdw_ground_inside(const pdw_ground *g, double s)
 }
 
 /* Weight of a patch [s_a, s_b] at s: 0 outside, 1 inside, the C2 smoothstep across each edge's
- * blend zone [edge - blend/2, edge + blend/2]. */
+ * blend zone [edge - blend/2, edge + blend/2]. The zone tests come first: only a point inside a
+ * blend zone pays for the divisions (a foot crosses a zone in a few steps of thousands). */
 static inline double pdw_ground_window(double s, double s_a, double s_b, double blend)
 {
+    const double hb = 0.5*blend;
+    if (s <= s_a - hb || s >= s_b + hb) return 0.0;
     double w = 1.0;
-    const double ua = (s - (s_a - 0.5*blend)) / blend, ub = ((s_b + 0.5*blend) - s) / blend;
-    if (ua <= 0.0 || ub <= 0.0) return 0.0;
-    if (ua < 1.0) w *= ua*ua*ua*(10.0 + ua*(-15.0 + 6.0*ua));
-    if (ub < 1.0) w *= ub*ub*ub*(10.0 + ub*(-15.0 + 6.0*ub));
+    if (s < s_a + hb) { const double ua = (s - (s_a - hb)) / blend; w *= ua*ua*ua*(10.0 + ua*(-15.0 + 6.0*ua)); }
+    if (s > s_b - hb) { const double ub = ((s_b + hb) - s) / blend; w *= ub*ub*ub*(10.0 + ub*(-15.0 + 6.0*ub)); }
     return w;
 }
 
 /* The parameter vector at s: p_out = p with the patches' fields blended in (p_out may be p's copy;
- * only the patched fields are written). */
+ * only the patched fields are written). Each patch's window once (patches in order, each field
+ * summed in that order). */
 static inline void pdw_ground_params(const pdw_ground *g, double s, const double *p, double *p_out)
 {
-    for (int f = 0; f < g->n_fields; ++f) {
-        const int idx = g->fields[f];
-        double v = p[idx];
-        for (int i = 0; i < g->n_patches; ++i) {
-            const double *row = g->patches + i*(2 + g->n_fields);
+    const int nf = g->n_fields;
+    for (int f = 0; f < nf; ++f) p_out[g->fields[f]] = p[g->fields[f]];
+    for (int i = 0; i < g->n_patches; ++i) {
+        const double *row = g->patches + i*(2 + nf);
+        const double w = pdw_ground_window(s, row[0], row[1], g->blend);
+        if (!(w > 0.0)) continue;
+        for (int f = 0; f < nf; ++f) {
+            const int idx = g->fields[f];
             const double pv = row[2 + f];
-            if (pv != pv) continue;                                 /* NaN: not set here */
-            const double w = pdw_ground_window(s, row[0], row[1], g->blend);
-            if (w > 0.0) v += w * (pv - p[idx]);
+            if (pv == pv) p_out[idx] += w * (pv - p[idx]);     /* NaN: not set here */
         }
-        p_out[idx] = v;
     }
 }
 
