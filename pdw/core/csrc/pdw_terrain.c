@@ -47,8 +47,8 @@ static inline void inv_normals(double dh0, double dh1, double *n0, double *n1)
         const __m128d p23 = _mm_add_pd(_mm_set1_pd(INVN_C2), _mm_mul_pd(_mm_set1_pd(INVN_C3), q));
         const __m128d p45 = _mm_add_pd(_mm_set1_pd(INVN_C4), _mm_mul_pd(_mm_set1_pd(INVN_C5), q));
         const __m128d r = _mm_add_pd(_mm_add_pd(p01, _mm_mul_pd(q2, p23)), _mm_mul_pd(q4, p45));
-        _mm_storel_pd(n0, r);
-        _mm_storeh_pd(n1, r);
+        *n0 = _mm_cvtsd_f64(r);
+        *n1 = _mm_cvtsd_f64(_mm_unpackhi_pd(r, r));
         return;
     }
 #endif
@@ -92,45 +92,62 @@ static inline double load_fresh(const double *src)
     return v;
 }
 
+/* One foot's ground at s: h, h', h'' (out[0..2]) of its cell (the hint updated). A level cell
+ * (finite s) gives exactly pdw_ground_eval_cell's values (pdw_ground.h), known before s is (the
+ * time loop's chain skips the quintic). */
+static inline void sample_foot(const pdw_ground *g, double s, double *hint, double *out)
+{
+    const long c = pdw_ground_cell_hint(g, s, hint);
+    if (pdw_ground_cell_level(g, c) && s - s == 0.0) {
+        out[0] = g->cells[c*PDW_NGCELL + PDW_GCELL_A0] + 0.0;
+        out[1] = out[2] = 0.0;
+    } else {
+        pdw_ground_eval_cell(g, c, s, out);
+    }
+}
+
+/* One foot's sampled ground (layout GROUND) into gi. */
+static inline void put_ground(double *gi, const double *e, double sigma, double alpha, double c)
+{
+    gi[PDW_GROUND_H] = e[0];
+    gi[PDW_GROUND_DH] = e[1];
+    gi[PDW_GROUND_DDH] = e[2];
+    gi[PDW_GROUND_SIGMA] = sigma;
+    gi[PDW_GROUND_ALPHA] = alpha;
+    gi[PDW_GROUND_INV_N] = c;
+    gi[PDW_GROUND_S_N] = e[1] * c;      /* h'/N: the forces' coefficient */
+}
+
+/* Straight-line code on local arrays with constant indices (the feet written out, the generated
+ * kinematics inline): the compiler keeps the ground values in registers, where a loop over the
+ * feet passed them through memory on the time loop's chain; gnd is stored field by field (for
+ * the forces and the Jacobian), never read back here. */
 void pdw_terrain_kinematics(const pdw_kernel *k, const pdw_ground *g, const double *x,
                             const double *trig, const double *p, const double *anchors,
                             double *kin, double *gnd, double *cell)
 {
-    double sA[2], e[2][3];
+    double sA[2], e0[3], e1[3], c0, c1, gl[2*PDW_NGROUND];
+    double sig0 = 0.0, sig1 = 0.0, al0 = 0.0, al1 = 0.0;
     pdw_ground_points(x, trig, p, sA);
-    for (int i = 0; i < 2; ++i) {
-        double *gi = gnd + i*PDW_NGROUND;
-        const long c = pdw_ground_cell_hint(g, sA[i], cell + i);
-        if (pdw_ground_cell_level(g, c) && sA[i] - sA[i] == 0.0) {
-            /* a level cell (finite s): exactly pdw_ground_eval_cell's values (pdw_ground.h),
-             * known before s_A is (the time loop's chain skips u and the quintic) */
-            e[i][0] = g->cells[c*PDW_NGCELL + PDW_GCELL_A0] + 0.0;
-            e[i][1] = e[i][2] = 0.0;
-        } else {
-            pdw_ground_eval_cell(g, c, sA[i], e[i]);
-        }
-        gi[PDW_GROUND_H] = e[i][0];
-        gi[PDW_GROUND_DH] = e[i][1];
-        gi[PDW_GROUND_DDH] = e[i][2];
+    sample_foot(g, sA[0], cell, e0);
+    sample_foot(g, sA[1], cell + 1, e1);
+    inv_normals(e0[1], e1[1], &c0, &c1);
+    const int consistent = k->variant == 1;
+    if (consistent) {                   /* the rolling coordinate needs sigma, alpha */
+        sig0 = pdw_ground_arc(g, sA[0]);
+        al0 = atan(e0[1]);
+        sig1 = pdw_ground_arc(g, sA[1]);
+        al1 = atan(e1[1]);
     }
-    double c[2];
-    inv_normals(e[0][1], e[1][1], c, c + 1);
-    for (int i = 0; i < 2; ++i) {
-        double *gi = gnd + i*PDW_NGROUND;
-        gi[PDW_GROUND_INV_N] = c[i];
-        gi[PDW_GROUND_S_N] = e[i][1] * c[i];        /* h'/N, the forces' coefficient */
-        if (k->variant == 1) {          /* consistent: the rolling coordinate needs sigma, alpha */
-            gi[PDW_GROUND_SIGMA] = pdw_ground_arc(g, sA[i]);
-            gi[PDW_GROUND_ALPHA] = atan(e[i][1]);
-        } else {
-            gi[PDW_GROUND_SIGMA] = 0.0;
-            gi[PDW_GROUND_ALPHA] = 0.0;
-        }
-    }
-    if (k->variant == 1) pdw_consistent_ground_kinematics(x, trig, p, anchors, gnd, kin);
-    else pdw_paper_ground_kinematics(x, trig, p, anchors, gnd, kin);
-    for (int i = 0; i < 2; ++i)
-        kin[i*PDW_NKIN + PDW_KIN_Z] = k->nx > PDW_NX ? x[PDW_X_Z1 + i] : 0.0;
+    put_ground(gl, e0, sig0, al0, c0);
+    put_ground(gl + PDW_NGROUND, e1, sig1, al1, c1);
+    if (consistent) pdw_consistent_ground_kinematics(x, trig, p, anchors, gl, kin);
+    else pdw_paper_ground_kinematics(x, trig, p, anchors, gl, kin);
+    put_ground(gnd, e0, sig0, al0, c0);
+    put_ground(gnd + PDW_NGROUND, e1, sig1, al1, c1);
+    const int z = k->nx > PDW_NX;
+    kin[PDW_KIN_Z] = z ? x[PDW_X_Z1] : 0.0;
+    kin[PDW_NKIN + PDW_KIN_Z] = z ? x[PDW_X_Z1 + 1] : 0.0;
 }
 
 void pdw_terrain_contact(const pdw_kernel *k, const pdw_ground *g, const double *kin,
