@@ -155,26 +155,31 @@ void pdw_terrain_contact(const pdw_kernel *k, const pdw_ground *g, const double 
 {
     void (*stage)(const double *, const int *, const double *, double *) =
         partials ? k->contact_partials : k->contact;
-    if (g->n_patches == 0 || (!pdw_ground_patched(g, kin[PDW_KIN_X_D])
-                              && !pdw_ground_patched(g, kin[PDW_NKIN + PDW_KIN_X_D]))) {
-        stage(kin, flags, p, contact);      /* neither foot on a patch: the run's parameters */
+    /* Every contact stage writes 0.0 for a foot that is not a penetrating support foot,
+     * whatever p (derive/emit.py _contact_function): no penetrating foot, or one that no patch
+     * reaches, takes the run's parameters; with one penetrating foot, one call with that foot's
+     * parameters gives both feet's values (single support, the common case) */
+    const int pen0 = flags[0] && kin[PDW_KIN_Y_D] < 0.0;
+    const int pen1 = flags[1] && kin[PDW_NKIN + PDW_KIN_Y_D] < 0.0;
+    if (g->n_patches == 0 || !(pen0 || pen1)) {
+        stage(kin, flags, p, contact);
         return;
     }
     double pi[PDW_NP], ci[2*PDW_NCONTACT];
-    /* Every contact stage writes 0.0 for a foot that is not a penetrating support foot,
-     * whatever p (derive/emit.py _contact_function): with at most one penetrating foot, one call
-     * with that foot's parameters gives both feet's values (single support, the common case) */
-    const int pen0 = flags[0] && kin[PDW_KIN_Y_D] < 0.0;
-    const int pen1 = flags[1] && kin[PDW_NKIN + PDW_KIN_Y_D] < 0.0;
     if (!(pen0 && pen1)) {
         const double s = kin[(pen1 ? PDW_NKIN : 0) + PDW_KIN_X_D];
-        if (!(pen0 || pen1) || !pdw_ground_patched(g, s)) {
+        if (!pdw_ground_patched(g, s)) {
             stage(kin, flags, p, contact);
             return;
         }
         memcpy(pi, p, sizeof pi);
         pdw_ground_params(g, s, p, pi);
         stage(kin, flags, pi, contact);
+        return;
+    }
+    if (!pdw_ground_patched(g, kin[PDW_KIN_X_D])
+        && !pdw_ground_patched(g, kin[PDW_NKIN + PDW_KIN_X_D])) {
+        stage(kin, flags, p, contact);      /* neither foot on a patch: the run's parameters */
         return;
     }
     for (int i = 0; i < 2; ++i) {
