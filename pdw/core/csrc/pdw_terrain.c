@@ -131,8 +131,22 @@ void pdw_terrain_kinematics(const pdw_kernel *k, const pdw_ground *g, const doub
     pdw_ground_points(x, trig, p, sA);
     sample_foot(g, sA[0], cell, e0);
     sample_foot(g, sA[1], cell + 1, e1);
-    inv_normals(e0[1], e1[1], &c0, &c1);
     const int consistent = k->variant == 1;
+    if (!consistent && e0[1] == 0.0 && e1[1] == 0.0) {
+        /* h' = 0 under both feet (level cells: a plane on the slope, the flat parts of steps,
+         * a flat ground with patches): the tangent lines are level, 1/N = 1, and the paper
+         * variant's surface-frame kinematics are the flat kernel's own with y_D less the
+         * height (derive/terrain.py with h' = 0; equal to rounding: another association of the
+         * same sums). Not for the consistent variant, whose rolling coordinate starts from the
+         * ground's arc length sigma and must stay one coordinate on every cell. */
+        k->kinematics(x, trig, p, anchors, kin);
+        kin[PDW_KIN_Y_D] -= e0[0];
+        kin[PDW_NKIN + PDW_KIN_Y_D] -= e1[0];
+        put_ground(gnd, e0, 0.0, 0.0, 1.0);
+        put_ground(gnd + PDW_NGROUND, e1, 0.0, 0.0, 1.0);
+        return;
+    }
+    inv_normals(e0[1], e1[1], &c0, &c1);
     if (consistent) {                   /* the rolling coordinate needs sigma, alpha */
         sig0 = pdw_ground_arc(g, sA[0]);
         al0 = atan(e0[1]);
