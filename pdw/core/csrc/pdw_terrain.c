@@ -9,12 +9,12 @@
 #include "pdw_terrain_gen.h"
 
 /* 1/N = (1 + q)^(-1/2), q = h'^2, for q <= INVN_QMAX (|h'| <= 0.0442): the binomial series
- * through q^5 (Estrin's scheme) in place of a square root and a division, which the time loops
- * wait on (about 35 cycles against about 20). The series alternates with terms decreasing in
+ * through q^5 (Estrin's scheme: four levels of multiplies and adds) in place of an add, a square
+ * root and a division, which the time loops wait on. The series alternates with terms decreasing in
  * magnitude (|c_k+1 / c_k| = (2k+1)/(2k+2) < 1, q < 1), so the truncation error is below the
  * first omitted term, (231/1024) q^6 <= (231/1024) 2^-54 = 1.3e-17 (0.11 ulp of 1); with the
  * evaluation's roundings the value is within 1 ulp of the exact 1/N, as 1/sqrt(1 + q) rounded
- * twice is (tests/core/test_terrain_invn.py checks both against 1/N in extended precision).
+ * twice is (tests/core/test_terrain_invn.py checks both against 1/N in exact arithmetic).
  * The coefficients are exact binary fractions; q = 0 (level ground) gives 1 exactly. */
 #define INVN_QMAX 0x1p-9
 #define INVN_C1 (-0.5)
@@ -86,8 +86,8 @@ static inline void copy_fresh(double *dst, const double *src, int n)
 static inline double load_fresh(const double *src)
 {
     double v = *src;
-#if defined(__GNUC__)
-    __asm__("" : "+x"(v));
+#if defined(__GNUC__) && defined(__SSE2__)
+    __asm__("" : "+x"(v));      /* "x": an SSE register, where the value is used */
 #endif
     return v;
 }
@@ -234,7 +234,7 @@ void pdw_terrain_forces(const double *contact, const double *gnd, const double *
         }
         return;
     }
-    pdw_ground_forces(cf, gd, p, gf);   /* reads only F_n, F_t of cf and h', 1/N of gd */
+    pdw_ground_forces(cf, gd, p, gf);   /* reads only F_n, F_t of cf and 1/N, h'/N of gd */
     for (int i = 0; i < 2; ++i) {
         cw[i*PDW_NCONTACT + PDW_CONTACT_F_N] = gf[i*PDW_NGFORCE + PDW_GFORCE_F_Y];
         cw[i*PDW_NCONTACT + PDW_CONTACT_F_T] = gf[i*PDW_NGFORCE + PDW_GFORCE_F_X];
