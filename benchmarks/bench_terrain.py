@@ -93,7 +93,11 @@ def main(rounds=7, ref=None):
                 if proc:
                     rc, rinfo = _ask(proc, mname, k)
                     rper[k].append(rc)
-                    if rinfo != info[k]:
+                    # the same run: status and gait steps equal, integration steps within
+                    # 1 % (a shaped ground's results may differ at the rounding level between
+                    # versions, which can move an adaptive method's step count by a few)
+                    if (rinfo[:2] != info[k][:2]
+                            or abs(rinfo[2] - info[k][2]) > 0.01 * info[k][2]):
                         raise SystemExit("ref run of %s/%s differs: %s vs %s"
                                          % (mname, k, rinfo, info[k]))
         base = np.array(per["none"])

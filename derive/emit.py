@@ -1,4 +1,5 @@
-"""Emit ``generated/pdw_model.{h,c}`` and ``pdw/core/_layout.py`` from the symbolic stages.
+"""Emit ``generated/pdw_model.{h,c}``, ``generated/pdw_terrain_gen.h`` and ``pdw/core/_layout.py``
+from the symbolic stages.
 
 Deterministic: the same derive/ sources and SymPy version give the same bytes.
 Every emitted file carries `input_hash()`, the SHA-256 of the derive/ sources and
@@ -92,22 +93,11 @@ def _names(spec=None):
 
 
 def emit_terrain():
-    """C of the shaped-ground stages (derive/terrain.py): the sample points, each variant's
-    kinematics, the ground forces."""
+    """C of the shaped-ground Jacobians (derive/terrain.py), for generated/pdw_model.c; the
+    per-evaluation stages are `terrain_header`'s."""
     names = _names()
-    out = ["/* ---- shaped ground (derive/terrain.py, docs/terrain.md) ---- */\n"]
-    code, _ = c_block([stages._trig(e) for e in terrain.sample_points()],
-                      ["sA[%d]" % i for i in range(2)], names)
-    out.append(_function("void pdw_ground_points(const double *restrict x, const double *restrict trig,\n"
-                         "    const double *restrict p, double *restrict sA)", code))
-    kin_targets = ["kin[%d*PDW_NKIN + PDW_KIN_%s]" % (i, f.upper()) for i in range(2) for f in layout.KIN]
-    for v in mdl.VARIANTS:
-        exprs = [stages._trig(e) for i in range(2) for e in terrain.ground_kinematics(i, v).values()]
-        code, _ = c_block(exprs, kin_targets, names)
-        out.append(_function(
-            "void pdw_%s_ground_kinematics(const double *restrict x, const double *restrict trig,\n"
-            "    const double *restrict p, const double *restrict anchors, const double *restrict gnd,\n"
-            "    double *restrict kin)" % v, "    (void)anchors;\n" + code))
+    out = ["/* ---- shaped ground (derive/terrain.py, docs/terrain.md): the Jacobians; the sample\n"
+           " * points, kinematics and forces are static inline in pdw_terrain_gen.h ---- */\n"]
     for v in mdl.VARIANTS:
         code, _ = c_block(terrain.ground_jacobian(v), ["A[%d] += " % i for i in range(32)], names)
         code = code.replace("] +=  = ", "] += ")
@@ -115,13 +105,52 @@ def emit_terrain():
             "void pdw_%s_ground_jacobian(const double *restrict x, const double *restrict trig,\n"
             "    const double *restrict p, const double *restrict contact,\n"
             "    const double *restrict gnd, double *restrict A)" % v, code))
+    return "\n".join(out)
+
+
+TERRAIN_HEADER = """\
+{banner}
+/* The shaped-ground stages of every evaluation (derive/terrain.py, docs/terrain.md): the sample
+ * points, each variant's kinematics, the ground forces, static inline so that the shaped-ground
+ * kernel (pdw/core/csrc/pdw_terrain.c, the only includer) keeps their inputs and outputs in
+ * registers: the time loops wait on this chain (ground -> kinematics -> contact -> forces). */
+#ifndef PDW_TERRAIN_GEN_H
+#define PDW_TERRAIN_GEN_H
+
+#include <math.h>
+#include "pdw_model.h"
+
+{body}
+#endif /* PDW_TERRAIN_GEN_H */
+"""
+
+
+def terrain_header(banner):
+    """The text of generated/pdw_terrain_gen.h."""
+    names = _names()
+    out = []
+    code, _ = c_block([stages._trig(e) for e in terrain.sample_points()],
+                      ["sA[%d]" % i for i in range(2)], names)
+    out.append(_function("static inline void pdw_ground_points(const double *restrict x,\n"
+                         "    const double *restrict trig, const double *restrict p, double *restrict sA)",
+                         code))
+    kin_targets = ["kin[%d*PDW_NKIN + PDW_KIN_%s]" % (i, f.upper()) for i in range(2) for f in layout.KIN]
+    for v in mdl.VARIANTS:
+        exprs = [stages._trig(e) for i in range(2) for e in terrain.ground_kinematics(i, v).values()]
+        code, _ = c_block(exprs, kin_targets, names)
+        out.append(_function(
+            "static inline void pdw_%s_ground_kinematics(const double *restrict x,\n"
+            "    const double *restrict trig, const double *restrict p,\n"
+            "    const double *restrict anchors, const double *restrict gnd, double *restrict kin)" % v,
+            "    (void)anchors;\n" + code))
     exprs = [e for i in range(2) for e in terrain.ground_forces(i)]
     targets = ["gf[%d*PDW_NGFORCE + PDW_GFORCE_%s]" % (i, f.upper()) for i in range(2)
                for f in terrain.GROUND_FORCE]
     code, _ = c_block(exprs, targets, names)
-    out.append(_function("void pdw_ground_forces(const double *restrict contact, const double *restrict gnd,\n"
-                         "    const double *restrict p, double *restrict gf)", code))
-    return "\n".join(out)
+    out.append(_function("static inline void pdw_ground_forces(const double *restrict contact,\n"
+                         "    const double *restrict gnd, const double *restrict p, double *restrict gf)",
+                         code))
+    return TERRAIN_HEADER.format(banner=banner, body="\n".join(out))
 
 
 def _function(signature, body):
@@ -400,11 +429,8 @@ def header(h):
         "void pdw_precompute(const double *params, double *p);",
         "void pdw_trig(const double *x, double *trig);\n",
         "\n".join(protos),
-        "\n/* shaped ground (derive/terrain.py): sample points, kinematics per variant, forces */",
-        "void pdw_ground_points(const double *x, const double *trig, const double *p, double *sA);",
-        "\n".join("void pdw_%s_ground_kinematics(const double *x, const double *trig, const double *p,\n"
-                  "    const double *anchors, const double *gnd, double *kin);" % v for v in mdl.VARIANTS),
-        "void pdw_ground_forces(const double *contact, const double *gnd, const double *p, double *gf);",
+        "\n/* shaped ground (derive/terrain.py): the Jacobians; the sample points, kinematics and"
+        " forces\n * are static inline in pdw_terrain_gen.h */",
         "\n".join("void pdw_%s_ground_jacobian(const double *x, const double *trig, const double *p,\n"
                   "    const double *contact, const double *gnd, double *A);" % v for v in mdl.VARIANTS),
         "\n#endif /* PDW_MODEL_H */\n",
@@ -531,6 +557,7 @@ def write_all(root: pathlib.Path):
     files = {
         root / "generated" / "pdw_model.h": header(h),
         root / "generated" / "pdw_model.c": src,
+        root / "generated" / "pdw_terrain_gen.h": terrain_header(banner),
         root / "generated" / "pdw_batch_gen.h": emit_batch.header(banner, h, KERNELS, _names,
                                                                    c_block, NFORCES),
         root / "pdw" / "core" / "_layout.py": python_layout(h, ops),

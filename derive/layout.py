@@ -72,7 +72,8 @@ CONTACT = (
 )
 
 # The compiled ground (pdw/core/ground.py, pdw/core/csrc/pdw_ground.h, docs/terrain.md): one cell
-# of the piecewise-quintic height table, h = sum_j a_j u^j with u = (s - s_k) / w_k on the cell.
+# of the piecewise-quintic height table, h = sum_j a_j d^j with d = s - s_k [m] on the cell (the
+# cell's width w_k = 1 / inv_w scales the arc-length table's u = d / w_k).
 GROUND_CELL = ("s", "inv_w", "a0", "a1", "a2", "a3", "a4", "a5")
 # The ground sampled under one foot (at s = x_A, the foot arc centre's distance along the slope),
 # the inputs of the shaped-ground kinematics (derive/terrain.py).
@@ -83,6 +84,7 @@ GROUND = (
     "sigma",    # arc length of the surface from s_min [m] (the consistent variant's anchor)
     "alpha",    # surface angle atan(h') [rad]
     "inv_n",    # 1/N = 1/sqrt(1 + h'^2), computed once per foot and evaluation [-]
+    "s_n",      # h'/N: the tangent's Y component (t = (1/N, h'/N)), the forces' coefficient [-]
 )
 
 # Energies (docs/model.md section 3).

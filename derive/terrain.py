@@ -24,7 +24,8 @@ The kinematics stage writes these into the flat model's `layout.KIN` fields in t
 runs unchanged. The forces F_n (along n) and F_t (along t) act at C; their generalized force is
 the flat dynamics stage's (forces along X, Y at D) applied to F_x = t_x F_t + n_x F_n,
 F_y = t_y F_t + n_y F_n, plus the moment of moving their point from D to C:
-r (y - n) x F = r (h'/N F_y - (1 - 1/N) F_x) on theta_i (`ground_forces`).
+r (y - n) x F = r (h'/N F_y - (1 - 1/N) F_x) = r ((1 - 1/N) F_t + h'/N F_n) on theta_i
+(`ground_forces`).
 """
 from __future__ import annotations
 
@@ -80,22 +81,26 @@ def ground_kinematics(foot: int, variant: str) -> dict:
 
 def ground_forces(foot: int):
     """(F_x, F_y, M_theta) of foot ``foot``: its surface-frame forces F_n, F_t as slope-frame
-    components at D, and the moment r (y - n) x F of moving them from D to C."""
+    components at D, and the moment r (y - n) x F of moving them from D to C.
+
+    Written linear in F_n and F_t with coefficients of the ground alone, c = 1/N and s = h'/N
+    (t = (c, s), n = (-s, c)): F_x = c F_t - s F_n, F_y = s F_t + c F_n, and the moment
+    r (s F_y - (1 - c) F_x) = r ((1 - c) F_t + s F_n) by s^2 + c^2 = 1. The forces come last in
+    the time loops' chain (ground -> kinematics -> contact -> forces): in this form each output
+    is one product and one sum after them. Equal to the (h' F_t + F_n)/N form to rounding."""
     r = mdl.P["r"]
-    dh = GND[foot]["dh"]
-    N = 1 / GND[foot]["inv_n"]
+    c, s = GND[foot]["inv_n"], GND[foot]["s_n"]      # s = h' c, sampled with the ground
     fn, ft = mdl.F_N[foot], mdl.F_T[foot]
-    fx = (ft - dh * fn) / N
-    fy = (dh * ft + fn) / N
-    return [fx, fy, r * (dh / N * fy - (1 - 1 / N) * fx)]
+    return [c * ft - s * fn, s * ft + c * fn, r * ((1 - c) * ft + s * fn)]
 
 
 def _ground_slopes(g):
     """d/ds of each sampled ground value (the chain rule through s_A): h' , h'', sigma' = N,
-    alpha' = h''/N^2, (1/N)' = -h' h''/N^3; h'' itself does not enter the kinematics."""
+    alpha' = h''/N^2, (1/N)' = -h' h''/N^3, (h'/N)' = h''/N^3; h'' itself does not enter the
+    kinematics."""
     dh, ddh, inv_n = g["dh"], g["ddh"], g["inv_n"]
     return {"h": dh, "dh": ddh, "sigma": 1 / inv_n, "alpha": ddh * inv_n ** 2,
-            "ddh": sp.S.Zero, "inv_n": -dh * ddh * inv_n ** 3}
+            "ddh": sp.S.Zero, "inv_n": -dh * ddh * inv_n ** 3, "s_n": ddh * inv_n ** 3}
 
 
 def _total_gradient(e, g, slope, dsA):
@@ -129,9 +134,11 @@ def ground_jacobian(variant: str):
         dFt = sym[i, "dFt_dxi"] * grad[2] + sym[i, "dFt_dv"] * grad[3] + sym[i, "mu"] * dFn
         ddh_dx = sp.Matrix([[slope["dh"] * dsA[j] for j in range(len(x))]])
         dinv_dx = sp.Matrix([[slope["inv_n"] * dsA[j] for j in range(len(x))]])
-        fn, ft, dh, inv_n = mdl.F_N[i], mdl.F_T[i], g["dh"], g["inv_n"]
+        ds_dx = sp.Matrix([[slope["s_n"] * dsA[j] for j in range(len(x))]])
+        fn, ft, dh, inv_n, s_n = mdl.F_N[i], mdl.F_T[i], g["dh"], g["inv_n"], g["s_n"]
         fx, fy, mom = (sp.diff(e, fn) * dFn + sp.diff(e, ft) * dFt + sp.diff(e, dh) * ddh_dx
-                       + sp.diff(e, inv_n) * dinv_dx for e in ground_forces(i))
+                       + sp.diff(e, inv_n) * dinv_dx + sp.diff(e, s_n) * ds_dx
+                       for e in ground_forces(i))
         # the flat forcing's columns for the forces along X (F_T) and Y (F_N) at D
         A += f.diff(mdl.F_T[i]) * fx + f.diff(mdl.F_N[i]) * fy
         A[2 + i, :] += mom

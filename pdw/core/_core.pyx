@@ -121,6 +121,7 @@ cdef extern from "pdw_sim.h":
     void pdw_terrain_jacobian(const pdw_kernel *k, const pdw_ground *g, const double *x,
                               const double *p, const int *flags, const double *anchors,
                               double *J, double *work) noexcept nogil
+    void pdw_terrain_inv_normals(long n, const double *dh, double *inv_n) noexcept nogil
 
 
 cdef extern from "pdw_tableaus.h":
@@ -700,6 +701,18 @@ def _real_states(x, bint allow_rows, int nx=PDW_NX):
 # --- the model object for external solvers (pdw.ode_function) ----------------------------
 
 include "_ode.pxi"
+
+
+@_named_buffers
+def ground_inv_normals(const double[::1] dh):
+    """1/N = 1/sqrt(1 + h'^2) (n,) of h' (n,) as the shaped-ground kernel computes it
+    (pdw_terrain.c; pairs as the two feet, an odd last one paired with 0), for tests."""
+    cdef long n = dh.shape[0]
+    out = np.zeros(n)
+    cdef double[::1] o = out
+    if n:
+        pdw_terrain_inv_normals(n, &dh[0], &o[0])
+    return out
 
 
 @_named_buffers

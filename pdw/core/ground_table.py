@@ -36,7 +36,8 @@ _GL_X, _GL_W = 0.5 * (_GL_X + 1.0), 0.5 * _GL_W
 class GroundTable:
     """The compiled ground (`pdw/core/csrc/pdw_ground.h`), NumPy arrays the C loop reads.
 
-    cells : (n, 8) float64: per cell [s_k, 1/w_k, a_0 .. a_5], h = sum a_j u^j, u = (s - s_k)/w_k
+    cells : (n, 8) float64: per cell [s_k, 1/w_k, a_0 .. a_5], h = sum a_j d^j, d = s - s_k [m]
+        (the quintic in d, not in u = d/w_k: the C evaluator's h' then waits on no scaling)
     arc : (n, 6) float64: the arc length sigma(s) = int_{s_min}^s sqrt(1 + h'^2) ds, same form
     lut : (m,) int64: the cell containing s_min + j / lut_inv (O(1) search)
     patch_fields : (f,) int32: kernel parameter indices (`_layout` PARAMS + CONTACT_PARAMS) patched
@@ -72,7 +73,7 @@ class GroundTable:
         # a_1 .. a_5 are then all bits zero, which the C kernel's level-cell test reads
         # (pdw_ground.h pdw_ground_cell_level)
         coef = _hermite5(w, va, vb) + 0.0
-        cells = np.column_stack([a, 1.0 / w, coef])
+        cells = np.column_stack([a, 1.0 / w, _in_d(coef, w, va)])
         # arc length: exact values at the knots by Gauss-Legendre on the table's own polynomial,
         # Hermite within the cell from sigma' = sqrt(1 + h'^2), sigma'' = h' h'' / sigma'
         u = _GL_X
@@ -107,7 +108,7 @@ class GroundTable:
         s = np.asarray(s, float)
         k = np.clip(np.searchsorted(self.cells[:, 0], s, side="right") - 1, 0, len(self.cells) - 1)
         c = self.cells[k]
-        u = (s - c[..., 0]) * c[..., 1]
+        u = s - c[..., 0]
         a = c[..., 2:]
         h = a[..., 5]
         for j in range(4, -1, -1):
@@ -118,7 +119,7 @@ class GroundTable:
         dd = 20 * a[..., 5]
         for j in range(4, 1, -1):
             dd = dd * u + j * (j - 1) * a[..., j]
-        return h, d * c[..., 1], dd * c[..., 1] ** 2
+        return h, d, dd
 
     def arc_length(self, s):
         """sigma(s) [m] from the table."""
@@ -130,6 +131,14 @@ class GroundTable:
         for j in range(4, -1, -1):
             out = out * u + a[..., j]
         return out
+
+
+def _in_d(coef, w, va):
+    """The quintic in u = d/w (`_hermite5`) as one in d: a_j / w^j, the first three exactly the
+    cell's start values h, h', h''/2 (+ 0.0: every zero coefficient +0, as `build` needs)."""
+    out = coef / w[:, None] ** np.arange(6)
+    out[:, 0], out[:, 1], out[:, 2] = va[0], va[1], 0.5 * va[2]
+    return out + 0.0
 
 
 def _knot_values(g, knots, mid):

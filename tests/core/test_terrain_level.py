@@ -4,7 +4,9 @@ pdw_terrain.c): where a cell's a_1 .. a_5 are all +0.0 the kernel takes h = a_0,
 multiplications by 1/N. These are claimed to be bitwise the general path's values: checked here
 by running the same ground with its level cells' zero coefficients turned into -0.0 (the same
 polynomial, which the level test refuses, so every evaluation takes the general path) and
-comparing the recorded runs byte for byte."""
+comparing the recorded runs byte for byte. (Where h' = 0 under both feet the paper variant takes
+the flat kernel's kinematics less the height in both runs, the -0.0 cells' h' being a zero too:
+that path is checked against the flat model in test_terrain.py, to rounding.)"""
 import dataclasses
 
 import numpy as np

@@ -4,7 +4,7 @@
  * the time loops (pdw_terrain.c) and the hybrid loop can reuse it.
  *
  * Height: cells k = 0..n-1 on knots s_0 < ... < s_n, each row (layout GROUND_CELL)
- *     [s_k, 1/w_k, a_0 .. a_5],   h(s) = sum_j a_j u^j,  u = (s - s_k)/w_k in [0, 1],
+ *     [s_k, 1/w_k, a_0 .. a_5],   h(s) = sum_j a_j d^j,  d = s - s_k in [0, w_k],
  * a piecewise quintic (C2 where the shape is). The cell is found in O(1): lut[j] is the cell
  * containing s_min + j/lut_inv, then a short forward scan.
  * Patches: rows [s_a, s_b, v_1 .. v_f] (NaN: field not set), field i sets p[field[i]]; within
@@ -83,13 +83,15 @@ static inline int pdw_ground_cell_level(const pdw_ground *g, long k)
 static inline void pdw_ground_eval_cell(const pdw_ground *g, long k, double s, double *out)
 {
     const double *c = g->cells + k*PDW_NGCELL;
-    const double iw = c[PDW_GCELL_INV_W], u = (s - c[PDW_GCELL_S]) * iw;
+    const double d = s - c[PDW_GCELL_S];
     const double *a = c + PDW_GCELL_A0;
-    /* Estrin's scheme: short dependency chains (the time loops wait on these values) */
-    const double u2 = u*u, u4 = u2*u2;
-    out[0] = (a[0] + a[1]*u) + u2*(a[2] + a[3]*u) + u4*(a[4] + a[5]*u);
-    out[1] = ((a[1] + 2.0*a[2]*u) + u2*(3.0*a[3] + 4.0*a[4]*u) + u4*(5.0*a[5])) * iw;
-    out[2] = ((2.0*a[2] + 6.0*a[3]*u) + u2*(12.0*a[4] + 20.0*a[5]*u)) * (iw * iw);
+    /* Estrin's scheme in d itself: short dependency chains (the time loops wait on h', and no
+     * scaling u = d/w sits before it or after it); the derivative's coefficients (2 a_2, ...)
+     * need only the cell, not s */
+    const double d2 = d*d, d4 = d2*d2;
+    out[0] = (a[0] + a[1]*d) + d2*(a[2] + a[3]*d) + d4*(a[4] + a[5]*d);
+    out[1] = (a[1] + 2.0*a[2]*d) + d2*(3.0*a[3] + 4.0*a[4]*d) + d4*(5.0*a[5]);
+    out[2] = (2.0*a[2] + 6.0*a[3]*d) + d2*(12.0*a[4] + 20.0*a[5]*d);
 }
 
 /* h, h', h'' at s into out[0..2]. */
@@ -114,32 +116,34 @@ static inline int pdw_ground_inside(const pdw_ground *g, double s)
 }
 
 /* Weight of a patch [s_a, s_b] at s: 0 outside, 1 inside, the C2 smoothstep across each edge's
- * blend zone [edge - blend/2, edge + blend/2]. */
+ * blend zone [edge - blend/2, edge + blend/2]. The zone tests come first: only a point inside a
+ * blend zone pays for the divisions (a foot crosses a zone in a few steps of thousands). */
 static inline double pdw_ground_window(double s, double s_a, double s_b, double blend)
 {
+    const double hb = 0.5*blend;
+    if (s <= s_a - hb || s >= s_b + hb) return 0.0;
     double w = 1.0;
-    const double ua = (s - (s_a - 0.5*blend)) / blend, ub = ((s_b + 0.5*blend) - s) / blend;
-    if (ua <= 0.0 || ub <= 0.0) return 0.0;
-    if (ua < 1.0) w *= ua*ua*ua*(10.0 + ua*(-15.0 + 6.0*ua));
-    if (ub < 1.0) w *= ub*ub*ub*(10.0 + ub*(-15.0 + 6.0*ub));
+    if (s < s_a + hb) { const double ua = (s - (s_a - hb)) / blend; w *= ua*ua*ua*(10.0 + ua*(-15.0 + 6.0*ua)); }
+    if (s > s_b - hb) { const double ub = ((s_b + hb) - s) / blend; w *= ub*ub*ub*(10.0 + ub*(-15.0 + 6.0*ub)); }
     return w;
 }
 
 /* The parameter vector at s: p_out = p with the patches' fields blended in (p_out may be p's copy;
- * only the patched fields are written). */
+ * only the patched fields are written). Each patch's window once (patches in order, each field
+ * summed in that order). */
 static inline void pdw_ground_params(const pdw_ground *g, double s, const double *p, double *p_out)
 {
-    for (int f = 0; f < g->n_fields; ++f) {
-        const int idx = g->fields[f];
-        double v = p[idx];
-        for (int i = 0; i < g->n_patches; ++i) {
-            const double *row = g->patches + i*(2 + g->n_fields);
+    const int nf = g->n_fields;
+    for (int f = 0; f < nf; ++f) p_out[g->fields[f]] = p[g->fields[f]];
+    for (int i = 0; i < g->n_patches; ++i) {
+        const double *row = g->patches + i*(2 + nf);
+        const double w = pdw_ground_window(s, row[0], row[1], g->blend);
+        if (!(w > 0.0)) continue;
+        for (int f = 0; f < nf; ++f) {
+            const int idx = g->fields[f];
             const double pv = row[2 + f];
-            if (pv != pv) continue;                                 /* NaN: not set here */
-            const double w = pdw_ground_window(s, row[0], row[1], g->blend);
-            if (w > 0.0) v += w * (pv - p[idx]);
+            if (pv == pv) p_out[idx] += w * (pv - p[idx]);     /* NaN: not set here */
         }
-        p_out[idx] = v;
     }
 }
 

@@ -6,36 +6,63 @@
 #endif
 #include "pdw_terrain.h"
 #include "pdw_jacobian.h"
+#include "pdw_terrain_gen.h"
 
-/* 1/N = 1/sqrt(1 + h'^2) of both feet: with SSE2 one vector multiply, add, square root and
- * division (each an IEEE operation on each lane: the bits of the scalar expression) instead of
- * two chains of them; the time loops wait on these values. Level ground under both feet (h' = 0:
- * a plane, the flat parts of steps and patches) gives 1 exactly without them. */
+/* 1/N = (1 + q)^(-1/2), q = h'^2, for q <= INVN_QMAX (|h'| <= 0.0442): the binomial series
+ * through q^5 (Estrin's scheme: four levels of multiplies and adds) in place of an add, a square
+ * root and a division, which the time loops wait on. The series alternates with terms decreasing in
+ * magnitude (|c_k+1 / c_k| = (2k+1)/(2k+2) < 1, q < 1), so the truncation error is below the
+ * first omitted term, (231/1024) q^6 <= (231/1024) 2^-54 = 1.3e-17 (0.11 ulp of 1); with the
+ * evaluation's roundings the value is within 1 ulp of the exact 1/N, as 1/sqrt(1 + q) rounded
+ * twice is (tests/core/test_terrain_invn.py checks both against 1/N in exact arithmetic).
+ * The coefficients are exact binary fractions; q = 0 (level ground) gives 1 exactly. */
+#define INVN_QMAX 0x1p-9
+#define INVN_C1 (-0.5)
+#define INVN_C2 0.375
+#define INVN_C3 (-0.3125)
+#define INVN_C4 0.2734375
+#define INVN_C5 (-0.24609375)
+
+static inline double inv_norm_series(double q)
+{
+    const double q2 = q*q, q4 = q2*q2;
+    return ((1.0 + INVN_C1*q) + q2*(INVN_C2 + INVN_C3*q)) + q4*(INVN_C4 + INVN_C5*q);
+}
+
+static inline double inv_norm(double dh)
+{
+    const double q = dh*dh;
+    return q <= INVN_QMAX ? inv_norm_series(q) : 1.0 / sqrt(1.0 + q);
+}
+
+/* 1/N of both feet: with SSE2 one vector series (the same IEEE operations on each lane, the
+ * bits of inv_norm) when both feet are in its range, else each foot's inv_norm. */
 static inline void inv_normals(double dh0, double dh1, double *n0, double *n1)
 {
-    /* a foot on level ground (h' = 0: a plane on the slope, the flat parts of steps and patches)
-     * gets 1 exactly (1/sqrt(1 + 0)) without waiting for the other foot's square root: a support
-     * foot on a flat part while the swing foot passes an edge (branches, not a blend, so that no
-     * value waits on the other lane) */
-    if (dh0 == 0.0) {
-        *n0 = 1.0;
-        *n1 = dh1 == 0.0 ? 1.0 : 1.0 / sqrt(1.0 + dh1*dh1);
-        return;
-    }
-    if (dh1 == 0.0) {
-        *n0 = 1.0 / sqrt(1.0 + dh0*dh0);
-        *n1 = 1.0;
-        return;
-    }
 #if defined(__SSE2__)
-    const __m128d d = _mm_set_pd(dh1, dh0), one = _mm_set1_pd(1.0);
-    const __m128d r = _mm_div_pd(one, _mm_sqrt_pd(_mm_add_pd(one, _mm_mul_pd(d, d))));
-    _mm_storel_pd(n0, r);
-    _mm_storeh_pd(n1, r);
-#else
-    *n0 = 1.0 / sqrt(1.0 + dh0*dh0);
-    *n1 = 1.0 / sqrt(1.0 + dh1*dh1);
+    const __m128d d = _mm_set_pd(dh1, dh0), q = _mm_mul_pd(d, d);
+    if (_mm_movemask_pd(_mm_cmple_pd(q, _mm_set1_pd(INVN_QMAX))) == 3) {
+        const __m128d q2 = _mm_mul_pd(q, q), q4 = _mm_mul_pd(q2, q2);
+        const __m128d p01 = _mm_add_pd(_mm_set1_pd(1.0), _mm_mul_pd(_mm_set1_pd(INVN_C1), q));
+        const __m128d p23 = _mm_add_pd(_mm_set1_pd(INVN_C2), _mm_mul_pd(_mm_set1_pd(INVN_C3), q));
+        const __m128d p45 = _mm_add_pd(_mm_set1_pd(INVN_C4), _mm_mul_pd(_mm_set1_pd(INVN_C5), q));
+        const __m128d r = _mm_add_pd(_mm_add_pd(p01, _mm_mul_pd(q2, p23)), _mm_mul_pd(q4, p45));
+        *n0 = _mm_cvtsd_f64(r);
+        *n1 = _mm_cvtsd_f64(_mm_unpackhi_pd(r, r));
+        return;
+    }
 #endif
+    *n0 = inv_norm(dh0);
+    *n1 = inv_norm(dh1);
+}
+
+void pdw_terrain_inv_normals(long n, const double *dh, double *inv_n)
+{
+    for (long i = 0; i < n; i += 2) {
+        double b;
+        inv_normals(dh[i], i + 1 < n ? dh[i + 1] : 0.0, inv_n + i, &b);
+        if (i + 1 < n) inv_n[i + 1] = b;
+    }
 }
 
 /* Copy n doubles one at a time. The contact stage has just stored them one by one, and a wider
@@ -52,42 +79,89 @@ static inline void copy_fresh(double *dst, const double *src, int n)
     }
 }
 
+/* *src as a value of its own: the empty asm takes it in a register, so the compiler cannot merge
+ * two such loads into one 16-byte load, which (across two fresh 8-byte stores of the contact
+ * stage) would wait until the stores are written instead of taking the value from the store
+ * buffer (copy_fresh's reason). */
+static inline double load_fresh(const double *src)
+{
+    double v = *src;
+#if defined(__GNUC__) && defined(__SSE2__)
+    __asm__("" : "+x"(v));      /* "x": an SSE register, where the value is used */
+#endif
+    return v;
+}
+
+/* One foot's ground at s: h, h', h'' (out[0..2]) of its cell (the hint updated). A level cell
+ * (finite s) gives exactly pdw_ground_eval_cell's values (pdw_ground.h), known before s is (the
+ * time loop's chain skips the quintic). */
+static inline void sample_foot(const pdw_ground *g, double s, double *hint, double *out)
+{
+    const long c = pdw_ground_cell_hint(g, s, hint);
+    if (pdw_ground_cell_level(g, c) && s - s == 0.0) {
+        out[0] = g->cells[c*PDW_NGCELL + PDW_GCELL_A0] + 0.0;
+        out[1] = out[2] = 0.0;
+    } else {
+        pdw_ground_eval_cell(g, c, s, out);
+    }
+}
+
+/* One foot's sampled ground (layout GROUND) into gi. */
+static inline void put_ground(double *gi, const double *e, double sigma, double alpha, double c)
+{
+    gi[PDW_GROUND_H] = e[0];
+    gi[PDW_GROUND_DH] = e[1];
+    gi[PDW_GROUND_DDH] = e[2];
+    gi[PDW_GROUND_SIGMA] = sigma;
+    gi[PDW_GROUND_ALPHA] = alpha;
+    gi[PDW_GROUND_INV_N] = c;
+    gi[PDW_GROUND_S_N] = e[1] * c;      /* h'/N: the forces' coefficient */
+}
+
+/* Straight-line code on local arrays with constant indices (the feet written out, the generated
+ * kinematics inline): the compiler keeps the ground values in registers, where a loop over the
+ * feet passed them through memory on the time loop's chain; gnd is stored field by field (for
+ * the forces and the Jacobian), never read back here. */
 void pdw_terrain_kinematics(const pdw_kernel *k, const pdw_ground *g, const double *x,
                             const double *trig, const double *p, const double *anchors,
                             double *kin, double *gnd, double *cell)
 {
-    double sA[2], e[2][3];
+    double sA[2], e0[3], e1[3], c0, c1, gl[2*PDW_NGROUND];
+    double sig0 = 0.0, sig1 = 0.0, al0 = 0.0, al1 = 0.0;
     pdw_ground_points(x, trig, p, sA);
-    for (int i = 0; i < 2; ++i) {
-        double *gi = gnd + i*PDW_NGROUND;
-        const long c = pdw_ground_cell_hint(g, sA[i], cell + i);
-        if (pdw_ground_cell_level(g, c) && sA[i] - sA[i] == 0.0) {
-            /* a level cell (finite s): exactly pdw_ground_eval_cell's values (pdw_ground.h),
-             * known before s_A is (the time loop's chain skips u and the quintic) */
-            e[i][0] = g->cells[c*PDW_NGCELL + PDW_GCELL_A0] + 0.0;
-            e[i][1] = e[i][2] = 0.0;
-        } else {
-            pdw_ground_eval_cell(g, c, sA[i], e[i]);
-        }
-        gi[PDW_GROUND_H] = e[i][0];
-        gi[PDW_GROUND_DH] = e[i][1];
-        gi[PDW_GROUND_DDH] = e[i][2];
+    sample_foot(g, sA[0], cell, e0);
+    sample_foot(g, sA[1], cell + 1, e1);
+    const int consistent = k->variant == 1;
+    if (!consistent && e0[1] == 0.0 && e1[1] == 0.0) {
+        /* h' = 0 under both feet (level cells: a plane on the slope, the flat parts of steps,
+         * a flat ground with patches): the tangent lines are level, 1/N = 1, and the paper
+         * variant's surface-frame kinematics are the flat kernel's own with y_D less the
+         * height (derive/terrain.py with h' = 0; equal to rounding: another association of the
+         * same sums). Not for the consistent variant, whose rolling coordinate starts from the
+         * ground's arc length sigma and must stay one coordinate on every cell. */
+        k->kinematics(x, trig, p, anchors, kin);
+        kin[PDW_KIN_Y_D] -= e0[0];
+        kin[PDW_NKIN + PDW_KIN_Y_D] -= e1[0];
+        put_ground(gnd, e0, 0.0, 0.0, 1.0);
+        put_ground(gnd + PDW_NGROUND, e1, 0.0, 0.0, 1.0);
+        return;
     }
-    inv_normals(e[0][1], e[1][1], gnd + PDW_GROUND_INV_N, gnd + PDW_NGROUND + PDW_GROUND_INV_N);
-    for (int i = 0; i < 2; ++i) {
-        double *gi = gnd + i*PDW_NGROUND;
-        if (k->variant == 1) {          /* consistent: the rolling coordinate needs sigma, alpha */
-            gi[PDW_GROUND_SIGMA] = pdw_ground_arc(g, sA[i]);
-            gi[PDW_GROUND_ALPHA] = atan(e[i][1]);
-        } else {
-            gi[PDW_GROUND_SIGMA] = 0.0;
-            gi[PDW_GROUND_ALPHA] = 0.0;
-        }
+    inv_normals(e0[1], e1[1], &c0, &c1);
+    if (consistent) {                   /* the rolling coordinate needs sigma, alpha */
+        sig0 = pdw_ground_arc(g, sA[0]);
+        al0 = atan(e0[1]);
+        sig1 = pdw_ground_arc(g, sA[1]);
+        al1 = atan(e1[1]);
     }
-    if (k->variant == 1) pdw_consistent_ground_kinematics(x, trig, p, anchors, gnd, kin);
-    else pdw_paper_ground_kinematics(x, trig, p, anchors, gnd, kin);
-    for (int i = 0; i < 2; ++i)
-        kin[i*PDW_NKIN + PDW_KIN_Z] = k->nx > PDW_NX ? x[PDW_X_Z1 + i] : 0.0;
+    put_ground(gl, e0, sig0, al0, c0);
+    put_ground(gl + PDW_NGROUND, e1, sig1, al1, c1);
+    if (consistent) pdw_consistent_ground_kinematics(x, trig, p, anchors, gl, kin);
+    else pdw_paper_ground_kinematics(x, trig, p, anchors, gl, kin);
+    put_ground(gnd, e0, sig0, al0, c0);
+    put_ground(gnd + PDW_NGROUND, e1, sig1, al1, c1);
+    const int z = k->nx > PDW_NX;
+    kin[PDW_KIN_Z] = z ? x[PDW_X_Z1] : 0.0;
+    kin[PDW_NKIN + PDW_KIN_Z] = z ? x[PDW_X_Z1 + 1] : 0.0;
 }
 
 void pdw_terrain_contact(const pdw_kernel *k, const pdw_ground *g, const double *kin,
@@ -95,26 +169,31 @@ void pdw_terrain_contact(const pdw_kernel *k, const pdw_ground *g, const double 
 {
     void (*stage)(const double *, const int *, const double *, double *) =
         partials ? k->contact_partials : k->contact;
-    if (g->n_patches == 0 || (!pdw_ground_patched(g, kin[PDW_KIN_X_D])
-                              && !pdw_ground_patched(g, kin[PDW_NKIN + PDW_KIN_X_D]))) {
-        stage(kin, flags, p, contact);      /* neither foot on a patch: the run's parameters */
+    /* Every contact stage writes 0.0 for a foot that is not a penetrating support foot,
+     * whatever p (derive/emit.py _contact_function): no penetrating foot, or one that no patch
+     * reaches, takes the run's parameters; with one penetrating foot, one call with that foot's
+     * parameters gives both feet's values (single support, the common case) */
+    const int pen0 = flags[0] && kin[PDW_KIN_Y_D] < 0.0;
+    const int pen1 = flags[1] && kin[PDW_NKIN + PDW_KIN_Y_D] < 0.0;
+    if (g->n_patches == 0 || !(pen0 || pen1)) {
+        stage(kin, flags, p, contact);
         return;
     }
     double pi[PDW_NP], ci[2*PDW_NCONTACT];
-    /* Every contact stage writes 0.0 for a foot that is not a penetrating support foot,
-     * whatever p (derive/emit.py _contact_function): with at most one penetrating foot, one call
-     * with that foot's parameters gives both feet's values (single support, the common case) */
-    const int pen0 = flags[0] && kin[PDW_KIN_Y_D] < 0.0;
-    const int pen1 = flags[1] && kin[PDW_NKIN + PDW_KIN_Y_D] < 0.0;
     if (!(pen0 && pen1)) {
         const double s = kin[(pen1 ? PDW_NKIN : 0) + PDW_KIN_X_D];
-        if (!(pen0 || pen1) || !pdw_ground_patched(g, s)) {
+        if (!pdw_ground_patched(g, s)) {
             stage(kin, flags, p, contact);
             return;
         }
         memcpy(pi, p, sizeof pi);
         pdw_ground_params(g, s, p, pi);
         stage(kin, flags, pi, contact);
+        return;
+    }
+    if (!pdw_ground_patched(g, kin[PDW_KIN_X_D])
+        && !pdw_ground_patched(g, kin[PDW_NKIN + PDW_KIN_X_D])) {
+        stage(kin, flags, p, contact);      /* neither foot on a patch: the run's parameters */
         return;
     }
     for (int i = 0; i < 2; ++i) {
@@ -129,26 +208,33 @@ void pdw_terrain_contact(const pdw_kernel *k, const pdw_ground *g, const double 
 void pdw_terrain_forces(const double *contact, const double *gnd, const double *p, double *cw,
                         double *moment)
 {
-    double gf[2*PDW_NGFORCE];
-    copy_fresh(cw, contact, 2*PDW_NCONTACT);
-    if (gnd[PDW_GROUND_DH] == 0.0 && gnd[PDW_NGROUND + PDW_GROUND_DH] == 0.0) {
-        /* level under both feet (h' = +0 and 1/N = 1: pdw_terrain_kinematics sets them so):
-         * ground_forces' expressions with dh = 0 and 1/N = 1 written out, each product by 1/N = 1
+    double gf[2*PDW_NGFORCE], cf[2*PDW_NCONTACT], gd[2*PDW_NGROUND];
+    for (int i = 0; i < 2; ++i) {       /* the inputs, one load each (load_fresh) */
+        const int c = i*PDW_NCONTACT, j = i*PDW_NGROUND;
+        cf[c + PDW_CONTACT_F_N] = load_fresh(contact + c + PDW_CONTACT_F_N);
+        cf[c + PDW_CONTACT_F_T] = load_fresh(contact + c + PDW_CONTACT_F_T);
+        gd[j + PDW_GROUND_DH] = load_fresh(gnd + j + PDW_GROUND_DH);
+        gd[j + PDW_GROUND_INV_N] = load_fresh(gnd + j + PDW_GROUND_INV_N);
+        gd[j + PDW_GROUND_S_N] = load_fresh(gnd + j + PDW_GROUND_S_N);
+    }
+    if (gd[PDW_GROUND_DH] == 0.0 && gd[PDW_NGROUND + PDW_GROUND_DH] == 0.0) {
+        /* level under both feet (h' = +0, 1/N = 1 and h'/N = +0: pdw_terrain_kinematics sets
+         * them so): ground_forces' expressions (pdw_terrain_gen.h) with each product by 1/N = 1
          * dropped (x * 1 is x, bit for bit, NaN and signed zeros included): the same values
          * without the multiplications the forces wait on */
         const double r = p[PDW_P_R];
         for (int i = 0; i < 2; ++i) {
-            const double fn = contact[i*PDW_NCONTACT + PDW_CONTACT_F_N];
-            const double ft = contact[i*PDW_NCONTACT + PDW_CONTACT_F_T];
-            const double dh = gnd[i*PDW_NGROUND + PDW_GROUND_DH];
-            const double t0 = -fn*dh + ft, t1 = fn + ft*dh;
-            cw[i*PDW_NCONTACT + PDW_CONTACT_F_N] = t1;
-            cw[i*PDW_NCONTACT + PDW_CONTACT_F_T] = t0;
-            moment[i] = r*(dh*t1 - t0*(1.0 - 1.0));
+            const double fn = cf[i*PDW_NCONTACT + PDW_CONTACT_F_N];
+            const double ft = cf[i*PDW_NCONTACT + PDW_CONTACT_F_T];
+            const double sn = gd[i*PDW_NGROUND + PDW_GROUND_S_N];
+            const double t0 = fn*sn;
+            cw[i*PDW_NCONTACT + PDW_CONTACT_F_N] = fn + ft*sn;
+            cw[i*PDW_NCONTACT + PDW_CONTACT_F_T] = ft - t0;
+            moment[i] = r*(ft*(1.0 - 1.0) + t0);
         }
         return;
     }
-    pdw_ground_forces(contact, gnd, p, gf);
+    pdw_ground_forces(cf, gd, p, gf);   /* reads only F_n, F_t of cf and 1/N, h'/N of gd */
     for (int i = 0; i < 2; ++i) {
         cw[i*PDW_NCONTACT + PDW_CONTACT_F_N] = gf[i*PDW_NGFORCE + PDW_GFORCE_F_Y];
         cw[i*PDW_NCONTACT + PDW_CONTACT_F_T] = gf[i*PDW_NGFORCE + PDW_GFORCE_F_X];

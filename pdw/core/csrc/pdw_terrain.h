@@ -17,14 +17,19 @@ void pdw_terrain_kinematics(const pdw_kernel *k, const pdw_ground *g, const doub
                             const double *trig, const double *p, const double *anchors,
                             double *kin, double *gnd, double *cell);
 
+/* 1/N = 1/sqrt(1 + h'^2) of dh[0..n) as the kinematics computes it (in pairs, as the two feet;
+ * an odd last one paired with 0), for tests. */
+void pdw_terrain_inv_normals(long n, const double *dh, double *inv_n);
+
 /* The kernel's contact stage (forces, or with partials = 1 forces and partials) with each foot's
  * parameters at its contact point (the patches of g, blended; none: one call, as the kernel). */
 void pdw_terrain_contact(const pdw_kernel *k, const pdw_ground *g, const double *kin,
                          const int *flags, const double *p, double *contact, int partials);
 
 /* The surface-frame forces of contact as the slope-frame forces the flat dynamics stage takes
- * (cw: a copy of contact with F_n := F_y, F_t := F_x) and the moments moment[i] to add to the
- * theta_i rows of f (or Q_f - G). */
+ * (cw: only F_n := F_y, F_t := F_x are written, the only fields every dynamics and cdm_terms
+ * stage reads; the Jacobian sets the partials it passes) and the moments moment[i] to add to
+ * the theta_i rows of f (or Q_f - G). */
 void pdw_terrain_forces(const double *contact, const double *gnd, const double *p, double *cw,
                         double *moment);
 
