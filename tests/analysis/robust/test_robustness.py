@@ -291,6 +291,23 @@ def test_cli_robustness_writes_csv_json_figure_and_exits_2_on_a_bad_spec(tmp_pat
     assert "options.indicator" in capsys.readouterr().err
 
 
+def test_spec_sweep_does_not_walk_from_an_unstable_branch():
+    """From k_hip 0.95 to 0.5 in one step the followed hybrid gait is another, unstable one
+    (period 0.567 s, |mu| 2.30); the sweep falls back to the stable gait (0.668 s, 0.388)."""
+    from pdw.studies.robustness_spec import parse_spec, run_spec
+
+    spec = parse_spec('name = "g"\nmeasure = "gait_sensitivity"\n[options]\ncheck = false\n'
+                      '[sweep]\nparameter = "k_hip"\nvalues = [0.95, 0.5]\n')
+    rows, _, _ = run_spec(spec)
+    jump = H.find_gait(P.replace(k_hip=0.5), guess=H.find_gait(P).state, settle_steps=0)
+    assert max(abs(jump.multipliers)) > 2                 # the trap is still there
+    stable = H.find_gait(P.replace(k_hip=0.5))
+    G = pdw.gait_sensitivity(P.replace(k_hip=0.5), gait=stable, check=False)
+    assert rows[1]["norm"] == pytest.approx(G.norm, rel=1e-9) and math.isfinite(G.norm)
+    assert rows[1]["gait_mu_max"] == pytest.approx(0.388, abs=1e-3)
+    assert rows[1]["gait_period"] == pytest.approx(stable.period, rel=1e-9)
+
+
 # --- the compliant model --------------------------------------------------------------------------
 
 @pytest.fixture(scope="module")
