@@ -357,3 +357,19 @@ def test_first_passage_continuous_each_walker_its_own_ground_and_resume(cgait, t
     assert c.meta["resumed"] == 6 and np.array_equal(c.steps, a.steps)
     with pytest.raises(pdw.InvalidInputError, match="Ground.random"):
         pdw.first_passage(P, model="continuous", ground=pdw.Ground.flat(), gait=cgait)
+
+
+def test_first_passage_continuous_outcomes_censor_at_max_steps():
+    """Steps up to and including the failing one; a walker still walking at max_steps is
+    censored there, also when it falls in the run's last period and a half."""
+    from types import SimpleNamespace
+
+    from pdw.analysis.robust.robustness_continuous import outcomes
+
+    b = SimpleNamespace(n_touch_down=np.array([5, 9, 10, 12, 10, 4]),
+                        status=np.array(["fell", "fell", "fell", "diverged", "walked",
+                                         "off_ground"]))
+    steps, failed, status = outcomes(b, 10)
+    assert steps.tolist() == [6, 10, 10, 10, 10, 4]
+    assert failed.tolist() == [True, True, False, False, False, False]
+    assert status.tolist() == ["fell", "fell", "ok", "ok", "ok", "ok"]
