@@ -233,7 +233,7 @@ class TunedMfpt:
     holdout : FirstPassage or None
         At x on the held-out walkers (out-of-sample), when a holdout seed was given.
     nfev : int
-        The optimizer's calls of the objective.
+        The calls of the objective (the grid's and the optimizer's).
     evaluations : list of (tuple, float)
         Each call's point and statistic [steps], in order.
     result : scipy.optimize.OptimizeResult
@@ -259,7 +259,7 @@ class TunedMfpt:
 
 
 def tune_first_passage(params=None, names=("k_hip",), bounds=((0.5, 1.5),), *, x0=None,
-                       xatol=0.02, maxiter=30, holdout_seed=None, objective=None,
+                       xatol=0.02, maxiter=30, holdout_seed=None, objective=None, grid=None,
                        **objective_kw) -> TunedMfpt:
     """Tune parameters to maximize the first-passage statistic with `scipy.optimize` on a
     common-random-numbers objective (`MfptObjective`).
@@ -269,7 +269,10 @@ def tune_first_passage(params=None, names=("k_hip",), bounds=((0.5, 1.5),), *, x
     base values, clipped into the bounds), its first simplex a quarter of each bound's width
     from it, xatol absolute in each parameter, fatol 1 step. ``holdout_seed``: the optimum re-evaluated on as many walkers
     of that seed (a seed set disjoint from the tuning one when the seeds differ by more than
-    ``walkers`` on the continuous model).
+    ``walkers`` on the continuous model). ``grid`` (one parameter): the objective is first
+    evaluated at these points (sorted, inside the bounds) and Brent runs on the bracket of the
+    best one's neighbours: a rugged objective (the compliant walker's, docs/terrain.md) has
+    local maxima that Brent from the whole interval ends in.
 
     Parameters
     ----------
@@ -284,6 +287,8 @@ def tune_first_passage(params=None, names=("k_hip",), bounds=((0.5, 1.5),), *, x
     holdout_seed : int, optional
     objective : MfptObjective, optional
         Instead of building one from ``params, names, **objective_kw``.
+    grid : sequence of float, optional
+        One parameter: points scanned first; Brent then on the best point's neighbours.
     objective_kw
         `MfptObjective`'s keywords (model, sigma or ground, walkers, max_steps, seed,
         statistic, threads, ...).
@@ -309,9 +314,20 @@ def tune_first_passage(params=None, names=("k_hip",), bounds=((0.5, 1.5),), *, x
         return v
 
     if len(f.names) == 1:
-        res = minimize_scalar(lambda v: g([v]), bounds=bounds[0], method="bounded",
+        lo, hi = bounds[0]
+        if grid is not None:
+            pts = np.unique(np.asarray(grid, dtype=float))
+            if pts.ndim != 1 or len(pts) < 3 or pts[0] < lo or pts[-1] > hi:
+                raise InvalidInputError("grid must hold at least 3 points inside the bounds "
+                                        "%r, got %r" % (bounds[0], grid))
+            vals = [g([p]) for p in pts]
+            i = int(np.argmin(vals))
+            lo, hi = float(pts[max(i - 1, 0)]), float(pts[min(i + 1, len(pts) - 1)])
+        res = minimize_scalar(lambda v: g([v]), bounds=(lo, hi), method="bounded",
                               options=dict(xatol=xatol, maxiter=maxiter))
-        x = np.array([float(res.x)])
+        # Brent never evaluates its bracket's ends: the best point seen (a grid point included)
+        best = min(calls, key=lambda c: -c[1])
+        x = np.array([float(res.x) if -res.fun >= best[1] else best[0][0]])
     else:
         lo, hi = np.array([b[0] for b in bounds]), np.array([b[1] for b in bounds])
         start = np.clip(f.x0 if x0 is None else np.asarray(x0, dtype=float), lo, hi)

@@ -46,6 +46,18 @@ def test_tuned_k_hip_beats_its_bracket_ends_on_the_same_walkers():
     assert t.holdout.walkers == KW["walkers"]
 
 
+def test_grid_then_brent_in_the_best_cell():
+    f = MfptObjective(P, ("k_hip",), **KW)
+    grid = [0.5, 0.75, 1.0, 1.25, 1.5]
+    t = tune_first_passage(objective=f, bounds=[(0.5, 1.5)], grid=grid, xatol=0.02)
+    vals = [f.value([k]) for k in grid]
+    i = int(np.argmax(vals))
+    assert grid[max(i - 1, 0)] <= t.x[0] <= grid[min(i + 1, 4)]
+    assert t.value >= max(vals) and t.nfev > len(grid)
+    with pytest.raises(pdw.InvalidInputError, match="grid"):
+        tune_first_passage(objective=f, bounds=[(0.5, 1.5)], grid=[0.4, 0.9, 1.2])
+
+
 def test_nelder_mead_over_two_parameters_stays_in_bounds():
     f = MfptObjective(P, ("k_hip", "d_hip"), **KW)
     t = tune_first_passage(objective=f, bounds=[(0.6, 1.4), (0.0, 0.02)], xatol=0.02,
