@@ -166,6 +166,13 @@ def test_max_step_bad_input():
         pdw.max_step(P, budget=3)
     with pytest.raises(pdw.InvalidInputError, match="dh"):
         pdw.max_step(P, dh=0.01)
+    # the hybrid model would ignore them: refused, not silently dropped
+    with pytest.raises(pdw.InvalidInputError, match="ground"):
+        pdw.max_step(P, ground=pdw.Ground.step(0.2, -0.004))
+    with pytest.raises(pdw.InvalidInputError, match="executor"):
+        from concurrent.futures import ThreadPoolExecutor
+        with ThreadPoolExecutor(1) as ex:
+            pdw.max_step(P, executor=ex)
 
 
 # --- first passage ------------------------------------------------------------------------------
@@ -373,3 +380,19 @@ def test_first_passage_continuous_outcomes_censor_at_max_steps():
     assert steps.tolist() == [6, 10, 10, 10, 10, 4]
     assert failed.tolist() == [True, True, False, False, False, False]
     assert status.tolist() == ["fell", "fell", "ok", "ok", "ok", "ok"]
+
+
+def test_first_passage_runs_on_an_executor_of_processes(gait, cgait):
+    """Issue 22 item 5: the chunks are plain-data tasks for any executor (a process pool here,
+    Dask's client.get_executor() alike); the walkers are those of the threads run."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    hy = dict(sigma=0.002, walkers=12, max_steps=200, seed=3, gait=gait, chunk_size=5)
+    co = dict(model="continuous", ground=pdw.Ground.random(0.0025, 0.1), walkers=3,
+              max_steps=10, seed=2, gait=cgait, chunk_size=2)
+    a, c = pdw.first_passage(P, **hy), pdw.first_passage(P, **co)
+    with ProcessPoolExecutor(2) as ex:
+        b, d = pdw.first_passage(P, executor=ex, **hy), pdw.first_passage(P, executor=ex, **co)
+    assert np.array_equal(a.steps, b.steps) and np.array_equal(a.failed, b.failed)
+    assert np.array_equal(c.steps, d.steps) and np.array_equal(c.status, d.status)
+    assert a.failures > 0
