@@ -61,7 +61,7 @@ def test_grid_then_brent_in_the_best_cell():
 def test_nelder_mead_over_two_parameters_stays_in_bounds():
     f = MfptObjective(P, ("k_hip", "d_hip"), **KW)
     t = tune_first_passage(objective=f, bounds=[(0.6, 1.4), (0.0, 0.02)], xatol=0.02,
-                           maxiter=14)
+                           maxiter=8)
     assert all(0.6 <= x[0] <= 1.4 and 0.0 <= x[1] <= 0.02 for x, _ in t.evaluations)
     assert t.value >= f.value([0.95, 0.010])                 # the start
 
