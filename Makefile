@@ -116,6 +116,7 @@ study: $(STAMP)
 	$(PY) benchmarks/robustness_compliant.py $(UPDATE_DOCS)
 	$(PY) benchmarks/robustness_compliant_khip.py $(UPDATE_DOCS)
 	$(PY) benchmarks/robustness_compliant_mat.py $(UPDATE_DOCS)
+	$(PY) benchmarks/robustness_tuning.py $(UPDATE_DOCS)
 	$(PY) benchmarks/terrain_rigid_limit.py $(UPDATE_DOCS)
 	$(PY) benchmarks/markov_vs_mc.py $(UPDATE_DOCS)
 

@@ -80,11 +80,16 @@ def main():
     mf = {}
     for k in (0.5, 0.95, 1.5) if not QUICK else (0.5, 1.5):
         P = with_(k_hip=k)
-        g = gait_along("k_hip", [0.95, k])[k]      # on the branch of the paper's k_hip
+        # on the branch of the paper's k_hip, in steps of at most 0.1: one jump from 0.95 to
+        # 0.5 lands on another, unstable period-one gait (period 0.567 s, |mu| 2.30)
+        path = np.linspace(0.95, k, 1 + int(np.ceil(abs(k - 0.95) / 0.1)))
+        g = gait_along("k_hip", list(path))[path[-1]]
+        mu = max(abs(g.multipliers))
         for s in sig:
             fp = pdw.first_passage(P, sigma=s, walkers=walkers, max_steps=3000, gait=g, seed=1)
             mf[(k, s)] = fp
-            lines.append("k_hip %.2f sigma %.1f mm: %s" % (k, s * 1e3, fp))
+            lines.append("k_hip %.2f (gait period %.4f s, |mu|max %.4f) sigma %.1f mm: %s"
+                         % (k, g.period, mu, s * 1e3, fp))
 
     # Markov chain against Monte Carlo
     lines += ["", "Markov chain (n_dh step-height bins, cells of side res) vs Monte Carlo, "

@@ -209,8 +209,16 @@ def parse_spec(text, path=None) -> RobustnessSpec:
 
 # --- running -----------------------------------------------------------------------------------
 
-def _row(measure, value, out) -> dict:
-    """The numbers of one measure's result, as one CSV row."""
+def _row(measure, value, out, gait=None) -> dict:
+    """The numbers of one measure's result, as one CSV row (with the gait's period [s] and
+    largest Floquet multiplier modulus: a walk from an unstable gait says so)."""
+    row = _row_of(measure, value, out)
+    if gait is not None:
+        row.update(gait_period=gait.period, gait_mu_max=float(np.max(np.abs(gait.multipliers))))
+    return row
+
+
+def _row_of(measure, value, out) -> dict:
     if measure == "max_step":
         return dict(value=value, height=out.height, bracket_lo=out.bracket[0],
                     bracket_hi=out.bracket[1], steps_to_return=out.steps_to_return,
@@ -251,7 +259,7 @@ def run_spec(spec: RobustnessSpec, *, executor=None, path_for=None, on_row=None)
         except PdwError as e:
             raise type(e)("%s at %s = %r: %s" % (spec.measure, spec.parameter or "params", v,
                                                  e)) from None
-        row = _row(spec.measure, v, out)
+        row = _row(spec.measure, v, out, kw["gait"])
         rows.append(row)
         results.append(out)
         if on_row is not None:
@@ -262,7 +270,11 @@ def run_spec(spec: RobustnessSpec, *, executor=None, path_for=None, on_row=None)
 
 def _gait_along(spec, params, prev):
     """The gait at this axis point, followed from the previous point's (one branch of gaits
-    along the axis, as the studies do); the default guesses when that fails or at the first."""
+    along the axis, as the studies do); the default guesses when that fails or at the first,
+    and when the followed gait is unstable (|multiplier| >= 1) while the default guesses find a
+    stable one: a long step along the axis can land on another, unstable branch (the hybrid
+    walker from k_hip 0.95 to 0.5 in one step: period 0.567 s, |mu| 2.30, where the stable
+    gait has 0.668 s, 0.388), and walks from it measure that branch, not the walker."""
     from ..analysis.gait_types import GaitNotFoundError
     from ..analysis.rigid import hybrid as _hy
     from ..analysis.stepmap import limit_cycle as _lc
@@ -273,10 +285,18 @@ def _gait_along(spec, params, prev):
     if prev is not None:
         try:
             if spec.model == "hybrid":
-                return find(params, guess=prev.state, settle_steps=0, **step)
-            return find(params, guess=prev)
+                g = find(params, guess=prev.state, settle_steps=0, **step)
+            else:
+                g = find(params, guess=prev)
         except (GaitNotFoundError, PdwError):
-            pass
+            return find(params, **step)
+        if np.max(np.abs(g.multipliers)) < 1.0:
+            return g
+        try:
+            d = find(params, **step)
+        except (GaitNotFoundError, PdwError):
+            return g
+        return d if np.max(np.abs(d.multipliers)) < 1.0 else g
     return find(params, **step)
 
 

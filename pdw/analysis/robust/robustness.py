@@ -208,6 +208,12 @@ def max_step(params=None, *, direction="down", model="hybrid", h_max=None, h_tol
                                                                lo_open=True)
     if "dh" in options:
         raise InvalidInputError("max_step sets the floor offset dh itself; do not pass it")
+    if model == "hybrid" and (executor is not None or ground is not None):
+        raise InvalidInputError("max_step(model='hybrid') takes neither executor nor ground "
+                                "(its trials run on threads; the step is its floor offset): "
+                                "got %s" % ", ".join(n for n, v in (("executor", executor),
+                                                                    ("ground", ground))
+                                                     if v is not None))
     if model == "continuous":
         from . import robustness_continuous as _rc
         run = _rc.step_trials_fn(params, direction=direction, budget=budget,

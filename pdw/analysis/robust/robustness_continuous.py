@@ -226,7 +226,15 @@ def chunk(params, gait, ground, seed, lo, hi, max_steps, options):
     ground's extent, is censored at its steps."""
     grounds = [walker_ground(ground, seed, i, max_steps, gait.step_length) for i in range(lo, hi)]
     b = batch(params, gait, grounds, max_steps, threads=1, **options)
+    return outcomes(b, max_steps)
+
+
+def outcomes(b, max_steps):
+    """The first-passage data (steps (N,), failed (N,), status (N,)) of a batch of walkers
+    (`batch`): see `chunk`."""
     n = np.asarray(b.n_touch_down, dtype=np.int64)      # steps taken
-    fell = ~np.isin(b.status, ("walked", "periodic", "off_ground"))
-    steps = np.where(fell, np.minimum(n + 1, max_steps), np.minimum(n, max_steps))
+    # a walker that fell after max_steps steps (the run goes on for a period and a half) was
+    # still walking at max_steps: censored there, not a failure
+    fell = ~np.isin(b.status, ("walked", "periodic", "off_ground")) & (n < max_steps)
+    steps = np.where(fell, n + 1, np.minimum(n, max_steps))
     return steps, fell, np.where(fell, b.status, "ok")

@@ -166,6 +166,13 @@ def test_max_step_bad_input():
         pdw.max_step(P, budget=3)
     with pytest.raises(pdw.InvalidInputError, match="dh"):
         pdw.max_step(P, dh=0.01)
+    # the hybrid model would ignore them: refused, not silently dropped
+    with pytest.raises(pdw.InvalidInputError, match="ground"):
+        pdw.max_step(P, ground=pdw.Ground.step(0.2, -0.004))
+    with pytest.raises(pdw.InvalidInputError, match="executor"):
+        from concurrent.futures import ThreadPoolExecutor
+        with ThreadPoolExecutor(1) as ex:
+            pdw.max_step(P, executor=ex)
 
 
 # --- first passage ------------------------------------------------------------------------------
@@ -291,6 +298,23 @@ def test_cli_robustness_writes_csv_json_figure_and_exits_2_on_a_bad_spec(tmp_pat
     assert "options.indicator" in capsys.readouterr().err
 
 
+def test_spec_sweep_does_not_walk_from_an_unstable_branch():
+    """From k_hip 0.95 to 0.5 in one step the followed hybrid gait is another, unstable one
+    (period 0.567 s, |mu| 2.30); the sweep falls back to the stable gait (0.668 s, 0.388)."""
+    from pdw.studies.robustness_spec import parse_spec, run_spec
+
+    spec = parse_spec('name = "g"\nmeasure = "gait_sensitivity"\n[options]\ncheck = false\n'
+                      '[sweep]\nparameter = "k_hip"\nvalues = [0.95, 0.5]\n')
+    rows, _, _ = run_spec(spec)
+    jump = H.find_gait(P.replace(k_hip=0.5), guess=H.find_gait(P).state, settle_steps=0)
+    assert max(abs(jump.multipliers)) > 2                 # the trap is still there
+    stable = H.find_gait(P.replace(k_hip=0.5))
+    G = pdw.gait_sensitivity(P.replace(k_hip=0.5), gait=stable, check=False)
+    assert rows[1]["norm"] == pytest.approx(G.norm, rel=1e-9) and math.isfinite(G.norm)
+    assert rows[1]["gait_mu_max"] == pytest.approx(0.388, abs=1e-3)
+    assert rows[1]["gait_period"] == pytest.approx(stable.period, rel=1e-9)
+
+
 # --- the compliant model --------------------------------------------------------------------------
 
 @pytest.fixture(scope="module")
@@ -340,3 +364,35 @@ def test_first_passage_continuous_each_walker_its_own_ground_and_resume(cgait, t
     assert c.meta["resumed"] == 6 and np.array_equal(c.steps, a.steps)
     with pytest.raises(pdw.InvalidInputError, match="Ground.random"):
         pdw.first_passage(P, model="continuous", ground=pdw.Ground.flat(), gait=cgait)
+
+
+def test_first_passage_continuous_outcomes_censor_at_max_steps():
+    """Steps up to and including the failing one; a walker still walking at max_steps is
+    censored there, also when it falls in the run's last period and a half."""
+    from types import SimpleNamespace
+
+    from pdw.analysis.robust.robustness_continuous import outcomes
+
+    b = SimpleNamespace(n_touch_down=np.array([5, 9, 10, 12, 10, 4]),
+                        status=np.array(["fell", "fell", "fell", "diverged", "walked",
+                                         "off_ground"]))
+    steps, failed, status = outcomes(b, 10)
+    assert steps.tolist() == [6, 10, 10, 10, 10, 4]
+    assert failed.tolist() == [True, True, False, False, False, False]
+    assert status.tolist() == ["fell", "fell", "ok", "ok", "ok", "ok"]
+
+
+def test_first_passage_runs_on_an_executor_of_processes(gait, cgait):
+    """Issue 22 item 5: the chunks are plain-data tasks for any executor (a process pool here,
+    Dask's client.get_executor() alike); the walkers are those of the threads run."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    hy = dict(sigma=0.002, walkers=12, max_steps=200, seed=3, gait=gait, chunk_size=5)
+    co = dict(model="continuous", ground=pdw.Ground.random(0.0025, 0.1), walkers=3,
+              max_steps=10, seed=2, gait=cgait, chunk_size=2)
+    a, c = pdw.first_passage(P, **hy), pdw.first_passage(P, **co)
+    with ProcessPoolExecutor(2) as ex:
+        b, d = pdw.first_passage(P, executor=ex, **hy), pdw.first_passage(P, executor=ex, **co)
+    assert np.array_equal(a.steps, b.steps) and np.array_equal(a.failed, b.failed)
+    assert np.array_equal(c.steps, d.steps) and np.array_equal(c.status, d.status)
+    assert a.failures > 0
