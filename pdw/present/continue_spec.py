@@ -90,6 +90,13 @@ def check_spec(spec: dict, where: str = "spec") -> dict:
     if not isinstance(spec, dict):
         raise InvalidInputError("%s: a continuation spec is a table, got %r" % (where, spec))
     spec = dict(spec)
+    if "ground" in spec:
+        raise InvalidInputError(
+            "%s: [ground]: a continuation follows a gait, a fixed point of the step map, which "
+            "needs the same ground under every step (the uniform slope of the model); a tilted "
+            "plane Ground.plane(slope=d) is the walker on slope gamma + d (docs/terrain.md, "
+            "exactness checks): continue in gamma instead; shaped ground and patches are for a "
+            "scene, a study or `pdw robustness`" % where)
     _unknown(where, {k: v for k, v in spec.items() if not k.startswith("_")}, KEYS, "")
     for k in ("name", "parameter", "stop"):
         if k not in spec:

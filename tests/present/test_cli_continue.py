@@ -191,6 +191,16 @@ def test_the_continuous_models_options_and_contact_are_checked(tmp_path):
         continue_spec.check_spec(spec, "s.toml")
 
 
+def test_a_ground_table_is_refused_with_the_reason(tmp_path):
+    """issue 22 item 1: a continuation spec reads no [ground] (a gait needs the same ground
+    under every step); it says so and points to the slope, not "unknown key"."""
+    from pdw.present import continue_spec
+    spec = dict(BASE, ground={"kind": "plane", "slope": 0.01})
+    with pytest.raises(cli_continue.InvalidInputError,
+                       match=r"spec\.toml: \[ground\]: .*same ground under every step.*gamma"):
+        continue_spec.check_spec(spec, "spec.toml")
+
+
 @pytest.mark.parametrize("name", ["compass_cascade", "d_hip", "fig11_k_n", "rigid_limit",
                                   "simplest_walker"])
 def test_every_shipped_spec_passes_the_check(name):
