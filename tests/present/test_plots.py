@@ -197,3 +197,33 @@ def test_stick_is_equal_aspect_and_slope_descends(run):
     lines = [ln for ln in ax.get_lines() if len(ln.get_xdata()) == 2 and ln.get_color() == "k"]
     x, y = np.asarray(lines[0].get_xdata()), np.asarray(lines[0].get_ydata())
     assert (y[1] - y[0]) / (x[1] - x[0]) == pytest.approx(-np.tan(run.params.gamma))
+
+
+def test_walk_figures_draw_the_grounds_shape_and_its_patches():
+    """issue 22 item 8: the surface drawn is h(s) of the result's Ground in the world frame
+    (a 4 mm step down at s = 0.5 m), and a patch is a band over exactly its interval, labelled
+    with the property it sets."""
+    import types
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from pdw.present import figure_kit as fk
+    ground = pdw.Ground.steps([0.5], [-0.004], width=0.05,
+                              patches=[pdw.Patch.make(0.8, 1.2, k_n=2.0e4)])
+    gamma = 0.0524
+    fig, ax = plt.subplots()
+    try:
+        gx, gy = fk.draw_ground(ax, types.SimpleNamespace(ground=ground), -0.2, 1.5, 0.05, gamma)
+        s = np.linspace(-0.2, 1.5, len(gx))
+        wx, wy = fk._to_world(s, ground.h(s), gamma)
+        assert np.allclose(gx, wx, atol=1e-12) and np.allclose(gy, wy, atol=1e-12)
+        fx, fy = fk._to_world(s, np.zeros_like(s), gamma)
+        assert np.max(np.abs(gy - fy)) > 0.0039          # the step is drawn, not a flat line
+        bands = [ln for ln in ax.get_lines() if ln.get_color() == fk.PATCH_COLOR]
+        assert len(bands) == 1 and bands[0].get_label() == "patch: k_n = 2e+04"
+        bs = bands[0].get_xdata() * np.cos(gamma) - bands[0].get_ydata() * np.sin(gamma)
+        assert 0.8 <= bs.min() < 0.802 and 1.198 < bs.max() <= 1.2    # along the slope [m]
+    finally:
+        plt.close(fig)
