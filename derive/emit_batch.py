@@ -155,9 +155,60 @@ def _contact_consts(fname, exprs, soa, c_block):
     reads = "".join("            const double %s = kc[%d*PDW_SOA + l];\n" % (t, j)
                     for j, t in enumerate(names))
     body_s = "\n".join(step)
-    return consts, _contact_body(fname + "_kc", ", const double *restrict kc",
-                                 _loads(loads, body_s) + reads + body_s,
-                                 layout.CONTACT[:len(exprs)], outs), len(names)
+    return consts, _contact_body_once(fname + "_kc", ", const double *restrict kc",
+                                      _loads(loads, body_s) + reads + body_s,
+                                      layout.CONTACT[:len(exprs)], outs), len(names)
+
+
+# the inputs of the law from kin row block ki (a leg's), as the scalar stage takes them
+_INPUTS = (("delta", "-%s[PDW_KIN_Y_D*PDW_SOA + l]"), ("deltad", "-%s[PDW_KIN_V_Y*PDW_SOA + l]"),
+           ("v_t", "%s[PDW_KIN_V_X*PDW_SOA + l]"), ("xi", "%s[PDW_KIN_XI*PDW_SOA + l]"),
+           ("v_in", "%s[PDW_KIN_V_IN*PDW_SOA + l]"))
+
+
+def _contact_body_once(fname, extra, code, fields, outs):
+    """The cdm lanes' contact stage: the force law once per lane, for leg 0 where it is a
+    penetrating support foot and else for leg 1, and a second pass for leg 1 only when a lane
+    of the block has both feet on (double support, rare): a swing leg's law is not computed
+    (the scalar stage's branch skips it), so half the law's work of a block with every lane in
+    single support. Each evaluation is the law's statements on that leg's inputs, the same
+    bits as the scalar stage."""
+    def law(pick):
+        ins = "".join("            const double %s = %s;\n" % (v, pick(src)) for v, src in _INPUTS)
+        return (ins + "            (void)delta; (void)deltad; (void)v_t; (void)xi; (void)v_in;\n"
+                "            double %s;\n%s\n" % (", ".join(outs), code))
+    on = ("            const long long on0 = (f0[l] != 0) & (k0[PDW_KIN_Y_D*PDW_SOA + l] < 0.0);\n"
+          "            const long long on1 = (f1[l] != 0) & (k1[PDW_KIN_Y_D*PDW_SOA + l] < 0.0);\n")
+    first = "\n".join(
+        "            c0[PDW_CONTACT_%s*PDW_SOA + l] = on0 ? %s : 0.0;\n"
+        "            c1[PDW_CONTACT_%s*PDW_SOA + l] = (on1 & !on0) ? %s : 0.0;"
+        % (f.upper(), o, f.upper(), o) for f, o in zip(fields, outs))
+    second = "\n".join(
+        "            const double w_%s = c1[PDW_CONTACT_%s*PDW_SOA + l];\n"
+        "            c1[PDW_CONTACT_%s*PDW_SOA + l] = (on0 & on1) ? %s : w_%s;"
+        % (o, f.upper(), f.upper(), o, o) for f, o in zip(fields, outs))
+    return _function(
+        "static void %s(int W, const double *restrict kin, const long long *restrict flags,\n"
+        "    const double *restrict p%s, double *restrict contact)" % (fname, extra),
+        "    const double *restrict k0 = kin, *restrict k1 = kin + PDW_NKIN*PDW_SOA;\n"
+        "    const long long *restrict f0 = flags, *restrict f1 = flags + PDW_SOA;\n"
+        "    double *restrict c0 = contact, *restrict c1 = contact + PDW_NCONTACT*PDW_SOA;\n"
+        "    long long both = 0;\n"
+        "    /* the law for leg 0 if it is a penetrating support foot, else for leg 1 */\n"
+        "    for (int l0 = 0; l0 < W; l0 += PDW_SOA_CHUNK) {\n"
+        "    #pragma omp simd reduction(|:both)\n"
+        "    for (int l = l0; l < l0 + PDW_SOA_CHUNK; ++l) {\n"
+        + on + "            both |= on0 & on1;\n"
+        + law(lambda src: "(on0 ? %s : %s)" % (src.lstrip("-") % "k0", src.lstrip("-") % "k1")
+              if not src.startswith("-") else
+              "-(on0 ? %s : %s)" % (src.lstrip("-") % "k0", src.lstrip("-") % "k1"))
+        + first + "\n        }\n    }\n"
+        "    if (!both) return;\n"
+        "    /* double support: leg 1's own law where both feet are on */\n"
+        "    for (int l0 = 0; l0 < W; l0 += PDW_SOA_CHUNK) {\n"
+        "    #pragma omp simd\n"
+        "    for (int l = l0; l < l0 + PDW_SOA_CHUNK; ++l) {\n"
+        + on + law(lambda src: src % "k1") + second + "\n        }\n    }")
 
 
 def _contact_body(fname, extra, code, fields, outs, void_p=True):
