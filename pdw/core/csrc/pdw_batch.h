@@ -82,10 +82,10 @@ typedef struct pdw_soa_state {
     long long flags[2*PDW_SOA_STRIDE], armed[2*PDW_SOA_STRIDE], armed_next[2*PDW_SOA_STRIDE];
     long long upd[PDW_SOA_STRIDE];  /* 1: past the first step (the flags are updated first) */
     long long rare[PDW_SOA_STRIDE]; /* out: 1 = nothing committed, run the scalar step */
-    double trig[PDW_NTRIG*PDW_SOA_STRIDE], kin[2*PDW_NKIN*PDW_SOA_STRIDE];
+    double trig[PDW_NTRIG*PDW_SOA_STRIDE];
     double contact[2*PDW_NCONTACT*PDW_SOA_STRIDE];
-    double M[PDW_NQ*PDW_NQ*PDW_SOA_STRIDE], C[PDW_NQ*PDW_NQ*PDW_SOA_STRIDE];
-    double QmG[PDW_NQ*PDW_SOA_STRIDE];
+    /* M[2][2], M[3][3] (the stage cdm_update keeps M, C and Q_f - G in registers) */
+    double mdiag[2*PDW_SOA_STRIDE];
     /* the contact law's parameter-only temporaries of each lane (the kernel's contact_consts,
      * generated/pdw_batch_gen.h), computed again before the next step when kc_stale */
     double kc[PDW_SOA_KC_ROWS*PDW_SOA_STRIDE];
