@@ -90,6 +90,7 @@ typedef struct pdw_soa_state {
      * generated/pdw_batch_gen.h), computed again before the next step when kc_stale */
     double kc[PDW_SOA_KC_ROWS*PDW_SOA_STRIDE];
     int kc_stale;
+    int first;      /* a lane may be at its first step (upd 0): set by a load */
     /* pdw_cdm_update's cache of the inverses of K's diagonal block, per lane: kdiag the
      * entries K[2][2], K[3][3] the inverses kinv were computed from (0: none) */
     double kdiag[2*PDW_SOA_STRIDE], kinv[2*PDW_SOA_STRIDE];
