@@ -175,8 +175,9 @@ enum { PDW_BATCH_SERIAL = 2 };
 
 /* 1 if walkers [i0, i1) in blocks of W lanes run faster through pdw_batch_serial: a block
  * would hold at most PDW_BATCH_SERIAL walkers, and the trig is libm's (vector = 0: the serial
- * loop is bitwise the lanes; vector = 1 stays in the lanes, whose libmvec trig a walker's
- * numbers must not depend on the batch size for). */
+ * loop is bitwise the lanes; vector = 1 stays in the lanes, so that a walker's libmvec
+ * numbers do not depend on the range or chunk it is in: pdw.simulate_batch gives a whole
+ * batch of at most PDW_BATCH_SERIAL walkers vector = 0 instead). */
 int pdw_batch_serial_pays(long i0, long i1, int W, int vector);
 
 /* Advance walkers [i0, i1) of job with rodas4 (job->method must name it), as
