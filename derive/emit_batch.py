@@ -72,16 +72,37 @@ def emit_kernel(spec, names, c_block, nforces):
                                      layout.CONTACT[:nout], soa, c_block))
     # the cdm lane loop's contact stage: the friction law's parameter-only temporaries (its
     # divisions by v_d - v_s, ...) once per walker, into rows kc
-    consts, contact_kc, nkc = _contact_consts(k + "_contact", stages.contact(spec)[:nforces],
-                                              soa, c_block)
-    out += [consts, contact_kc, "enum { %s_NKC = %d };\n" % (k.upper(), nkc)]
-    targets = [_soa("M[%d]" % i) for i in range(16)] + [_soa("C[%d]" % i) for i in range(16)] \
-        + [_soa("QmG[%d]" % i) for i in range(4)]
-    code, _ = c_block(stages.cdm_terms(spec), targets, soa, indent="        ")
+    # ... and the cdm lanes' kinematics, flag rules (PDW_SOA_RULES, pdw_batch_soa.inc) and
+    # contact stage in one lane loop, the kinematics in locals kin_<leg>_<FIELD>
+    kin_locals = ["kin_%d_%s" % (i, f.upper()) for i in range(2) for f in layout.KIN]
+    kin_code, _ = c_block(stages.kinematics(spec), kin_locals, soa, tmp_prefix="tk",
+                          indent="            ")
+    consts, kin_contact, nkc = _contact_consts(k, stages.contact(spec)[:nforces], soa, c_block,
+                                               kin_code, kin_locals)
+    out += [consts, kin_contact, "enum { %s_NKC = %d };\n" % (k.upper(), nkc)]
+    # the cdm lanes' cdm_terms and update in one lane loop: M, C and Q_f - G into locals
+    # M_i_j, C_i_j, QmG_i (the scalar stage's statements, so the same bits), then
+    # PDW_SOA_CDM_UPDATE (pdw/core/csrc/pdw_batch_soa.inc, defined before this header)
+    local = ["M_%d_%d" % divmod(i, 4) for i in range(16)] + ["C_%d_%d" % divmod(i, 4)
+                                                            for i in range(16)] \
+        + ["QmG_%d" % i for i in range(4)]
+    code, _ = c_block(stages.cdm_terms(spec), local, soa, indent="        ")
+    decl = "        double %s;\n" % ", ".join(local)
+    unused = "        %s\n" % " ".join("(void)%s;" % v for v in local)
     out.append(_function(
-        "static void %s_cdm_terms(int W, const double *restrict x, const double *restrict trig,\n"
-        "    const double *restrict p, const double *restrict contact,\n"
-        "    double *restrict M, double *restrict C, double *restrict QmG)" % k, LOOP % code))
+        "static void %s_cdm_update(int W, double *restrict x, double *restrict u_prev,\n"
+        "    const double *restrict trig, const double *restrict p, const double *restrict contact,\n"
+        "    const double *restrict hip, const double *restrict kinv, long long *restrict armed,\n"
+        "    const long long *restrict armed_next, long long *restrict rare, double idt2,\n"
+        "    double ih, double max_speed)" % k,
+        LOOP % (decl + code + "\n" + unused + "        PDW_SOA_CDM_UPDATE")))
+    # M[2][2] and M[3][3] alone (the update's cached inverses): the same statements (the
+    # compiler drops those the two do not need), so the same bits as cdm_update's
+    out.append(_function(
+        "static void %s_mdiag(int W, const double *restrict x, const double *restrict trig,\n"
+        "    const double *restrict p, const double *restrict contact, double *restrict md)" % k,
+        LOOP % (decl + code + "\n" + unused
+                + "        md[0*PDW_SOA + l] = M_2_2;\n        md[1*PDW_SOA + l] = M_3_3;")))
 
     # the right-hand side's and the Jacobian's stages (the lane loop of rodas4, pdw_batch_ros.inc)
     targets = [_soa("M[%d]" % i) for i in range(16)] + [_soa("f[%d]" % i) for i in range(4)]
@@ -134,7 +155,7 @@ def _loads(pre, text, indent="            "):
                    for v, load in sorted(pre.items()) if v in used)
 
 
-def _contact_consts(fname, exprs, soa, c_block):
+def _contact_consts(k, exprs, soa, c_block, kin_code, kin_locals):
     """The contact stage with its parameter-only temporaries read from rows kc (computed once
     per walker by fname_consts): (the two functions' C, the number of kc rows)."""
     used = set().union(*(e.free_symbols for e in exprs))
@@ -145,7 +166,7 @@ def _contact_consts(fname, exprs, soa, c_block):
     loads = {v: soa[s_] for s_, v in pre.items()}
     body_w = "\n".join(walker)
     consts = _function(
-        "static void %s_consts(int W, const double *restrict p, double *restrict kc)" % fname,
+        "static void %s_contact_consts(int W, const double *restrict p, double *restrict kc)" % k,
         "    for (int l0 = 0; l0 < W; l0 += PDW_SOA_CHUNK) {\n"
         "    #pragma omp simd\n"
         "    for (int l = l0; l < l0 + PDW_SOA_CHUNK; ++l) {\n"
@@ -155,9 +176,68 @@ def _contact_consts(fname, exprs, soa, c_block):
     reads = "".join("            const double %s = kc[%d*PDW_SOA + l];\n" % (t, j)
                     for j, t in enumerate(names))
     body_s = "\n".join(step)
-    return consts, _contact_body(fname + "_kc", ", const double *restrict kc",
-                                 _loads(loads, body_s) + reads + body_s,
-                                 layout.CONTACT[:len(exprs)], outs), len(names)
+    return consts, _kin_contact(k + "_kin_contact", kin_code, kin_locals,
+                                _loads(loads, body_s) + reads + body_s,
+                                layout.CONTACT[:len(exprs)], outs), len(names)
+
+
+# the inputs of the law from leg i's kinematics (locals kin_<i>_<FIELD>), as the scalar
+# stage takes them
+_INPUTS = (("delta", "-kin_%s_Y_D"), ("deltad", "-kin_%s_V_Y"), ("v_t", "kin_%s_V_X"),
+           ("xi", "kin_%s_XI"), ("v_in", "kin_%s_V_IN"))
+
+
+def _kin_contact(fname, kin_code, kin_locals, code, fields, outs):
+    """The cdm lanes' kinematics, flag rules and contact stage in one lane loop, the kinematics
+    in locals (kin_code: the scalar stage's statements into kin_locals, the same bits), the
+    rules PDW_SOA_RULES (pdw/core/csrc/pdw_batch_soa.inc, defined before this header). The force
+    law once per lane, for leg 0 where it is a penetrating support foot and else for leg 1,
+    and a second pass (the kinematics again, then leg 1's law) only when a lane of the block
+    has both feet on (double support, rare): a swing leg's law is not computed (the scalar
+    stage's branch skips it). Each evaluation is the law's statements on that leg's inputs,
+    the same bits as the scalar stage."""
+    def law(pick):
+        ins = "".join("            const double %s = %s;\n" % (v, pick(src)) for v, src in _INPUTS)
+        return (ins + "            (void)delta; (void)deltad; (void)v_t; (void)xi; (void)v_in;\n"
+                "            double %s;\n%s\n" % (", ".join(outs), code))
+
+    def sel(src):
+        neg, name = ("-", src[1:]) if src.startswith("-") else ("", src)
+        return "%s(on0 ? %s : %s)" % (neg, name % 0, name % 1)
+    kin = ("            double %s;\n" % ", ".join(kin_locals) + kin_code + "\n"
+           + "            %s\n" % " ".join("(void)%s;" % v for v in kin_locals))
+    on = ("            const long long on0 = (flags[l] != 0) & (kin_0_Y_D < 0.0);\n"
+          "            const long long on1 = (flags[PDW_SOA + l] != 0) & (kin_1_Y_D < 0.0);\n")
+    first = "\n".join(
+        "            c0[PDW_CONTACT_%s*PDW_SOA + l] = on0 ? %s : 0.0;\n"
+        "            c1[PDW_CONTACT_%s*PDW_SOA + l] = (on1 & !on0) ? %s : 0.0;"
+        % (f.upper(), o, f.upper(), o) for f, o in zip(fields, outs))
+    second = "\n".join(
+        "            const double w_%s = c1[PDW_CONTACT_%s*PDW_SOA + l];\n"
+        "            c1[PDW_CONTACT_%s*PDW_SOA + l] = (on0 & on1) ? %s : w_%s;"
+        % (o, f.upper(), f.upper(), o, o) for f, o in zip(fields, outs))
+    return _function(
+        "static void %s(int W, const double *restrict x, const double *restrict trig,\n"
+        "    const double *restrict p, const double *restrict anchors, const double *restrict kc,\n"
+        "    const long long *restrict flags, const long long *restrict armed,\n"
+        "    const long long *restrict upd, const double *restrict depth,\n"
+        "    long long *restrict armed_next, long long *restrict rare, double *restrict contact)"
+        % fname,
+        "    double *restrict c0 = contact, *restrict c1 = contact + PDW_NCONTACT*PDW_SOA;\n"
+        "    long long both = 0;\n"
+        "    (void)anchors;\n"
+        "    for (int l0 = 0; l0 < W; l0 += PDW_SOA_CHUNK) {\n"
+        "    #pragma omp simd reduction(|:both)\n"
+        "    for (int l = l0; l < l0 + PDW_SOA_CHUNK; ++l) {\n"
+        + kin + "            PDW_SOA_RULES\n" + on + "            both |= on0 & on1;\n"
+        "            /* the law for leg 0 if it is a penetrating support foot, else for leg 1 */\n"
+        + law(sel) + first + "\n        }\n    }\n"
+        "    if (!both) return;\n"
+        "    /* double support: leg 1's own law where both feet are on */\n"
+        "    for (int l0 = 0; l0 < W; l0 += PDW_SOA_CHUNK) {\n"
+        "    #pragma omp simd\n"
+        "    for (int l = l0; l < l0 + PDW_SOA_CHUNK; ++l) {\n"
+        + kin + on + law(lambda src: src % 1) + second + "\n        }\n    }")
 
 
 def _contact_body(fname, extra, code, fields, outs, void_p=True):
@@ -232,8 +312,14 @@ typedef struct pdw_soa_kernel {{
                        const double *anchors, double *kin);
     void (*contact)(int W, const double *kin, const long long *flags, const double *p,
                     double *contact);
-    void (*cdm_terms)(int W, const double *x, const double *trig, const double *p,
-                      const double *contact, double *M, double *C, double *QmG);
+    /* the cdm lane loop's cdm_terms and update in one (PDW_SOA_CDM_UPDATE), and M[2][2],
+     * M[3][3] alone into rows md */
+    void (*cdm_update)(int W, double *x, double *u_prev, const double *trig, const double *p,
+                       const double *contact, const double *hip, const double *kinv,
+                       long long *armed, const long long *armed_next, long long *rare,
+                       double idt2, double ih, double max_speed);
+    void (*mdiag)(int W, const double *x, const double *trig, const double *p,
+                  const double *contact, double *md);
     /* the right-hand side's and the Jacobian's (rodas4's lane loop) */
     void (*contact_partials)(int W, const double *kin, const long long *flags,
                              const double *p, double *contact);
@@ -241,11 +327,14 @@ typedef struct pdw_soa_kernel {{
                      const double *contact, double *M, double *f);
     void (*dynamics_jacobian)(int W, const double *x, const double *trig, const double *p,
                               const double *contact, const double *qdd, double *A);
-    /* the cdm lane loop's contact stage: contact_consts (once per walker) writes the law's
-     * parameter-only temporaries into nkc rows kc, which contact_kc reads (same bits) */
+    /* the cdm lane loop's kinematics, flag rules and contact stage in one (PDW_SOA_RULES):
+     * contact_consts (once per walker) writes the law's parameter-only temporaries into nkc
+     * rows kc, which kin_contact reads (same bits) */
     void (*contact_consts)(int W, const double *p, double *kc);
-    void (*contact_kc)(int W, const double *kin, const long long *flags, const double *p,
-                       const double *kc, double *contact);
+    void (*kin_contact)(int W, const double *x, const double *trig, const double *p,
+                        const double *anchors, const double *kc, const long long *flags,
+                        const long long *armed, const long long *upd, const double *depth,
+                        long long *armed_next, long long *rare, double *contact);
     int nkc;
 }} pdw_soa_kernel;
 
@@ -267,14 +356,14 @@ def header(banner, h, kernels, names_of, c_block, nforces):
     body, rows, nkc = [], [], 0
     for spec in kernels:
         if spec.normal != "hunt_crossley" or getattr(spec, "friction", "coulomb") != "coulomb":
-            rows.append("    {NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, 0},   /* %s */"
+            rows.append("    {NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, 0},   /* %s */"
                         % spec.name)
             continue
         body.append(emit_kernel(spec, names_of(spec), c_block, nforces))
-        rows.append("    {%s_kinematics, %s_contact, %s_cdm_terms,\n"
+        rows.append("    {%s_kinematics, %s_contact, %s_cdm_update, %s_mdiag,\n"
                     "     %s_contact_partials, %s_dynamics, %s_dynamics_jacobian,\n"
-                    "     %s_contact_consts, %s_contact_kc, %s_NKC},"
-                    % (("pdw_soa_" + spec.name,) * 8 + (("PDW_SOA_" + spec.name).upper(),)))
+                    "     %s_contact_consts, %s_kin_contact, %s_NKC},"
+                    % (("pdw_soa_" + spec.name,) * 9 + (("PDW_SOA_" + spec.name).upper(),)))
         nkc = max(nkc, int(re.search(r"_NKC = (\d+)", body[-1]).group(1)))
     return HEADER.format(banner=banner, hash=h, body="\n".join(body), table="\n".join(rows),
                          nkc=nkc)

@@ -38,6 +38,7 @@ cdef extern from "pdw_sim.h":
 cdef extern from "pdw_batch.h":
     enum:
         PDW_BATCH_MAXW
+        PDW_BATCH_SERIAL
     ctypedef struct pdw_batch_job:
         const pdw_kernel *kernel
         long n
@@ -91,6 +92,9 @@ cdef extern from "pdw_sim.h":
 
 
 MAX_LANES = PDW_BATCH_MAXW
+SERIAL_WALKERS = PDW_BATCH_SERIAL
+"""A block of at most this many walkers runs the scalar loop, one walker after the other
+(pdw_batch_serial): the lanes would compute a whole chunk of 8 for them."""
 ISAS = {"scalar": -1, "base": 0, "avx2": 1, "avx512": 2}
 """The cdm lane loops: "scalar" (every lane through the generated scalar stages), and the
 structure-of-arrays step compiled for the x86-64 baseline (SSE2), AVX2 and AVX-512F."""

@@ -273,7 +273,10 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
         routines (libmvec, within 4 ulp of libm's); flag switches on the step grid (cdm) and
         the adaptive step sequence (rodas4) turn those last bits into shifts of events, so final
         states then agree with `simulate` in outcome, not to 1e-12 (docs/ensemble.md). The
-        results do not depend on the lane or thread a walker runs in.
+        results do not depend on the lane, thread or chunk a walker runs in. True permits the
+        vector trig, it does not require it: a batch of at most 2 walkers
+        (``pdw.core._batch.SERIAL_WALKERS``), too few for the lanes to pay, runs the scalar
+        loop with libm's sin/cos, bitwise its `simulate` runs as with False.
     executor : concurrent.futures.Executor-like, optional
         Cut the batch into chunks of ``chunk_size`` consecutive walkers, each one task
         ``executor.submit`` (a thread or process pool, Dask's ``client.get_executor()``), the
@@ -318,6 +321,9 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
         thread): ``.result`` is the partial `BatchResult`, whose unfinished walkers have status
         ``"interrupted"`` and their state when stopped (or at t = 0 if never started).
     """
+    # run_chunked's chunks of a larger batch keep the lanes whatever their size (the vector
+    # trig of a walker must not depend on the chunk it is in)
+    small_serial = _legacy.pop("_small_serial", True)
     settled = _opt.settle(
         "simulate_batch", _positional, _legacy, integrator=integrator, stop=stop,
         limits=limits, method=method, dt=dt, t_end=t_end,
@@ -350,6 +356,7 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
                   else _ground_list(ground, n))
         if chunk_size is None:
             chunk_size = max(1, math.ceil(n / 8))
+        kw["_small_serial"] = small_serial and n <= _batch.SERIAL_WALKERS
         try:
             return run_chunked(simulate_batch, kw, executor, chunk_size, progress=bar)
         finally:
@@ -437,7 +444,10 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
     if cground is not None:         # the per-lane scalar stages: bitwise the scalar runs
         opts.update(isa=-1, grounds=cground)
     if n:
-        args = (k, x, pvec, f0, hip, depth, copts, out, 0, n, lanes, bool(vector))
+        # a batch of at most SERIAL_WALKERS walkers runs the scalar loop also with vector=True
+        # (libm's trig: bitwise simulate): the lanes would cost more than they save
+        lane_trig = bool(vector) and not (small_serial and n <= _batch.SERIAL_WALKERS)
+        args = (k, x, pvec, f0, hip, depth, copts, out, 0, n, lanes, lane_trig)
         # the threads share the batch: each lane of each takes the next walker from one
         # counter, so no lane idles while a walker waits (pdw_batch_take)
         shared = np.zeros(1, dtype=np.int_) if threads > 1 else None

@@ -69,14 +69,42 @@ def test_three_walkers_take_the_lanes(method):
         _assert_bitwise(b, i, x[i], method)
 
 
-def test_vector_trig_stays_in_the_lanes():
-    """vector=True: a walker's numbers must not depend on the batch size, so a batch of one
-    runs the lanes (libmvec's sin/cos), not the scalar loop."""
-    x = _states(1, seed=5)
+@pytest.mark.parametrize("method", ["cdm", "rodas4"])
+@pytest.mark.parametrize("n", [1, 2])
+def test_vector_batch_of_one_or_two_runs_the_scalar_loop(method, n):
+    """vector=True permits the vector trig, it does not require it: a batch of at most
+    SERIAL_WALKERS walkers runs the scalar loop with libm's sin/cos, so each walker is bit for
+    bit its `simulate` run (the lanes' libmvec trig differs in the last bits) and no lane
+    took a step."""
+    assert _batch.SERIAL_WALKERS == 2
+    x = _states(n, seed=5)
+    _batch.lane_steps(reset=True)
+    b = simulate_batch(x, t_end=T_END, method=method, lanes=8, threads=1, vector=True,
+                       check_step="off", **KW[method])
+    assert _batch.lane_steps(reset=True) == 0
+    for i in range(n):
+        _assert_bitwise(b, i, x[i], method)
+
+
+def test_vector_trig_of_three_walkers_and_of_chunks_stays_in_the_lanes():
+    """One walker more than SERIAL_WALKERS: vector=True runs the lanes; and in a chunked batch
+    whose last chunk holds a single walker, that walker too runs the lanes, as unchunked (a
+    walker's vector numbers do not depend on the chunk it is in)."""
+    x = _states(3, seed=5)
     _batch.lane_steps(reset=True)
     simulate_batch(x, t_end=T_END, lanes=8, threads=1, vector=True,
                    integrator=pdw.Integrator(check_step="off"))
     assert _batch.lane_steps(reset=True) > 0
+    x = _states(9, seed=6)
+    _batch.lane_steps(reset=True)
+    whole = simulate_batch(x, t_end=T_END, lanes=8, threads=1, vector=True, check_step="off")
+    in_lanes = _batch.lane_steps(reset=True)
+    chunked = simulate_batch(x, t_end=T_END, lanes=8, threads=1, vector=True, chunk_size=8,
+                             check_step="off")
+    # the lanes commit a walker's ordinary steps wherever it runs: as many with the last
+    # walker alone in its chunk (none if that chunk had taken the scalar loop)
+    assert _batch.lane_steps(reset=True) == in_lanes > 0
+    np.testing.assert_array_equal(chunked.x_final, whole.x_final)
 
 
 @pytest.mark.parametrize("method, isa, n, lanes", [("cdm", "scalar", 4, 2),

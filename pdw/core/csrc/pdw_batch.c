@@ -343,6 +343,7 @@ static void soa_load(pdw_soa_state *S, int l, const pdw_sim *s)
         S->armed[i*PDW_SOA_STRIDE + l] = s->disc.armed[i];
     }
     S->upd[l] = s->n > 0;
+    S->first |= s->n == 0;
 }
 
 /* The parts of lane l's pdw_sim that the SoA step advances, from S. */

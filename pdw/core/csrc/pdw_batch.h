@@ -82,14 +82,18 @@ typedef struct pdw_soa_state {
     long long flags[2*PDW_SOA_STRIDE], armed[2*PDW_SOA_STRIDE], armed_next[2*PDW_SOA_STRIDE];
     long long upd[PDW_SOA_STRIDE];  /* 1: past the first step (the flags are updated first) */
     long long rare[PDW_SOA_STRIDE]; /* out: 1 = nothing committed, run the scalar step */
-    double trig[PDW_NTRIG*PDW_SOA_STRIDE], kin[2*PDW_NKIN*PDW_SOA_STRIDE];
+    double trig[PDW_NTRIG*PDW_SOA_STRIDE];
     double contact[2*PDW_NCONTACT*PDW_SOA_STRIDE];
-    double M[PDW_NQ*PDW_NQ*PDW_SOA_STRIDE], C[PDW_NQ*PDW_NQ*PDW_SOA_STRIDE];
-    double QmG[PDW_NQ*PDW_SOA_STRIDE];
+    /* M[2][2], M[3][3] (the stage cdm_update keeps M, C and Q_f - G in registers) */
+    double mdiag[2*PDW_SOA_STRIDE];
     /* the contact law's parameter-only temporaries of each lane (the kernel's contact_consts,
      * generated/pdw_batch_gen.h), computed again before the next step when kc_stale */
     double kc[PDW_SOA_KC_ROWS*PDW_SOA_STRIDE];
     int kc_stale;
+    int first;      /* a lane may be at its first step (upd 0): set by a load */
+    /* pdw_cdm_update's cache of the inverses of K's diagonal block, per lane: kdiag the
+     * entries K[2][2], K[3][3] the inverses kinv were computed from (0: none) */
+    double kdiag[2*PDW_SOA_STRIDE], kinv[2*PDW_SOA_STRIDE];
 } pdw_soa_state;
 
 /* The trig of lanes l < W from libm (bitwise pdw_trig): all lanes, or (only_first != 0) only
@@ -171,8 +175,9 @@ enum { PDW_BATCH_SERIAL = 2 };
 
 /* 1 if walkers [i0, i1) in blocks of W lanes run faster through pdw_batch_serial: a block
  * would hold at most PDW_BATCH_SERIAL walkers, and the trig is libm's (vector = 0: the serial
- * loop is bitwise the lanes; vector = 1 stays in the lanes, whose libmvec trig a walker's
- * numbers must not depend on the batch size for). */
+ * loop is bitwise the lanes; vector = 1 stays in the lanes, so that a walker's libmvec
+ * numbers do not depend on the range or chunk it is in: pdw.simulate_batch gives a whole
+ * batch of at most PDW_BATCH_SERIAL walkers vector = 0 instead). */
 int pdw_batch_serial_pays(long i0, long i1, int W, int vector);
 
 /* Advance walkers [i0, i1) of job with rodas4 (job->method must name it), as
