@@ -120,12 +120,15 @@ TERRAIN_HEADER = """\
 #include <math.h>
 #include "pdw_model.h"
 
+/* derive/ input hash these stages were generated from (= PDW_INPUT_HASH of pdw_model.h) */
+#define PDW_TERRAIN_INPUT_HASH "{hash}"
+
 {body}
 #endif /* PDW_TERRAIN_GEN_H */
 """
 
 
-def terrain_header(banner):
+def terrain_header(banner, h):
     """The text of generated/pdw_terrain_gen.h."""
     names = _names()
     out = []
@@ -150,7 +153,7 @@ def terrain_header(banner):
     out.append(_function("static inline void pdw_ground_forces(const double *restrict contact,\n"
                          "    const double *restrict gnd, const double *restrict p, double *restrict gf)",
                          code))
-    return TERRAIN_HEADER.format(banner=banner, body="\n".join(out))
+    return TERRAIN_HEADER.format(banner=banner, hash=h, body="\n".join(out))
 
 
 def _function(signature, body):
@@ -557,7 +560,7 @@ def write_all(root: pathlib.Path):
     files = {
         root / "generated" / "pdw_model.h": header(h),
         root / "generated" / "pdw_model.c": src,
-        root / "generated" / "pdw_terrain_gen.h": terrain_header(banner),
+        root / "generated" / "pdw_terrain_gen.h": terrain_header(banner, h),
         root / "generated" / "pdw_batch_gen.h": emit_batch.header(banner, h, KERNELS, _names,
                                                                    c_block, NFORCES),
         root / "pdw" / "core" / "_layout.py": python_layout(h, ops),

@@ -20,7 +20,8 @@ from derive import emit, layout  # noqa: E402
 from pdw.core import _core, _layout  # noqa: E402
 
 GENERATED = ("generated/pdw_model.h", "generated/pdw_model.c", "generated/pdw_hybrid.h",
-             "generated/pdw_hybrid.c", "generated/pdw_batch_gen.h", "pdw/core/_layout.py")
+             "generated/pdw_hybrid.c", "generated/pdw_batch_gen.h", "generated/pdw_terrain_gen.h",
+             "pdw/core/_layout.py")
 
 
 @pytest.fixture(scope="module")
@@ -42,7 +43,7 @@ def test_generated_c_hash_matches_derive(repo_root, current_hash, name):
     assert found == [current_hash], "%s is stale: run `make derive`" % name
     assert "SymPy %s" % sp.__version__ in text
     if name.endswith(".h"):
-        assert re.search(r'#define PDW_(HYBRID_|BATCH_)?INPUT_HASH "%s"' % current_hash, text)
+        assert re.search(r'#define PDW_(HYBRID_|BATCH_|TERRAIN_)?INPUT_HASH "%s"' % current_hash, text)
 
 
 def test_input_hash_covers_every_derive_source(tmp_path, monkeypatch, current_hash):

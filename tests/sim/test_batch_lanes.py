@@ -80,7 +80,7 @@ def test_vector_batch_of_one_or_two_runs_the_scalar_loop(method, n):
     x = _states(n, seed=5)
     _batch.lane_steps(reset=True)
     b = simulate_batch(x, t_end=T_END, method=method, lanes=8, threads=1, vector=True,
-                       check_step="off", **KW[method])
+                       integrator=pdw.Integrator(check_step="off", **KW[method]))
     assert _batch.lane_steps(reset=True) == 0
     for i in range(n):
         _assert_bitwise(b, i, x[i], method)
@@ -97,10 +97,11 @@ def test_vector_trig_of_three_walkers_and_of_chunks_stays_in_the_lanes():
     assert _batch.lane_steps(reset=True) > 0
     x = _states(9, seed=6)
     _batch.lane_steps(reset=True)
-    whole = simulate_batch(x, t_end=T_END, lanes=8, threads=1, vector=True, check_step="off")
+    whole = simulate_batch(x, t_end=T_END, lanes=8, threads=1, vector=True,
+                           integrator=pdw.Integrator(check_step="off"))
     in_lanes = _batch.lane_steps(reset=True)
     chunked = simulate_batch(x, t_end=T_END, lanes=8, threads=1, vector=True, chunk_size=8,
-                             check_step="off")
+                             integrator=pdw.Integrator(check_step="off"))
     # the lanes commit a walker's ordinary steps wherever it runs: as many with the last
     # walker alone in its chunk (none if that chunk had taken the scalar loop)
     assert _batch.lane_steps(reset=True) == in_lanes > 0
