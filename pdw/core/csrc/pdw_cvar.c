@@ -41,6 +41,7 @@ typedef struct cv_ctx {
     double lu_h;                /* h of the factors; 0: none */
     double u[NS][NMAX];         /* stage increments of y of the last attempt */
     double Y[NS][NMAX];         /* its stage points */
+    double alpha[NS], gsum[NS]; /* cv_stage_times */
 } cv_ctx;
 
 static void cv_f(cv_ctx *c, const double *y, double *f)
@@ -241,16 +242,71 @@ static double cv_step_y(cv_ctx *c, const pdw_cvar_opts *o, const double *y_n, co
     return cv_norm(PDW_NX, y_n, ynew, errv, o->rtol, o->atol);
 }
 
-/* Phi over the step of the last cv_step_y (its stages and factors): Phinew; the error norm of
- * Phi. n a constant at the call sites (PDW_NX or NMAX), so that the loops unroll. A's and
- * dA's rows 0..3 are [0, I, 0] and 0, rows 8.. zero: the products need rows 4..7 only. */
+static void cv_hermite(int n, const double *x0, const double *f0, const double *x1,
+                       const double *f1, double h, double th, double *out);
+
+/* The stage times alpha_i and the sums gamma_i = sum_j gamma_ij of RODAS4's original form
+ * (Hairer & Wanner II, Eq. IV.7.1; rodas.f's C_i and D_i) from the transformed tableau: with
+ * Gamma^-1 = diag(1/gamma) - C, gamma_i the row sums of Gamma and alpha_i = sum_k a_ik gamma_k. */
+static void cv_stage_times(double *alpha, double *gsum)
+{
+    const pdw_ros_tableau *T = &pdw_tableau_rodas4;
+    double Gi[NS][NS] = {{0.0}}, G[NS][NS] = {{0.0}};
+    for (int i = 0; i < T->stages; ++i) {
+        Gi[i][i] = 1.0 / T->gamma;
+        for (int j = 0; j < i; ++j) Gi[i][j] = -T->C[i][j];
+    }
+    for (int j = 0; j < T->stages; ++j) {
+        G[j][j] = T->gamma;
+        for (int i = j + 1; i < T->stages; ++i) {
+            double acc = 0.0;
+            for (int k = j; k < i; ++k) acc += Gi[i][k] * G[k][j];
+            G[i][j] = -T->gamma * acc;
+        }
+    }
+    for (int i = 0; i < T->stages; ++i) {
+        gsum[i] = 0.0;
+        for (int j = 0; j <= i; ++j) gsum[i] += G[i][j];
+    }
+    for (int i = 0; i < T->stages; ++i) {
+        alpha[i] = 0.0;
+        for (int k = 0; k < i; ++k) alpha[i] += T->a[i][k] * gsum[k];
+    }
+    /* rounding: the stiffly accurate last stages sit at alpha = 1 with gamma_i = 0 exactly
+     * (rodas.f: C5 = C6 = 1, D5 = D6 = 0); the computed sums are off by ~1e-15 */
+    for (int i = 0; i < T->stages; ++i) {
+        if (fabs(alpha[i] - 1.0) < 1e-12) alpha[i] = 1.0;
+        if (fabs(gsum[i]) < 1e-12) gsum[i] = 0.0;
+    }
+}
+
+/* Phi over a step [t_n, t_n + h] of y (y_n -> ynew, f_n and fnew their f; E factored for h):
+ * RODAS4 on the linear non-autonomous Phi' = A(y(t)) Phi (Eq. IV.7.4' with its f_t term:
+ *     E U_i = A(y(t_n + alpha_i h)) P_i + sum_j (C_ij / h) U_j + gamma_i h A_t Phi_n,
+ * P_i = Phi_n + sum_j a_ij U_j, A_t = dA[f_n] the time derivative of A along y), y(t) the cubic
+ * Hermite interpolant of the step (error O(h^4): order 4 is kept). The stage times 0 and 1
+ * reuse A(y_n) and A(ynew) (written to Anew, the next step's): three new Jacobians a step, and
+ * A_t from two more. Returns the error norm of Phi; Phinew. n a constant at the call sites
+ * (PDW_NX or NMAX), so that the loops unroll. A's and A_t's rows 0..3 are [0, I, 0] and 0,
+ * rows 8.. zero: the products need rows 4..7 only. */
 static inline double cv_step_phi_n(cv_ctx *c, const pdw_cvar_opts *o, const double *Phi,
-                                   double h, double *Phinew, const int n)
+                                   double h, const double *y_n, const double *f_n,
+                                   const double *ynew, const double *fnew, double *Phinew,
+                                   double *Anew, const int n)
 {
     const pdw_ros_tableau *T = &pdw_tableau_rodas4;
     const int nn = n * n;
     double U[NS][NMAX * NMAX], P[NMAX * NMAX], Ai[NMAX * NMAX], D[NMAX * NMAX];
+    double AtP[PDW_NQ * NMAX], yi[NMAX];
     const double ih = 1.0 / h;
+    int have_new = 0;
+    cv_dA(c, o, y_n, f_n, D);
+    for (int r = 0; r < PDW_NQ; ++r)
+        for (int q = 0; q < n; ++q) {
+            double acc = 0.0;
+            for (int k = 0; k < n; ++k) acc += D[(PDW_NQ + r) * n + k] * Phi[k * n + q];
+            AtP[r * n + q] = h * acc;
+        }
     for (int i = 0; i < T->stages; ++i) {
         double *R = U[i];
         for (int k = 0; k < nn; ++k) {
@@ -260,17 +316,28 @@ static inline double cv_step_phi_n(cv_ctx *c, const pdw_cvar_opts *o, const doub
             R[k] = ih * cc;
         }
         const double *A = c->A;
-        if (i > 0) { cv_jac(c, c->Y[i], Ai); A = Ai; }
-        cv_dA(c, o, c->Y[0], c->u[i], D);
+        const double al = c->alpha[i];
+        if (al == 1.0) {
+            if (!have_new) { cv_jac(c, ynew, Anew); have_new = 1; }
+            A = Anew;
+        } else if (al != 0.0) {
+            cv_hermite(n, y_n, f_n, ynew, fnew, h, al, yi);
+            cv_jac(c, yi, Ai);
+            A = Ai;
+        }
         for (int r = 0; r < PDW_NQ; ++r)
             for (int q = 0; q < n; ++q) R[r * n + q] += P[(PDW_NQ + r) * n + q];
-        for (int r = PDW_NQ; r < PDW_NX; ++r)
+        const double gi = c->gsum[i];
+        for (int r = PDW_NQ; r < PDW_NX; ++r) {
+            for (int q = 0; q < n; ++q) R[r * n + q] += gi * AtP[(r - PDW_NQ) * n + q];
             for (int k = 0; k < n; ++k) {
-                const double a = A[r * n + k], dd = D[r * n + k];
-                for (int q = 0; q < n; ++q) R[r * n + q] += a * P[k * n + q] + dd * Phi[k * n + q];
+                const double a = A[r * n + k];
+                for (int q = 0; q < n; ++q) R[r * n + q] += a * P[k * n + q];
             }
+        }
         cv_solve(c, R, n, n);
     }
+    if (!have_new) cv_jac(c, ynew, Anew);
     double errv[NMAX * NMAX];
     for (int k = 0; k < nn; ++k) {
         double acc = 0.0, err = 0.0;
@@ -282,10 +349,12 @@ static inline double cv_step_phi_n(cv_ctx *c, const pdw_cvar_opts *o, const doub
 }
 
 static double cv_step_phi(cv_ctx *c, const pdw_cvar_opts *o, const double *Phi, double h,
-                          double *Phinew)
+                          const double *y_n, const double *f_n, const double *ynew,
+                          const double *fnew, double *Phinew, double *Anew)
 {
-    return c->n == PDW_NX ? cv_step_phi_n(c, o, Phi, h, Phinew, PDW_NX)
-                          : cv_step_phi_n(c, o, Phi, h, Phinew, NMAX);
+    return c->n == PDW_NX
+        ? cv_step_phi_n(c, o, Phi, h, y_n, f_n, ynew, fnew, Phinew, Anew, PDW_NX)
+        : cv_step_phi_n(c, o, Phi, h, y_n, f_n, ynew, fnew, Phinew, Anew, NMAX);
 }
 
 /* event function k at y (shifted) and, if grad is not NULL, its gradient (n) */
@@ -356,10 +425,12 @@ int pdw_cvar_interval(const pdw_cvar_model *m, const pdw_cvar_opts *o, const pdw
 {
     cv_ctx c;
     const int n = PDW_NX + m->na;
-    double f_n[NMAX], ynew[NMAX], fnew[NMAX], ys[NMAX], Phinew[NMAX * NMAX], grad[NMAX];
+    double f_n[NMAX], ynew[NMAX], fnew[NMAX], ys[NMAX], fs[NMAX], grad[NMAX];
+    double Phinew[NMAX * NMAX], Anew[NMAX * NMAX];
     double g_old[PDW_CVAR_MAXEV], g_new[PDW_CVAR_MAXEV];
     int last_rejected = 0;
     c.m = m; c.st = st; c.work = work; c.n = n; c.lu_h = 0.0;
+    cv_stage_times(c.alpha, c.gsum);
     if (n_ev > PDW_CVAR_MAXEV) n_ev = PDW_CVAR_MAXEV;
     cv_f(&c, y, f_n);
     cv_jac(&c, y, c.A);
@@ -375,8 +446,9 @@ int pdw_cvar_interval(const pdw_cvar_model *m, const pdw_cvar_opts *o, const pdw
         if (!(hs > 8.0 * DBL_EPSILON * fmax(fabs(*t), 1e-3))) return PDW_CVAR_STEP_SIZE;
         double err = cv_step_y(&c, o, y, f_n, hs, ynew);
         int phi_done = 0;
+        if (err <= 1.0) cv_f(&c, ynew, fnew);
         if (o->phi_error && err <= 1.0) {
-            err = fmax(err, cv_step_phi(&c, o, Phi, hs, Phinew));
+            err = fmax(err, cv_step_phi(&c, o, Phi, hs, y, f_n, ynew, fnew, Phinew, Anew));
             phi_done = 1;
         }
         if (!(err <= 1.0)) {
@@ -395,7 +467,6 @@ int pdw_cvar_interval(const pdw_cvar_model *m, const pdw_cvar_opts *o, const pdw
         for (int k = 0; k < n_ev; ++k) {
             g_new[k] = cv_event(m, &ev[k], ynew, NULL, n);
             if (!cv_crossed(&ev[k], g_old[k], g_new[k])) continue;
-            if (kb < 0) cv_f(&c, ynew, fnew);
             const double s = cv_locate_hermite(m, &ev[k], n, y, f_n, ynew, fnew, hs, g_old[k]);
             if (s < sb) { sb = s; kb = k; }
         }
@@ -410,7 +481,7 @@ int pdw_cvar_interval(const pdw_cvar_model *m, const pdw_cvar_opts *o, const pdw
                 const double g = cv_event(m, &ev[kb], ys, grad, n);
                 if (g == 0.0) break;
                 if ((g < 0.0) == (glo < 0.0)) lo = s; else hi = s;
-                double fs[NMAX], gd = 0.0;
+                double gd = 0.0;
                 cv_f(&c, ys, fs);
                 for (int i = 0; i < n; ++i) gd += grad[i] * fs[i];
                 const double ds = -g / gd;
@@ -419,9 +490,10 @@ int pdw_cvar_interval(const pdw_cvar_model *m, const pdw_cvar_opts *o, const pdw
                 s += ds;
                 if (hi - lo <= 4.0 * DBL_EPSILON * fmax(*t + hi, 1e-3)) { s = hi; }
             }
-            /* the stages in c are those of the step of length s_done (the last cv_step_y) */
+            /* the factors in c are those of the step of length s_done (the last cv_step_y) */
             s = s_done;
-            cv_step_phi(&c, o, Phi, s, Phinew);
+            cv_f(&c, ys, fs);
+            cv_step_phi(&c, o, Phi, s, y, f_n, ys, fs, Phinew, Anew);
             memcpy(y, ys, (size_t)n * sizeof(double));
             memcpy(Phi, Phinew, (size_t)(n * n) * sizeof(double));
             *t += s;
@@ -430,7 +502,7 @@ int pdw_cvar_interval(const pdw_cvar_model *m, const pdw_cvar_opts *o, const pdw
             st->n_steps++;
             return PDW_CVAR_EVENT;
         }
-        if (!phi_done) cv_step_phi(&c, o, Phi, hs, Phinew);
+        if (!phi_done) cv_step_phi(&c, o, Phi, hs, y, f_n, ynew, fnew, Phinew, Anew);
         memcpy(y, ynew, (size_t)n * sizeof(double));
         memcpy(Phi, Phinew, (size_t)(n * n) * sizeof(double));
         for (int i = 0; i < n; ++i)
@@ -438,8 +510,8 @@ int pdw_cvar_interval(const pdw_cvar_model *m, const pdw_cvar_opts *o, const pdw
         *t = last ? o->t_max : *t + hs;
         st->n_steps++;
         memcpy(g_old, g_new, sizeof g_old);
-        cv_f(&c, y, f_n);
-        cv_jac(&c, y, c.A);
+        memcpy(f_n, fnew, (size_t)n * sizeof(double));
+        memcpy(c.A, Anew, (size_t)(n * n) * sizeof(double));
         c.lu_h = 0.0;
         hh = h_next;
         *h = hh;
