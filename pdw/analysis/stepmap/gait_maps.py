@@ -307,8 +307,9 @@ class ContinuousProblem(_Problem):
             if exact:
                 from . import variational
                 try:
-                    M = variational.step_jacobian(z, self.params_at(mu), **{
-                        k: self.opts[k] for k in ("rtol", "atol") if k in self.opts})["M"]
+                    M = variational.step_jacobian(z, self.params_at(mu), contact=self.contact,
+                                                  **{k: self.opts[k] for k in ("rtol", "atol")
+                                                     if k in self.opts})["M"]
                 except InvalidInputError as e:
                     return Evaluation(False, "exact monodromy: %s" % e)
                 P_lam = (vals[1] - vals[2]) / (up - down)

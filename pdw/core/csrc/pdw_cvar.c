@@ -309,11 +309,11 @@ static inline double cv_step_phi_n(cv_ctx *c, const pdw_cvar_opts *o, const doub
         }
     for (int i = 0; i < T->stages; ++i) {
         double *R = U[i];
-        for (int k = 0; k < nn; ++k) {
-            double acc = 0.0, cc = 0.0;
-            for (int j = 0; j < i; ++j) { acc += T->a[i][j] * U[j][k]; cc += T->C[i][j] * U[j][k]; }
-            P[k] = Phi[k] + acc;
-            R[k] = ih * cc;
+        for (int k = 0; k < nn; ++k) { P[k] = Phi[k]; R[k] = 0.0; }
+        for (int j = 0; j < i; ++j) {           /* contiguous inner loops: they vectorize */
+            const double a = T->a[i][j], cc = ih * T->C[i][j];
+            const double *Uj = U[j];
+            for (int k = 0; k < nn; ++k) { P[k] += a * Uj[k]; R[k] += cc * Uj[k]; }
         }
         const double *A = c->A;
         const double al = c->alpha[i];
@@ -339,11 +339,11 @@ static inline double cv_step_phi_n(cv_ctx *c, const pdw_cvar_opts *o, const doub
     }
     if (!have_new) cv_jac(c, ynew, Anew);
     double errv[NMAX * NMAX];
-    for (int k = 0; k < nn; ++k) {
-        double acc = 0.0, err = 0.0;
-        for (int j = 0; j < T->stages; ++j) { acc += T->m[j] * U[j][k]; err += T->e[j] * U[j][k]; }
-        Phinew[k] = Phi[k] + acc;
-        errv[k] = err;
+    for (int k = 0; k < nn; ++k) { Phinew[k] = Phi[k]; errv[k] = 0.0; }
+    for (int j = 0; j < T->stages; ++j) {
+        const double mj = T->m[j], ej = T->e[j];
+        const double *Uj = U[j];
+        for (int k = 0; k < nn; ++k) { Phinew[k] += mj * Uj[k]; errv[k] += ej * Uj[k]; }
     }
     return cv_norm(nn, Phi, Phinew, errv, o->phi_rtol, o->phi_atol);
 }

@@ -127,3 +127,23 @@ def test_kelvin_voigt_gait_compiled_against_python_and_differences():
     a = _agree(c, g.details["z"], 2e-4, 2e-3)
     m = np.linalg.eigvals(a["M"])
     assert np.min(np.abs(m - g.multipliers[0])) < 2e-4
+
+
+def test_continuation_problem_passes_its_contact_law_to_the_exact_monodromy(z0):
+    """ContinuousProblem(monodromy="exact") with a law that has approach speeds: before, M was
+    asked of the default law (and a 7-coordinate z was refused); now M is the law's, equal to
+    the finite differences' to 1e-4 of its largest entry."""
+    from pdw.analysis.stepmap.gait_maps import ContinuousProblem
+    c = pdw.Contact("flores", e=0.18)
+    z = np.r_[z0, 0.3]
+    out = {}
+    for mono in ("differences", "exact"):
+        prob = ContinuousProblem(P, "k_hip", workers=1, options={"contact": c})
+        prob.monodromy = mono
+        ev = prob.evaluate(z, P.k_hip)
+        assert ev.ok, ev.status
+        out[mono] = ev
+    J = out["differences"].M
+    assert out["exact"].M.shape == (7, 7)
+    assert np.max(np.abs(out["exact"].M - J)) < 1e-4 * np.abs(J).max()
+    np.testing.assert_allclose(out["exact"].P_lam, out["differences"].P_lam, atol=1e-12)
