@@ -43,9 +43,27 @@ rest. LuGre friction is refused: its kernel's Jacobian is itself a central diffe
 exact) and its bristle states reset at touch-down; use finite differences there.
 
 Scope: the paper variant (the consistent variant's tangential anchors are not differentiated).
-Slower than the finite differences (one Python integration of 72 equations, 110 with approach
-speeds; benchmarks/bench_monodromy.py), so not the continuation's default: it is the
-cross-check of `GaitMap.crosscheck` and of a user's doubts near a kink.
+
+Two engines integrate each interval between events (``engine=``); the flag logic and the
+saltation matrices above are this module's, shared by both:
+
+* ``"compiled"`` (default; pdw/core/csrc/pdw_cvar.c, `pdw.core._core.cvar_interval`): x by
+  RODAS4 (rtol, atol) and Phi by RODAS4 on the linear non-autonomous Phi' = A(x(t)) Phi along
+  x's step (its f_t term from a difference of the symbolic Jacobian along f; x at the stage
+  times from the step's Hermite interpolant), Phi's error estimate controlling the steps too
+  (`PHI_TOL`); the events located in C to rounding (Newton on re-steps).
+* ``"python"``: SciPy's Radau (rtol 1e-10) with the event functions, then LSODA for (x, Phi)
+  (``phi_rtol``): the reference.
+
+They agree to 2e-8 on paper_steady's multipliers (3e-10 at rtol 1e-12), to ~1e-7 for the
+other laws, to 4e-5 for Kelvin-Voigt's calibrated gait, whose rises' saltations move by 1e-3
+with a 1e-11 s shift of the event (the Python version itself moves by 2.5e-5 between rtol 1e-10
+and 1e-11). Cost (benchmarks/bench_monodromy.py, CPU): compiled 0.2-0.6 x the finite
+differences (13-15 maps through the ensemble engine), Python 5-27 x; a branch point of
+`continue_gait` with the exact M costs 1.1 x the differences' for the default law (the 12 maps
+of the differences ride almost free in the engine's lanes) and 0.4 x for flores. Not the
+continuation's default (the lead's decision); it is the cross-check of `GaitMap.crosscheck` and
+of a user's doubts near a kink.
 """
 from __future__ import annotations
 
