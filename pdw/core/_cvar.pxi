@@ -17,6 +17,7 @@ cdef extern from "pdw_cvar.h":
     ctypedef struct pdw_cvar_opts:
         double rtol, atol, phi_rtol, phi_atol, t_max, dir_step
         int phi_error
+        int a_hermite
         int one_sided
         long max_steps
     ctypedef struct pdw_cvar_stats:
@@ -32,13 +33,14 @@ def cvar_interval(OdeFunction f not None, double l, double r, int na, events, do
                   double[::1] y, double[:, ::1] Phi, double h, double t_max, *,
                   double rtol=1e-10, double atol=1e-12, double phi_rtol=1e-10,
                   double phi_atol=1e-10, double dir_step=1e-7,
-                  bint phi_error=False, bint one_sided=False, long max_steps=200000, stats=None):
+                  bint phi_error=False, bint one_sided=False, bint a_hermite=True, long max_steps=200000, stats=None):
     """Integrate (y, Phi) of f (its flags and anchors held) from t to the first crossing of
     ``events`` (a sequence of (kind, leg, dir): pdw_cvar.h's PDW_CVAR_EV_* codes, leg 0 or 1,
     crossing direction +1, -1 or 0), in place: y (8 + na,) and Phi (8 + na, 8 + na), na 0 or
     2 (approach speeds after x). l, r: leg length and foot radius [m]. Returns (status, t,
     index of the event or -1, next step h): status 0 an event, 1 t_max, -1 the step size
-    failed, -2 max_steps. ``stats`` (a list of 4 ints, optional) accumulates steps, rejections,
+    failed, -2 max_steps. ``a_hermite`` (default): A at the inner stage times from its cubic
+    Hermite interpolant (pdw_cvar.h); ``one_sided``: forward differences for dA/dt. ``stats`` (a list of 4 ints, optional) accumulates steps, rejections,
     f and Jacobian evaluations."""
     cdef pdw_cvar_model m
     cdef pdw_cvar_opts o
@@ -73,6 +75,7 @@ def cvar_interval(OdeFunction f not None, double l, double r, int na, events, do
     o.phi_rtol, o.phi_atol = phi_rtol, phi_atol
     o.phi_error = phi_error
     o.one_sided = one_sided
+    o.a_hermite = a_hermite
     o.max_steps = max_steps
     st.n_steps = st.n_rejected = st.n_rhs = st.n_jac = 0
     with nogil:

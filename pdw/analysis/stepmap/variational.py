@@ -49,19 +49,20 @@ saltation matrices above are this module's, shared by both:
 
 * ``"compiled"`` (default; pdw/core/csrc/pdw_cvar.c, `pdw.core._core.cvar_interval`): x by
   RODAS4 (rtol, atol) and Phi by RODAS4 on the linear non-autonomous Phi' = A(x(t)) Phi along
-  x's step (its f_t term from a difference of the symbolic Jacobian along f; x at the stage
-  times from the step's Hermite interpolant), Phi's error estimate controlling the steps too
+  x's step (its f_t term dA/dt = dA[f] a central difference of the symbolic Jacobian along f;
+  A at the inner stage times from its cubic Hermite interpolant between the step's ends, A and
+  dA/dt there: 3 Jacobians a step), Phi's error estimate controlling the steps too
   (`PHI_TOL`); the events located in C to rounding (Newton on re-steps).
 * ``"python"``: SciPy's Radau (rtol 1e-10) with the event functions, then LSODA for (x, Phi)
   (``phi_rtol``): the reference.
 
-They agree to 2e-8 on paper_steady's multipliers (3e-10 at rtol 1e-12), to ~1e-7 for the
-other laws, to 4e-5 for Kelvin-Voigt's calibrated gait, whose rises' saltations move by 1e-3
-with a 1e-11 s shift of the event (the Python version itself moves by 2.5e-5 between rtol 1e-10
-and 1e-11). Cost (benchmarks/bench_monodromy.py, CPU): compiled 0.2-0.6 x the finite
-differences (13-15 maps through the ensemble engine), Python 5-27 x; a branch point of
-`continue_gait` with the exact M costs 1.1 x the differences' for the default law (the 12 maps
-of the differences ride almost free in the engine's lanes) and 0.4 x for flores. Not the
+They agree to 2e-8 on paper_steady's multipliers (2e-9 at rtol 1e-12, phi_rtol 1e-10), to
+~1e-7 for the other laws, to 2e-5 for Kelvin-Voigt's calibrated gait, whose rises' saltations
+move by 1e-3 with a 1e-11 s shift of the event (the Python version itself moves by 2.5e-5
+between rtol 1e-10 and 1e-11). Cost (benchmarks/bench_monodromy.py, CPU): compiled 0.16-0.5 x
+the finite differences (13-15 maps through the ensemble engine), Python 6-26 x; a branch point
+of `continue_gait` with the exact M costs 1.06 x the differences' for the default law (their 12
+extra maps ride almost free in the engine's lanes) and 0.35 x for flores. Not the
 continuation's default (the lead's decision); it is the cross-check of `GaitMap.crosscheck` and
 of a user's doubts near a kink.
 """
@@ -247,7 +248,7 @@ def _compiled_interval(F, p, specs, t0, y, Phi, h, t_max, rtol, atol, phi_tol):
     """(t_ev, k_ev, next step): y and Phi advanced in place to the first event (pdw_cvar.c)."""
     rc, t_ev, k_ev, h = _core.cvar_interval(F.f, p.l, p.r, F.na, specs, t0, y, Phi, h, t_max,
                                             rtol=rtol, atol=atol, phi_rtol=phi_tol,
-                                            phi_atol=phi_tol, phi_error=True)
+                                            phi_atol=phi_tol, phi_error=True, a_hermite=True)
     if rc == 1:
         raise InvalidInputError("variational step_jacobian: no touch-down by t_max = %g s"
                                 % t_max)

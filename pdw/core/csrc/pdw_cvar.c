@@ -1,24 +1,30 @@
-/* The continuous walker's variational equations by RODAS4 on the augmented system (pdw_cvar.h).
+/* The continuous walker's variational equations by RODAS4 (pdw_cvar.h).
  *
- * The augmented system (y, Phi)' = (f(y), A(y) Phi) has the block lower-triangular Jacobian
- * [[A, 0], [B, A]] with B u = dA[u] Phi (dA[u] = sum_j dA/dy_j u_j), so with E = I/(gamma h) - A
- * a RODAS4 stage (pdw_rodas4.c's transformed form, Hairer & Wanner II, Eq. IV.7.4') splits into
- *     E u_i   = f(Y_i) + sum_j (C_ij / h) u_j,
- *     E U_i   = A(Y_i) P_i + sum_j (C_ij / h) U_j + dA[u_i] Phi_n,
- * with Y_i = y_n + sum_j a_ij u_j and P_i = Phi_n + sum_j a_ij U_j: one factorisation of E per
- * step serves both, and Phi_{n+1} = Phi_n + sum m_i U_i is RODAS4's own solution of the
- * augmented system (order 4). A(Y_i) is the kernel's symbolic Jacobian; the directional
- * derivative dA[u_i] is a central difference of it along u_i (its largest state change
- * dir_step, 1e-7 by default: relative error ~1e-9; it enters only the correction term, a
- * fraction of U_i). With the approach speeds (na = 2) the columns df/dv_in are central
- * differences of f (step 1e-6 max(1, |v_in|)), as variational.py's, and their dA[u] a mixed
- * second difference (steps 1e-4).
- * Steps: the error estimate of y (and of Phi with phi_error) with an I controller
- * (h_new = h clamp(0.9 err^(-1/4), 0.2, 6), no increase right after a rejection). Events: after
- * each accepted step, an event function that crossed in its direction is located on the cubic
- * Hermite extension of the step, then by a safeguarded Newton iteration on re-steps of y of
- * length s from y_n (d g / d s = grad g . f(y(s))) to rounding; the last step, of the located
- * length, advances Phi too. */
+ * y by RODAS4 (pdw_rodas4.c's transformed form, Hairer & Wanner II, Eq. IV.7.4'; the matrix
+ * E = I/(gamma h) - A factored through its 4 x 4 Schur complement, cv_factor). Phi over the
+ * same step by RODAS4 applied to the linear non-autonomous Phi' = A(t) Phi, A(t) = A(y(t)):
+ *     E U_i = A(t_n + alpha_i h) P_i + sum_j (C_ij / h) U_j + gamma_i h A_t Phi_n,
+ * P_i = Phi_n + sum_j a_ij U_j, Phi_{n+1} = Phi_n + sum m_i U_i, with E the same factors, the
+ * stage times alpha_i and sums gamma_i of the original form (cv_stage_times: rodas.f's C_i,
+ * D_i) and A_t = dA[f(y_n)] (dA[u] = sum_j dA/dy_j u_j) a central difference of the kernel's
+ * symbolic Jacobian along f (largest state change dir_step, 1e-7: relative error ~1e-9).
+ * A(t) at the inner stage times (0.21, 0.386, 0.63) comes from the cubic Hermite interpolant of
+ * A between the step's ends (A and A_t at both; a_hermite, the default: 3 Jacobians a step,
+ * each reused by the next step) or from the Jacobian at y's Hermite interpolant (6 a step); the
+ * end times 0 and 1 are exact. Either interpolant is O(h^4): order 4 is kept. (The autonomous
+ * augmented system (y, Phi), whose Jacobian [[A, 0], [dA[.] Phi, A]] needs dA along every
+ * stage increment, took twice the Jacobians for the same accuracy.) With the approach speeds
+ * (na = 2) the columns df/dv_in are central differences of f (step 1e-6 max(1, |v_in|)), as
+ * variational.py's, and their dA[u] a mixed second difference (steps 1e-4).
+ * Steps: the error estimates of y and (phi_error) of Phi, an I controller (h_new = h clamp(0.9
+ * err^(-1/4), 0.2, 6), no increase right after a rejection); without Phi's estimate the stiff
+ * modes that Phi(0) = I and each saltation excite are not resolved (Phi off by 1e-4). Events:
+ * after each accepted step, an event function that crossed in its direction is located on the
+ * cubic Hermite extension of the step, then by a safeguarded Newton iteration on re-steps of y
+ * of length s from y_n (d g / d s = grad g . f(y(s))) to rounding; the last step, of the located
+ * length, advances Phi too.
+ * About 550 lines, one unit: the y step, its Phi companion and the event location share the
+ * step's context (factors, stages, A and A_t at its ends). */
 #include <float.h>
 #include <math.h>
 #include <string.h>
@@ -42,6 +48,8 @@ typedef struct cv_ctx {
     double u[NS][NMAX];         /* stage increments of y of the last attempt */
     double Y[NS][NMAX];         /* its stage points */
     double alpha[NS], gsum[NS]; /* cv_stage_times */
+    double At[NMAX * NMAX];     /* dA[f(y_n)] (a_hermite: kept from the last step's end) */
+    int at_valid;
 } cv_ctx;
 
 static void cv_f(cv_ctx *c, const double *y, double *f)
@@ -92,8 +100,9 @@ static void cv_jac(cv_ctx *c, const double *y, double *A)
     }
 }
 
-/* D = dA[u] at y (n x n): central differences along u */
-static void cv_dA(cv_ctx *c, const pdw_cvar_opts *o, const double *y, const double *u, double *D)
+/* D = dA[u] at y (n x n): central differences along u (one_sided: forward, from Ay = A(y)) */
+static void cv_dA(cv_ctx *c, const pdw_cvar_opts *o, const double *y, const double *Ay,
+                  const double *u, double *D)
 {
     const int n = c->n;
     double umax = 0.0, yp[NMAX], ym[NMAX], Jm[NMAX * NMAX];
@@ -106,7 +115,7 @@ static void cv_dA(cv_ctx *c, const pdw_cvar_opts *o, const double *y, const doub
     if (o->one_sided) {
         for (int i = 0; i < PDW_NX; ++i)
             for (int j = 0; j < PDW_NX; ++j)
-                D[i * n + j] = (D[i * n + j] - c->A[i * n + j]) / eps;
+                D[i * n + j] = (D[i * n + j] - Ay[i * n + j]) / eps;
     } else {
         cv_jac8(c, ym, Jm);
         for (int i = 0; i < PDW_NX; ++i)
@@ -292,7 +301,7 @@ static void cv_stage_times(double *alpha, double *gsum)
 static inline double cv_step_phi_n(cv_ctx *c, const pdw_cvar_opts *o, const double *Phi,
                                    double h, const double *y_n, const double *f_n,
                                    const double *ynew, const double *fnew, double *Phinew,
-                                   double *Anew, const int n)
+                                   double *Anew, double *Atnew, const int n)
 {
     const pdw_ros_tableau *T = &pdw_tableau_rodas4;
     const int nn = n * n;
@@ -300,11 +309,20 @@ static inline double cv_step_phi_n(cv_ctx *c, const pdw_cvar_opts *o, const doub
     double AtP[PDW_NQ * NMAX], yi[NMAX];
     const double ih = 1.0 / h;
     int have_new = 0;
-    cv_dA(c, o, y_n, f_n, D);
+    const double *Dn = D;
+    if (o->a_hermite) {
+        if (!c->at_valid) { cv_dA(c, o, y_n, c->A, f_n, c->At); c->at_valid = 1; }
+        Dn = c->At;
+        cv_jac(c, ynew, Anew);
+        cv_dA(c, o, ynew, Anew, fnew, Atnew);
+        have_new = 1;
+    } else {
+        cv_dA(c, o, y_n, c->A, f_n, D);
+    }
     for (int r = 0; r < PDW_NQ; ++r)
         for (int q = 0; q < n; ++q) {
             double acc = 0.0;
-            for (int k = 0; k < n; ++k) acc += D[(PDW_NQ + r) * n + k] * Phi[k * n + q];
+            for (int k = 0; k < n; ++k) acc += Dn[(PDW_NQ + r) * n + k] * Phi[k * n + q];
             AtP[r * n + q] = h * acc;
         }
     for (int i = 0; i < T->stages; ++i) {
@@ -320,6 +338,18 @@ static inline double cv_step_phi_n(cv_ctx *c, const pdw_cvar_opts *o, const doub
         if (al == 1.0) {
             if (!have_new) { cv_jac(c, ynew, Anew); have_new = 1; }
             A = Anew;
+        } else if (al != 0.0 && o->a_hermite) {
+            /* A's rows 4..7 from its cubic Hermite interpolant (A, dA/dt at both ends) */
+            const double th = al;
+            for (int r = PDW_NQ; r < PDW_NX; ++r)
+                for (int k = 0; k < n; ++k) {
+                    const int e = r * n + k;
+                    const double a0 = c->A[e], a1 = Anew[e];
+                    Ai[e] = (1.0 - th)*a0 + th*a1
+                          + th*(th - 1.0)*((1.0 - 2.0*th)*(a1 - a0) + (th - 1.0)*h*Dn[e]
+                                           + th*h*Atnew[e]);
+                }
+            A = Ai;
         } else if (al != 0.0) {
             cv_hermite(n, y_n, f_n, ynew, fnew, h, al, yi);
             cv_jac(c, yi, Ai);
@@ -350,11 +380,11 @@ static inline double cv_step_phi_n(cv_ctx *c, const pdw_cvar_opts *o, const doub
 
 static double cv_step_phi(cv_ctx *c, const pdw_cvar_opts *o, const double *Phi, double h,
                           const double *y_n, const double *f_n, const double *ynew,
-                          const double *fnew, double *Phinew, double *Anew)
+                          const double *fnew, double *Phinew, double *Anew, double *Atnew)
 {
     return c->n == PDW_NX
-        ? cv_step_phi_n(c, o, Phi, h, y_n, f_n, ynew, fnew, Phinew, Anew, PDW_NX)
-        : cv_step_phi_n(c, o, Phi, h, y_n, f_n, ynew, fnew, Phinew, Anew, NMAX);
+        ? cv_step_phi_n(c, o, Phi, h, y_n, f_n, ynew, fnew, Phinew, Anew, Atnew, PDW_NX)
+        : cv_step_phi_n(c, o, Phi, h, y_n, f_n, ynew, fnew, Phinew, Anew, Atnew, NMAX);
 }
 
 /* event function k at y (shifted) and, if grad is not NULL, its gradient (n) */
@@ -426,10 +456,10 @@ int pdw_cvar_interval(const pdw_cvar_model *m, const pdw_cvar_opts *o, const pdw
     cv_ctx c;
     const int n = PDW_NX + m->na;
     double f_n[NMAX], ynew[NMAX], fnew[NMAX], ys[NMAX], fs[NMAX], grad[NMAX];
-    double Phinew[NMAX * NMAX], Anew[NMAX * NMAX];
+    double Phinew[NMAX * NMAX], Anew[NMAX * NMAX], Atnew[NMAX * NMAX];
     double g_old[PDW_CVAR_MAXEV], g_new[PDW_CVAR_MAXEV];
     int last_rejected = 0;
-    c.m = m; c.st = st; c.work = work; c.n = n; c.lu_h = 0.0;
+    c.m = m; c.st = st; c.work = work; c.n = n; c.lu_h = 0.0; c.at_valid = 0;
     cv_stage_times(c.alpha, c.gsum);
     if (n_ev > PDW_CVAR_MAXEV) n_ev = PDW_CVAR_MAXEV;
     cv_f(&c, y, f_n);
@@ -448,7 +478,7 @@ int pdw_cvar_interval(const pdw_cvar_model *m, const pdw_cvar_opts *o, const pdw
         int phi_done = 0;
         if (err <= 1.0) cv_f(&c, ynew, fnew);
         if (o->phi_error && err <= 1.0) {
-            err = fmax(err, cv_step_phi(&c, o, Phi, hs, y, f_n, ynew, fnew, Phinew, Anew));
+            err = fmax(err, cv_step_phi(&c, o, Phi, hs, y, f_n, ynew, fnew, Phinew, Anew, Atnew));
             phi_done = 1;
         }
         if (!(err <= 1.0)) {
@@ -493,7 +523,7 @@ int pdw_cvar_interval(const pdw_cvar_model *m, const pdw_cvar_opts *o, const pdw
             /* the factors in c are those of the step of length s_done (the last cv_step_y) */
             s = s_done;
             cv_f(&c, ys, fs);
-            cv_step_phi(&c, o, Phi, s, y, f_n, ys, fs, Phinew, Anew);
+            cv_step_phi(&c, o, Phi, s, y, f_n, ys, fs, Phinew, Anew, Atnew);
             memcpy(y, ys, (size_t)n * sizeof(double));
             memcpy(Phi, Phinew, (size_t)(n * n) * sizeof(double));
             *t += s;
@@ -502,7 +532,7 @@ int pdw_cvar_interval(const pdw_cvar_model *m, const pdw_cvar_opts *o, const pdw
             st->n_steps++;
             return PDW_CVAR_EVENT;
         }
-        if (!phi_done) cv_step_phi(&c, o, Phi, hs, y, f_n, ynew, fnew, Phinew, Anew);
+        if (!phi_done) cv_step_phi(&c, o, Phi, hs, y, f_n, ynew, fnew, Phinew, Anew, Atnew);
         memcpy(y, ynew, (size_t)n * sizeof(double));
         memcpy(Phi, Phinew, (size_t)(n * n) * sizeof(double));
         for (int i = 0; i < n; ++i)
@@ -512,6 +542,7 @@ int pdw_cvar_interval(const pdw_cvar_model *m, const pdw_cvar_opts *o, const pdw
         memcpy(g_old, g_new, sizeof g_old);
         memcpy(f_n, fnew, (size_t)n * sizeof(double));
         memcpy(c.A, Anew, (size_t)(n * n) * sizeof(double));
+        if (o->a_hermite) memcpy(c.At, Atnew, (size_t)(n * n) * sizeof(double));
         c.lu_h = 0.0;
         hh = h_next;
         *h = hh;

@@ -54,6 +54,9 @@ typedef struct pdw_cvar_opts {
     double dir_step;            /* largest state change of the difference quotient of A along
                                  * a stage increment (the directional derivative dA[u]) */
     int phi_error;              /* 1: Phi's error estimate controls the step too */
+    int a_hermite;              /* 1: A at the inner stage times from its cubic Hermite
+                                 * interpolant (A and dA/dt at the step's ends) instead of the
+                                 * Jacobian at y's interpolant: 3 Jacobians a step, not 6 */
     int one_sided;              /* 1: dA[u] by a forward difference from A(y_n) (half the
                                  * Jacobians of the central one) */
     long max_steps;
