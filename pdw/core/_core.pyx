@@ -701,6 +701,7 @@ def _real_states(x, bint allow_rows, int nx=PDW_NX):
 # --- the model object for external solvers (pdw.ode_function) ----------------------------
 
 include "_ode.pxi"
+include "_cvar.pxi"
 
 
 @_named_buffers

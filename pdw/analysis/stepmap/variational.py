@@ -43,9 +43,28 @@ rest. LuGre friction is refused: its kernel's Jacobian is itself a central diffe
 exact) and its bristle states reset at touch-down; use finite differences there.
 
 Scope: the paper variant (the consistent variant's tangential anchors are not differentiated).
-Slower than the finite differences (one Python integration of 72 equations, 110 with approach
-speeds; benchmarks/bench_monodromy.py), so not the continuation's default: it is the
-cross-check of `GaitMap.crosscheck` and of a user's doubts near a kink.
+
+Two engines integrate each interval between events (``engine=``); the flag logic and the
+saltation matrices above are this module's, shared by both:
+
+* ``"compiled"`` (default; pdw/core/csrc/pdw_cvar.c, `pdw.core._core.cvar_interval`): x by
+  RODAS4 (rtol, atol) and Phi by RODAS4 on the linear non-autonomous Phi' = A(x(t)) Phi along
+  x's step (its f_t term dA/dt = dA[f] a central difference of the symbolic Jacobian along f;
+  A at the inner stage times from its cubic Hermite interpolant between the step's ends, A and
+  dA/dt there: 3 Jacobians a step), Phi's error estimate controlling the steps too
+  (`PHI_TOL`); the events located in C to rounding (Newton on re-steps).
+* ``"python"``: SciPy's Radau (rtol 1e-10) with the event functions, then LSODA for (x, Phi)
+  (``phi_rtol``): the reference.
+
+They agree to 2e-8 on paper_steady's multipliers (2e-9 at rtol 1e-12, phi_rtol 1e-10), to
+~1e-7 for the other laws, to 2e-5 for Kelvin-Voigt's calibrated gait, whose rises' saltations
+move by 1e-3 with a 1e-11 s shift of the event (the Python version itself moves by 2.5e-5
+between rtol 1e-10 and 1e-11). Cost (benchmarks/bench_monodromy.py, CPU): compiled 0.16-0.5 x
+the finite differences (13-15 maps through the ensemble engine), Python 6-26 x; a branch point
+of `continue_gait` with the exact M costs 1.06 x the differences' for the default law (their 12
+extra maps ride almost free in the engine's lanes) and 0.35 x for flores. Not the
+continuation's default (the lead's decision); it is the cross-check of `GaitMap.crosscheck` and
+of a user's doubts near a kink.
 """
 from __future__ import annotations
 
@@ -53,6 +72,7 @@ import math
 
 import numpy as np
 
+from ...core import _core  # type: ignore[attr-defined]  # compiled
 from ...core.contact import Contact
 from ...core.errors import InvalidInputError
 from ...core.ode import ode_function
@@ -195,10 +215,78 @@ def _saltation(F, y, grad_x, h, change):
     return S, y_plus
 
 
+def _specs(flags, pending, armed, gate_dir):
+    """The compiled engine's event list (kind, leg, direction), slot for slot as the lambdas
+    of `step_jacobian`'s loop (pdw_cvar.h's PDW_CVAR_EV_* codes)."""
+    out = []
+    for leg in (0, 1):
+        if flags[leg] and pending[leg]:
+            out.append((_EV_RATE, leg, 1.0))
+        elif flags[leg] or armed[leg]:
+            out.append((_EV_HEIGHT, leg, 1.0 if flags[leg] else -1.0))
+        else:
+            out.append((_EV_AHEAD, leg, 1.0))
+    for leg in (0, 1):
+        out.append((_EV_THETA if flags[leg] else _EV_NONE, leg, gate_dir[leg]))
+    for leg in (0, 1):
+        out.append((_EV_HEIGHT if pending[leg] else _EV_NONE, leg, -1.0))
+    return out
+
+
+#: pdw_cvar.h's event kinds
+_EV_NONE, _EV_HEIGHT, _EV_RATE, _EV_AHEAD, _EV_THETA = range(5)
+
+
+#: the compiled engine's tolerance of Phi (relative and absolute; `step_jacobian`'s
+#: ``phi_rtol``): its error estimate controls the steps too, else the stiff modes that Phi(0) = I
+#: and every saltation excite (and x does not) are not resolved (x's control alone: Phi off by
+#: 1e-4 over paper_steady's double support)
+PHI_TOL = 1e-8
+
+
+def _compiled_interval(F, p, specs, t0, y, Phi, h, t_max, rtol, atol, phi_tol):
+    """(t_ev, k_ev, next step): y and Phi advanced in place to the first event (pdw_cvar.c)."""
+    rc, t_ev, k_ev, h = _core.cvar_interval(F.f, p.l, p.r, F.na, specs, t0, y, Phi, h, t_max,
+                                            rtol=rtol, atol=atol, phi_rtol=phi_tol,
+                                            phi_atol=phi_tol, phi_error=True, a_hermite=True)
+    if rc == 1:
+        raise InvalidInputError("variational step_jacobian: no touch-down by t_max = %g s"
+                                % t_max)
+    if rc != 0:
+        raise InvalidInputError("variational step_jacobian: integration failed at t = %.6g s "
+                                "(%s)" % (t_ev, "step size below rounding or a non-finite "
+                                          "state" if rc == -1 else "step budget spent"))
+    return t_ev, k_ev, h
+
+
+def _python_interval(F, aug_rhs, evs, t0, y, Phi, t_max, rtol, atol, phi_rtol):
+    """(t_ev, k_ev, y, Phi) at the first event: Radau for x, then LSODA for (x, Phi)."""
+    from scipy.integrate import solve_ivp
+    n = F.n
+    sol = solve_ivp(F, (t0, t_max), y, method="Radau", rtol=rtol, atol=atol, jac=F.jac,
+                    events=evs)
+    if sol.status == -1:
+        raise InvalidInputError("variational step_jacobian: integration failed: %s"
+                                % sol.message)
+    hits = [(te[0], k) for k, te in enumerate(sol.t_events) if len(te) and te[0] > t0]
+    if not hits:
+        raise InvalidInputError("variational step_jacobian: no touch-down by t_max = %g s"
+                                % t_max)
+    t_ev, k_ev = min(hits)
+    y_ev = sol.y_events[k_ev][0].copy()
+    # the variational equations along this interval
+    ph = solve_ivp(aug_rhs, (t0, t_ev), np.concatenate([y, Phi.ravel()]),
+                   method="LSODA", rtol=phi_rtol, atol=phi_rtol * 1e-2)
+    if ph.status != 0:
+        raise InvalidInputError("variational step_jacobian: variational equations "
+                                "failed: %s" % ph.message)
+    return t_ev, k_ev, y_ev, ph.y[n:, -1].reshape(n, n).copy()
+
+
 def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
                   contact=None, rtol: float = 1e-10, atol: float = 1e-12,
-                  phi_rtol: float = 1e-10, t_max: float = 2.5,
-                  max_events: int = 12) -> dict:
+                  phi_rtol: float | None = None, t_max: float = 2.5,
+                  max_events: int = 12, engine: str = "compiled") -> dict:
     """One step of the touch-down map and its exact Jacobian (module docstring).
 
     Parameters
@@ -215,8 +303,14 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
         friction raises `pdw.InvalidInputError`.
     rtol, atol : float
         Radau tolerances of the trajectory x.
-    phi_rtol : float
-        LSODA's relative tolerance of (x, Phi) (absolute: 1e-2 of it).
+    phi_rtol : float, optional
+        The tolerance of Phi: ``engine="python"``, LSODA's relative tolerance of (x, Phi)
+        (absolute: 1e-2 of it; default 1e-10); ``"compiled"``, the relative and absolute
+        tolerance of Phi's error estimate (default `PHI_TOL`).
+    engine : {"compiled", "python"}
+        ``"compiled"`` (default): x and Phi together by RODAS4 in C (pdw/core/csrc/pdw_cvar.c,
+        `rtol`, `atol` on x), the events located there; ``"python"``: SciPy's Radau for x and
+        LSODA for (x, Phi), the reference (module docstring).
 
     Returns
     -------
@@ -226,7 +320,9 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
         n = 8, or 10 with approach speeds), ``x`` (the state at the touch-down, legs not
         relabelled), ``dx_dz`` (n, nz) and ``Phi`` (n, n).
     """
-    from scipy.integrate import solve_ivp
+    if engine not in ("compiled", "python"):
+        raise InvalidInputError("variational step_jacobian: engine must be 'compiled' or "
+                                "'python', got %r" % (engine,))
     if variant != "paper":
         raise InvalidInputError("variational step_jacobian: only variant='paper', got %r"
                                 % (variant,))
@@ -284,6 +380,7 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
             return leg if on else None
         return change
 
+    h_next = 1e-4             # the compiled engine's first trial step [s]
     for _ in range(max_events):
         evs = []
         for leg in (0, 1):
@@ -301,26 +398,14 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
         for leg in (0, 1):          # a pending foot back into the ground: contact again
             evs.append(_event(lambda t, xx, leg=leg, on=pending[leg]:
                               _foot(xx, leg, p)[0] if on else 1.0, -1.0))
-        y_start = y.copy()
-        sol = solve_ivp(F, (t0, t_max), y, method="Radau", rtol=rtol, atol=atol, jac=F.jac,
-                        events=evs)
-        if sol.status == -1:
-            raise InvalidInputError("variational step_jacobian: integration failed: %s"
-                                    % sol.message)
-        hits = [(te[0], k) for k, te in enumerate(sol.t_events) if len(te) and te[0] > t0]
-        if not hits:
-            raise InvalidInputError("variational step_jacobian: no touch-down by t_max = %g s"
-                                    % t_max)
-        t_ev, k_ev = min(hits)
-        y = sol.y_events[k_ev][0].copy()
+        if engine == "compiled":
+            t_ev, k_ev, h_next = _compiled_interval(
+                F, p, _specs(flags, pending, armed, gate_dir), t0, y, Phi, h_next, t_max, rtol,
+                atol, PHI_TOL if phi_rtol is None else phi_rtol)
+        else:
+            t_ev, k_ev, y, Phi = _python_interval(F, aug_rhs, evs, t0, y, Phi, t_max, rtol,
+                                                  atol, 1e-10 if phi_rtol is None else phi_rtol)
         leg = k_ev % 2
-        # the variational equations along this interval
-        ph = solve_ivp(aug_rhs, (t0, t_ev), np.concatenate([y_start, Phi.ravel()]),
-                       method="LSODA", rtol=phi_rtol, atol=phi_rtol * 1e-2)
-        if ph.status != 0:
-            raise InvalidInputError("variational step_jacobian: variational equations "
-                                    "failed: %s" % ph.message)
-        Phi = ph.y[n:, -1].reshape(n, n)
         t0 = t_ev
         if k_ev >= 4 or (k_ev < 2 and flags[leg] and pending[leg]):
             # a pending foot's normal rate through 0 (the lift-off, Eq. 18a: the flag-gated
