@@ -29,6 +29,7 @@ cdef extern from "pdw_cvar.h":
                           double *h, int *k_ev, pdw_cvar_stats *st, double *work) noexcept nogil
 
 
+@_named_buffers
 def cvar_interval(OdeFunction f not None, double l, double r, int na, events, double t,
                   double[::1] y, double[:, ::1] Phi, double h, double t_max, *,
                   double rtol=1e-10, double atol=1e-12, double phi_rtol=1e-10,
