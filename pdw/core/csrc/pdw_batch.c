@@ -402,12 +402,27 @@ static void soa_round(pdw_lanes *L)
     const soa_loop *c = L->ctx;
     pdw_soa_state *S = c->S;
     const pdw_batch_job *job = L->job;
-    c->stepfn(c->kernel, S, L->W, job->opt.dt, job->opt.max_speed, c->vector);
-    for (int l = 0; l < L->W; ++l) {
+    const int W = L->W;
+    long committed = 0;     /* into L->lane_steps once (a long that the stores to s may alias) */
+    c->stepfn(c->kernel, S, W, job->opt.dt, job->opt.max_speed, c->vector);
+    for (int l = 0; l < W; ++l) {
         if (L->walker[l] < 0) continue;
         pdw_sim *s = &L->sims[l];
         int more;
-        if (S->rare[l]) {
+        if (!S->rare[l]) {
+            /* the common case: commit the step */
+            const long n = s->n + 1;
+            s->n = n;
+            s->t = n * s->opt.dt;
+            s->n_rhs++;
+            committed++;
+            S->upd[l] = 1;
+            if (n < s->opt.n_steps) continue;
+            /* final flags at t_end (scalar trig), as step() */
+            soa_store(S, l, s);
+            if (pdw_update_flags(s, n * s->opt.dt) == 0) s->status = PDW_STATUS_DONE;
+            more = 0;
+        } else {
             /* the scalar step from the same state and trig: it takes the event, the fall
              * or the failure exactly as pdw_cdm_advance */
             soa_store(S, l, s);
@@ -415,21 +430,10 @@ static void soa_round(pdw_lanes *L)
                 s->work[PDW_WORK_TRIG + j] = S->trig[j*PDW_SOA_STRIDE + l];
             more = step(s);
             if (more) soa_load(S, l, s);
-        } else {
-            s->n++;
-            s->t = s->n * s->opt.dt;
-            s->n_rhs++;
-            L->lane_steps++;
-            S->upd[l] = 1;
-            more = s->n < s->opt.n_steps;
-            if (!more) {
-                /* final flags at t_end (scalar trig), as step() */
-                soa_store(S, l, s);
-                if (pdw_update_flags(s, s->n * s->opt.dt) == 0) s->status = PDW_STATUS_DONE;
-            }
         }
         if (!more) pdw_lanes_retire(L, l);
     }
+    L->lane_steps += committed;
 }
 
 static const pdw_lane_ops soa_ops = {soa_start, soa_round, soa_begin, soa_park};
