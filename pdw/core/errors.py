@@ -76,6 +76,6 @@ class StepSizeWarning(UserWarning):
 class PdwDeprecationWarning(DeprecationWarning):
     """A spelling of before that still works for one release: an old keyword or positional
     argument of `pdw.simulate` / `pdw.simulate_batch`, a scene key that moved, an old import
-    path of `pdw.analysis`. The message names the new spelling. A `DeprecationWarning`, so
+    path of ``pdw.analysis``. The message names the new spelling. A `DeprecationWarning`, so
     ``-W error::DeprecationWarning`` catches it; its own class lets a program (or pdw's own
     tests) turn pdw's deprecations into errors without a third party's."""

@@ -132,7 +132,7 @@ def continue_gait(params: Params, parameter: str, stop: float, *,
         The walker at the start (``parameter`` at its value there, or ``value``).
     parameter : str
         A `Params` field; with the continuous model also a parameter of the contact law,
-        ``"contact.<name>"`` (`pdw.Contact.axes`: ``contact.k``, ``contact.d`` (hunt_crossley,
+        ``"contact.<name>"`` (``pdw.Contact.axes()``: ``contact.k``, ``contact.d`` (hunt_crossley,
         kelvin_voigt), ``contact.e``, ``contact.v_in_min`` (lankarani_nikravesh, flores),
         LuGre's ``contact.sigma0`` ... ``contact.v_s``), applied to ``options["contact"]``
         (default the paper's law: its k, d start at ``Params.k_n``, ``d_n``); or any name when
