@@ -8,8 +8,11 @@ One step of the touch-down map (`pdw.analysis.stepmap.poincare.step`) from secti
                        g_i = y_o - r - (l - r) cos(theta_i) > 0 AND its normal rate v_i (the
                        paper's Eq. 5) > 0: where g_i passes 0 first, the foot stays support,
                        without penetration force, until v_i passes 0 (or g_i returns below 0);
-                       touch-down: a swing foot's height through 0 downwards while ahead of
-                       the other foot), and
+                       touch-down, Eq. 18b: an armed swing foot's height g_i < 0 AND v_i < 0
+                       (armed: above the ground while ahead of the other foot); where g_i
+                       passes 0 downwards with v_i >= 0 (the paper's v_i is not dg_i/dt) the
+                       foot stays swing, without forces, until v_i passes 0 (or g_i returns
+                       above 0)), and
     z' = R x(T)        at leg 1's touch-down (`section_coordinates(x, leg=1)`: relabelled).
 
 Its Jacobian is M = R S_T Phi(T) E with Phi' = A(x(t)) Phi (A = df/dx, `pdw.ode_function`'s
@@ -19,7 +22,8 @@ Its Jacobian is M = R S_T Phi(T) E with Phi' = A(x(t)) Phi (A = df/dx, `pdw.ode_
 
 (f- and f+ the vector fields before and after, the identity where the force law is continuous
 at zero penetration, as Hunt-Crossley is), and at the section event the projection
-S_T = I - f grad g1^T / (grad g1 . f) (the derivative of the touch-down time). x is integrated
+S_T = I - f grad g1^T / (grad g1 . f) (the derivative of the touch-down time; grad v1
+for v1 instead where the touch-down is v1's crossing). x is integrated
 by SciPy's Radau (rtol 1e-10) with the event functions (flag switches, the swing foot's
 arming, Eq. 11's gates), then (x, Phi) from each interval's start to its end by LSODA
 (``phi_rtol``). f jumps where a support foot's penetration reaches 0 (the tangential
@@ -65,6 +69,9 @@ of `continue_gait` with the exact M costs 1.06 x the differences' for the defaul
 extra maps ride almost free in the engine's lanes) and 0.35 x for flores. Not the
 continuation's default (the lead's decision); it is the cross-check of `GaitMap.crosscheck` and
 of a user's doubts near a kink.
+
+Over 500 lines: Eq. 18's flag rules, the saltations and the event loop that both engines share
+belong together (split, each part would read the others' state).
 """
 from __future__ import annotations
 
@@ -215,13 +222,15 @@ def _saltation(F, y, grad_x, h, change):
     return S, y_plus
 
 
-def _specs(flags, pending, armed, gate_dir):
+def _specs(flags, pending, armed, gate_dir, sunk):
     """The compiled engine's event list (kind, leg, direction), slot for slot as the lambdas
     of `step_jacobian`'s loop (pdw_cvar.h's PDW_CVAR_EV_* codes)."""
     out = []
     for leg in (0, 1):
         if flags[leg] and pending[leg]:
             out.append((_EV_RATE, leg, 1.0))
+        elif not flags[leg] and sunk[leg]:
+            out.append((_EV_RATE, leg, -1.0))
         elif flags[leg] or armed[leg]:
             out.append((_EV_HEIGHT, leg, 1.0 if flags[leg] else -1.0))
         else:
@@ -229,7 +238,10 @@ def _specs(flags, pending, armed, gate_dir):
     for leg in (0, 1):
         out.append((_EV_THETA if flags[leg] else _EV_NONE, leg, gate_dir[leg]))
     for leg in (0, 1):
-        out.append((_EV_HEIGHT if pending[leg] else _EV_NONE, leg, -1.0))
+        if pending[leg] or sunk[leg]:
+            out.append((_EV_HEIGHT, leg, 1.0 if sunk[leg] else -1.0))
+        else:
+            out.append((_EV_NONE, leg, -1.0))
     return out
 
 
@@ -286,7 +298,7 @@ def _python_interval(F, aug_rhs, evs, t0, y, Phi, t_max, rtol, atol, phi_rtol):
 def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
                   contact=None, rtol: float = 1e-10, atol: float = 1e-12,
                   phi_rtol: float | None = None, t_max: float = 2.5,
-                  max_events: int = 12, engine: str = "compiled") -> dict:
+                  max_events: int = 40, engine: str = "compiled") -> dict:
     """One step of the touch-down map and its exact Jacobian (module docstring).
 
     Parameters
@@ -307,6 +319,9 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
         The tolerance of Phi: ``engine="python"``, LSODA's relative tolerance of (x, Phi)
         (absolute: 1e-2 of it; default 1e-10); ``"compiled"``, the relative and absolute
         tolerance of Phi's error estimate (default `PHI_TOL`).
+    max_events : int
+        The most intervals between events in one step (a bouncing support foot, as Hertz's
+        at k_n = 1e6, rises and re-enters ~15 times a step).
     engine : {"compiled", "python"}
         ``"compiled"`` (default): x and Phi together by RODAS4 in C (pdw/core/csrc/pdw_cvar.c,
         `rtol`, `atol` on x), the events located there; ``"python"``: SciPy's Radau for x and
@@ -363,6 +378,10 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
     # a support foot above the ground whose normal rate is not yet > 0: Eq. 18a lifts it off
     # only when v > 0 too, so until then it stays support (flag 1) with no penetration force
     pending = [False, False]
+    # an armed swing foot below the ground whose normal rate is not yet < 0: Eq. 18b touches
+    # it down only when v < 0 too (the paper's v is not the height's rate), so until then it
+    # stays swing, without forces, until v passes 0 (touch-down) or g returns above 0
+    sunk = [False, False]
     # the trailing foot may start above the ground, still sinking (v <= 0): a damped law that
     # pulls no force (Kelvin-Voigt's clamp) let it rise before the section; the loop keeps it
     # support until v > 0, so it starts pending
@@ -386,6 +405,8 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
         for leg in (0, 1):
             if flags[leg] and pending[leg]:     # Eq. 18a's second condition, v through 0
                 evs.append(_event(lambda t, xx, leg=leg: _rate(xx, leg, p)[0], 1.0))
+            elif not flags[leg] and sunk[leg]:  # Eq. 18b's second condition, v through 0
+                evs.append(_event(lambda t, xx, leg=leg: _rate(xx, leg, p)[0], -1.0))
             elif flags[leg] or armed[leg]:
                 evs.append(_event(lambda t, xx, leg=leg: _foot(xx, leg, p)[0],
                                   1.0 if flags[leg] else -1.0))
@@ -395,18 +416,25 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
         for leg in (0, 1):          # Eq. 11's gate: the tangential damper acts while xi <= 0
             evs.append(_event(lambda t, xx, leg=leg, on=flags[leg]: xx[2 + leg] if on else 1.0,
                               gate_dir[leg]))
-        for leg in (0, 1):          # a pending foot back into the ground: contact again
-            evs.append(_event(lambda t, xx, leg=leg, on=pending[leg]:
-                              _foot(xx, leg, p)[0] if on else 1.0, -1.0))
+        for leg in (0, 1):          # a pending foot back into the ground: contact again;
+            # a sunk foot back above it: armed again for its next height crossing
+            d_back = 1.0 if sunk[leg] else -1.0
+            evs.append(_event(lambda t, xx, leg=leg, on=pending[leg] or sunk[leg], d=d_back:
+                              _foot(xx, leg, p)[0] if on else d, d_back))
         if engine == "compiled":
             t_ev, k_ev, h_next = _compiled_interval(
-                F, p, _specs(flags, pending, armed, gate_dir), t0, y, Phi, h_next, t_max, rtol,
+                F, p, _specs(flags, pending, armed, gate_dir, sunk), t0, y, Phi, h_next, t_max, rtol,
                 atol, PHI_TOL if phi_rtol is None else phi_rtol)
         else:
             t_ev, k_ev, y, Phi = _python_interval(F, aug_rhs, evs, t0, y, Phi, t_max, rtol,
                                                   atol, 1e-10 if phi_rtol is None else phi_rtol)
         leg = k_ev % 2
         t0 = t_ev
+        if k_ev >= 4 and sunk[leg]:
+            # a sunk swing foot back above the ground before its rate turned negative: no
+            # flag switch, f unchanged (a swing foot has no forces), no saltation
+            sunk[leg] = False
+            continue
         if k_ev >= 4 or (k_ev < 2 and flags[leg] and pending[leg]):
             # a pending foot's normal rate through 0 (the lift-off, Eq. 18a: the flag-gated
             # forces stop) or its height back through 0 (the penetration force returns)
@@ -436,7 +464,17 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
         if not flags[leg] and not armed[leg]:       # armed: no flag switch, no saltation
             armed[leg] = True
             continue
-        h, grad, _ = _foot(y, leg, p)
+        if not flags[leg] and sunk[leg]:
+            # the sunk foot's normal rate through 0 downwards: the touch-down (Eq. 18b) on
+            # the surface v = 0
+            sunk[leg] = False
+            h, grad = _rate(y, leg, p)
+        else:
+            h, grad, _ = _foot(y, leg, p)
+            if not flags[leg] and _rate(y, leg, p)[0] >= 0.0:
+                # below the ground but not moving down (Eq. 18b wants v < 0): still swing
+                sunk[leg] = True
+                continue
         if not flags[leg] and leg == 0:
             # leg 1's touch-down ahead of leg 2: the section (the projection S_T; the flags
             # and leg 1's approach speed after it are the next step's)
