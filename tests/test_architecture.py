@@ -182,10 +182,9 @@ def test_old_keyword_warns_and_maps_to_its_field(old):
 
 
 def test_an_unasserted_deprecation_is_an_error_in_the_tests():
-    """tests/conftest.py makes a deprecation of pdw that a test does not assert an error (here
-    an old keyword, which warns and runs outside the tests), not a third party's
-    DeprecationWarning; the files it still exempts exist, and this file is not one of them."""
-    import conftest
+    """pyproject.toml's filterwarnings makes a deprecation of pdw that a test does not assert
+    an error (here an old keyword, which warns and runs outside the tests), not a third
+    party's DeprecationWarning."""
     with pytest.raises(pdw.PdwDeprecationWarning,
                        match=r"simulate\(record_every=\.\.\.\) is deprecated"):
         pdw.simulate(t_end=0.01, record_every=0)
@@ -194,9 +193,6 @@ def test_an_unasserted_deprecation_is_an_error_in_the_tests():
     assert [w.category for w in rec] == [DeprecationWarning]
     with pytest.warns(DeprecationWarning, match=r"write record=pdw\.Record\(every=\.\.\.\)"):
         assert len(pdw.simulate(t_end=0.01, record_every=0).t) == 0
-    assert all((conftest.TESTS / path).is_file() for path in conftest.STILL_LEGACY)
-    assert pathlib.Path(__file__).resolve().relative_to(conftest.TESTS).as_posix() \
-        not in conftest.STILL_LEGACY
 
 
 def _by_position(rec):
