@@ -215,7 +215,8 @@ def _system(J, nz):
 
 
 #: the largest relative difference of the exact and the finite-difference norms that passes
-#: quietly (measured at paper_steady: 2e-7 at fd_step 1e-6; docs/robustness.md)
+#: quietly (measured at paper_steady: 8.2e-5 at fd_step 1e-6, 1.1e-5 at 1e-5, the differences'
+#: noise; a kink within the step gives ~1e-1; docs/robustness.md)
 REL_CHECK = 1e-3
 
 
@@ -253,7 +254,8 @@ def gait_sensitivity(params, names, *, gait=None, method="exact", check=True, fd
                     if method == "exact" else "the finite-difference norms at steps %g and %g"
                     % (fd_step, h2))
             warnings.warn("gait_sensitivity (continuous): %s differ by %.2g (relative): the "
-                          "linearization is not resolved" % (what, rel), stacklevel=3)
+                          "linearization is not resolved (or the map has a kink within the "
+                          "step)" % (what, rel), stacklevel=3)
     per = {n: _rb.h2_norm(A, B, C[i:i + 1], D[i:i + 1]) for i, n in enumerate(names)}
     return _rb.GaitSensitivity(norm=norm, per_indicator=per, indicators=tuple(names), A=A, B=B,
                                C=C, D=D, method=method, check=chk, gait=gait)
