@@ -216,7 +216,7 @@ def _system(J, nz):
 
 #: the largest relative difference of the exact and the finite-difference norms that passes
 #: quietly (measured at paper_steady: 8.2e-5 at fd_step 1e-6, 1.1e-5 at 1e-5, the differences'
-#: noise; a kink within the step gives ~1e-1; docs/robustness.md)
+#: noise; docs/robustness.md)
 REL_CHECK = 1e-3
 
 
