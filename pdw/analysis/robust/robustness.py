@@ -327,7 +327,7 @@ def _fd_system(params, y0, names, h, opts):
 
 
 def gait_sensitivity(params=None, *, indicators=("step_time",), model="hybrid", gait=None,
-                     fd_step=1e-6, check=True, **options) -> GaitSensitivity:
+                     method="exact", fd_step=1e-6, check=True, **options) -> GaitSensitivity:
     """The gait sensitivity norm (Hobbelen & Wisse 2007) of the period-one gait.
 
     The disturbance e is a floor-height change [m] at one step (the ground under the landing
@@ -344,14 +344,25 @@ def gait_sensitivity(params=None, *, indicators=("step_time",), model="hybrid", 
     model : {"hybrid", "continuous"}
         ``"hybrid"``: A, B, C, D exact (variational equations of the stance, the saltation of
         the heel strike, the impact map's derivative: ``pdw.core._hybrid.step_sens``), checked
-        against central differences. ``"continuous"``: see docs/robustness.md (needs a Ground).
+        against central differences. ``"continuous"``: the touch-down map's variational
+        equations with the ground heights under the trailing and the landing foot as
+        parameters (`pdw.analysis.stepmap.variational_ground`), in the section coordinates
+        augmented by the previous step's floor change (docs/robustness.md, "The compliant
+        model"); indicators step_time, step_length, speed.
     gait : Gait, optional
+    method : {"exact", "fd"}
+        ``"exact"`` (default): the linearization above; ``"fd"``: central differences of the
+        step map of step ``fd_step`` (the continuous model's cross-checked at fd_step / 2).
     fd_step : float
-        Step of the finite-difference cross-check (state and dh).
+        Step of the finite differences (state and floor height) [m, rad, m/s, rad/s].
     check : bool
-        Compute the finite-difference cross-check (``.check``).
+        Compute the finite-difference cross-check of the exact linearization (``.check``: its
+        norm and the relative difference; the continuous model warns above
+        ``robustness_continuous.REL_CHECK`` = 1e-3).
     options
-        Hybrid step-map options (default rtol = atol = 1e-12 here).
+        Hybrid step-map options (default rtol = atol = 1e-12 here); continuous: options of
+        `pdw.analysis.stepmap.poincare.step` (the differences' map; ``contact`` and
+        ``variant`` also the exact one's: the paper variant, Coulomb friction).
 
     Returns
     -------
@@ -365,9 +376,11 @@ def gait_sensitivity(params=None, *, indicators=("step_time",), model="hybrid", 
     for n in names:
         checks.choice("indicators", n, INDICATORS)
     fd_step = checks.number("fd_step", fd_step, lo=0.0, lo_open=True)
+    method = checks.choice("method", method, ("exact", "fd"))
     if model == "continuous":
         from . import robustness_continuous as _rc
-        return _rc.gait_sensitivity(params, names, gait=gait, fd_step=fd_step, **options)
+        return _rc.gait_sensitivity(params, names, gait=gait, method=method, check=check,
+                                    fd_step=fd_step, **options)
     opts = {**_hy._TIGHT, **_hy._options(options)}
     if opts.get("dh", 0.0) != 0.0:
         raise InvalidInputError("gait_sensitivity linearizes about dh = 0; do not pass dh")
@@ -379,10 +392,13 @@ def gait_sensitivity(params=None, *, indicators=("step_time",), model="hybrid", 
     B = _hybrid.impact_jac(p, np.ascontiguousarray(res["y_minus"])) @ ydh
     C, D = _indicator_rows(params, names, res, DP, Ym, ydh, Tg, Tdh, B)
     A = DP
+    if method == "fd":
+        A, Bf, C, D = _fd_system(params, gait.state, names, fd_step, opts)
+        B, check = Bf[:, 0], False
     if max(abs(np.asarray(gait.multipliers))) >= 1.0:        # unstable: infinite norm
         inf = {n: math.inf for n in names}
         return GaitSensitivity(norm=math.inf, per_indicator=inf, indicators=names, A=A,
-                               B=B[:, None], C=C, D=D, method="exact", gait=gait)
+                               B=B[:, None], C=C, D=D, method=method, gait=gait)
     norm = h2_norm(A, B[:, None], C, D)
     per = {n: h2_norm(A, B[:, None], C[i:i + 1], D[i:i + 1]) for i, n in enumerate(names)}
     chk = {}
@@ -392,7 +408,7 @@ def gait_sensitivity(params=None, *, indicators=("step_time",), model="hybrid", 
         chk = {"fd_norm": fd, "rel_diff": abs(fd - norm) / max(abs(norm), 1e-300),
                "fd_step": fd_step}
     return GaitSensitivity(norm=norm, per_indicator=per, indicators=names, A=A,
-                           B=B[:, None], C=C, D=D, method="exact", check=chk, gait=gait)
+                           B=B[:, None], C=C, D=D, method=method, check=chk, gait=gait)
 
 
 def disturbance_response(params=None, *, e=1e-5, n_steps=200, indicators=("step_time",),

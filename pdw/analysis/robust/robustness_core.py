@@ -96,12 +96,15 @@ class GaitSensitivity:
     indicators : tuple of str
     A, B, C, D : ndarray
         The linearized step map x(k+1) = A x(k) + B e(k), g(k) = C x(k) + D e(k) (state: the
-        hybrid model's post-impact state, 4).
+        hybrid model's post-impact state, 4; the continuous model's section point and the
+        previous step's floor change e_prev, 6 + 1, or 7 + 1 with approach speeds).
     method : str
-        "exact" (variational equations, saltation, impact derivative) or "fd".
+        "exact" (variational equations, saltations; the hybrid model's impact derivative) or
+        "fd" (central differences).
     check : dict
-        The cross-check: the norm from central differences of the step map (``fd_norm``) and
-        their largest relative difference (``rel_diff``).
+        The cross-check: the norm from central differences of the step map (``fd_norm``; with
+        ``method="fd"`` on the continuous model ``fd_norm_half_step``) and their relative
+        difference (``rel_diff``), the step (``fd_step``); empty with ``check=False``.
     gait : Gait
     """
 

@@ -145,6 +145,11 @@ class _Field:
     def __init__(self, f, na, params):
         self.f, self.na, self.n, self.params = f, na, N + na, params
         self.flags = [1, 1]
+        self.n_par = 0      # constant parameters after x and v_in (variational_ground's)
+
+    def height_grad(self, leg):
+        """d(leg's height event)/d(the parameters) (n_par,): none here (a subclass's hook)."""
+        return np.zeros(self.n_par)
 
     def _set(self, y):
         if self.na:
@@ -196,19 +201,23 @@ def _across(y, grad, h, side):
     return yy
 
 
-def _saltation(F, y, grad_x, h, change):
+def _saltation(F, y, grad_x, h, change, height_leg=None):
     """(S, y+) at a switching surface h = 0 with gradient ``grad_x`` (8,) at y (h: its value
     at y, ~0): ``change()`` applies the discrete change (flags; returns the touch-down leg
     whose approach speed resets, or None). S = D + (f+ - D f-) grad^T / (grad . f-), D the
     reset's Jacobian (the identity but for a reset v_in_i = -v_i(x)); f- and f+ the one-sided
     limits (`LIMIT_OFFSET`: f at the surface itself is neither side's). The side a state is
-    on before the event is the sign of -grad . f (the crossing direction)."""
+    on before the event is the sign of -grad . f (the crossing direction). ``height_leg``:
+    the surface is that leg's height (its parameter part, `_Field.height_grad`, enters grad).
+    """
     n = F.n
     fy = F(0.0, y)
     d = 1.0 if grad_x @ fy[:N] > 0 else -1.0      # crossing upwards (h: - to +) or down
     f_minus = F(0.0, _across(y, grad_x, h, -d))
     grad = np.zeros(n)
     grad[:N] = grad_x
+    if height_leg is not None and F.n_par:
+        grad[n - F.n_par:] = F.height_grad(height_leg)
     leg = change()
     D = np.eye(n)
     y_plus = y.copy()
@@ -298,7 +307,7 @@ def _python_interval(F, aug_rhs, evs, t0, y, Phi, t_max, rtol, atol, phi_rtol):
 def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
                   contact=None, rtol: float = 1e-10, atol: float = 1e-12,
                   phi_rtol: float | None = None, t_max: float = 2.5,
-                  max_events: int = 40, engine: str = "compiled") -> dict:
+                  max_events: int = 40, engine: str = "compiled", field=None) -> dict:
     """One step of the touch-down map and its exact Jacobian (module docstring).
 
     Parameters
@@ -326,11 +335,16 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
         ``"compiled"`` (default): x and Phi together by RODAS4 in C (pdw/core/csrc/pdw_cvar.c,
         `rtol`, `atol` on x), the events located there; ``"python"``: SciPy's Radau for x and
         LSODA for (x, Phi), the reference (module docstring).
+    field : callable, optional
+        ``field(f, na, params)`` -> a `_Field` whose state carries ``n_par`` constant
+        parameters after x (and v_in): their columns are appended to ``M``, ``dx_dz`` and
+        ``dT`` (`pdw.analysis.stepmap.variational_ground`; the Python engine only).
 
     Returns
     -------
     dict
-        ``z`` (z' (nz,)), ``M`` (nz, nz) dP/dz, ``T`` (the step time [s]), ``events`` (list of
+        ``z`` (z' (nz,)), ``M`` (nz, nz) dP/dz, ``T`` (the step time [s]), ``dT`` (nz,)
+        dT/dz, ``events`` (list of
         (t, kind, leg) of the flag switches and gates), ``saltations`` (their S_k, (n, n) with
         n = 8, or 10 with approach speeds), ``x`` (the state at the touch-down, legs not
         relabelled), ``dx_dz`` (n, nz) and ``Phi`` (n, n).
@@ -354,10 +368,14 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
     nz = len(z)
     f = ode_function(p, variant, flags=(1, 1), contact=law,
                      approach_speeds=v_in0 if na else (0.0, 0.0))
-    F = _Field(f, na, p)
+    F = _Field(f, na, p) if field is None else field(f, na, p)
+    if F.n_par and engine != "python":
+        raise InvalidInputError("variational step_jacobian: a field with parameters needs "
+                                "engine='python'")
     n = F.n
-    y = np.concatenate([x0, v_in0]) if na else x0.copy()
-    E = np.zeros((n, nz))
+    y = np.concatenate([x0, v_in0 if na else [], np.zeros(F.n_par)])
+    E = np.zeros((n, nz + F.n_par))
+    E[n - F.n_par:, nz:] = np.eye(F.n_par)
     E[:N, :6] = _embed_jac(z, p)
     if na:
         if z[6] > 0.0:
@@ -438,6 +456,7 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
         if k_ev >= 4 or (k_ev < 2 and flags[leg] and pending[leg]):
             # a pending foot's normal rate through 0 (the lift-off, Eq. 18a: the flag-gated
             # forces stop) or its height back through 0 (the penetration force returns)
+            hl = None
             if k_ev < 2:
                 h, grad = _rate(y, leg, p)
                 change = switch(leg, 0)
@@ -445,10 +464,10 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
                 events.append((t_ev, "lift_off", leg + 1))
             else:
                 h, grad, _ = _foot(y, leg, p)
-                change = lambda: None   # noqa: E731
+                change, hl = (lambda: None), leg
                 events.append((t_ev, "reentry", leg + 1))
             pending[leg] = False
-            S, y = _saltation(F, y, grad, h, change)
+            S, y = _saltation(F, y, grad, h, change, hl)
             Phi = S @ Phi
             salts.append(S)
             continue
@@ -469,8 +488,10 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
             # the surface v = 0
             sunk[leg] = False
             h, grad = _rate(y, leg, p)
+            hl = None
         else:
             h, grad, _ = _foot(y, leg, p)
+            hl = leg
             if not flags[leg] and _rate(y, leg, p)[0] >= 0.0:
                 # below the ground but not moving down (Eq. 18b wants v < 0): still swing
                 sunk[leg] = True
@@ -481,6 +502,8 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
             f_minus = F(t_ev, _across(y, grad, h, 1.0))   # above the ground: before
             g = np.zeros(n)
             g[:N] = grad
+            if hl is not None and F.n_par:
+                g[n - F.n_par:] = F.height_grad(hl)
             S = np.eye(n) - np.outer(f_minus, g) / (g @ f_minus)
             R = np.zeros((nz, n))
             for i, j in enumerate((3, 2, 4, 5, 7, 6)):
@@ -488,19 +511,20 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
             if na:
                 R[6, N + 1] = 1.0   # the trailing foot's approach speed: leg 2's held one
             M = R @ S @ Phi @ E
-            return {"z": R @ y, "M": M, "T": t_ev, "events": events, "saltations": salts,
+            return {"z": R @ y, "M": M, "T": t_ev, "dT": -(g @ Phi @ E) / (g @ f_minus),
+                    "events": events, "saltations": salts,
                     "x": y[:N].copy(), "dx_dz": S @ Phi @ E, "Phi": Phi}
         if flags[leg] and _rate(y, leg, p)[0] <= 0.0:
             # above the ground but not yet rising (Eq. 18a): the penetration force ends, the
             # flag stays 1 until v > 0
             pending[leg] = True
             events.append((t_ev, "rise", leg + 1))
-            S, y = _saltation(F, y, grad, h, lambda: None)
+            S, y = _saltation(F, y, grad, h, lambda: None, hl)
             Phi = S @ Phi
             salts.append(S)
             continue
         on = 0 if flags[leg] else 1
-        S, y = _saltation(F, y, grad, h, switch(leg, on))
+        S, y = _saltation(F, y, grad, h, switch(leg, on), hl)
         armed[leg] = False
         Phi = S @ Phi
         events.append((t_ev, "touch_down" if on else "lift_off", leg + 1))

@@ -118,7 +118,17 @@ def test_gait_sensitivity_equals_the_summed_response_of_a_direct_simulation(gait
                                     rel=2e-3)
 
 
+def test_gait_sensitivity_by_differences_is_the_cross_checks_system(gait):
+    G = pdw.gait_sensitivity(P, gait=gait, indicators=("step_time", "speed"))
+    F = pdw.gait_sensitivity(P, gait=gait, indicators=("step_time", "speed"), method="fd")
+    assert G.method == "exact" and F.method == "fd" and F.check == {}
+    assert F.norm == pytest.approx(G.check["fd_norm"], rel=1e-12)
+    assert F.A.shape == G.A.shape and F.B.shape == G.B.shape
+
+
 def test_gait_sensitivity_bad_input():
+    with pytest.raises(pdw.InvalidInputError, match="method"):
+        pdw.gait_sensitivity(P, method="newton")
     with pytest.raises(pdw.InvalidInputError, match="indicators"):
         pdw.gait_sensitivity(P, indicators=("hip_height",))
     with pytest.raises(pdw.InvalidInputError, match="model"):
@@ -340,7 +350,7 @@ def test_gait_sensitivity_continuous_matches_a_direct_step_down_response(cgait):
 
     G = pdw.gait_sensitivity(P, model="continuous", gait=cgait,
                              indicators=("step_time", "step_length"))
-    assert G.method == "fd" and G.check["rel_diff"] < 1e-3
+    assert G.method == "exact" and G.check["rel_diff"] < 1e-3
     e = 1e-4
     st, L, T = RC.walk(P, cgait, pdw.Ground.step(RC.edge_at(cgait), e, width=0.01), 40,
                        rtol=1e-11, atol=1e-12)
