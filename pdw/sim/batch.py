@@ -47,8 +47,14 @@ _STATUS = {_layout.STATUS.index(c): s for c, s in (
     ("running", "interrupted"), ("done", "walked"), ("fell", "fell"), ("diverged", "diverged"),
     ("singular", "diverged"), ("periodic", "periodic"))}
 _STOP = {i: ("t_end" if i == 0 else name) for i, name in enumerate(_layout.STOP)}
-LANES = 8
-"""Default lanes per block (walkers advanced in lockstep by one thread)."""
+LANES = 16
+"""Default lanes per block (walkers advanced in lockstep by one thread): two vector chunks of
+the cdm lane loops (`CHUNK`), which overlap and amortize one round's fixed costs (16 lanes
+against 8: 3.1x against 2.8x the scalar loop bitwise, 5.1x against 4.7x with ``vector=True``,
+benchmarks/bench_batch.py); no walker's result depends on it (docs/ensemble.md)."""
+CHUNK = 8
+"""Lanes per vector chunk of the structure-of-arrays lane loops (``PDW_SOA_CHUNK``): a block of
+W lanes computes ceil(W / 8) chunks, whatever its walkers."""
 ISA_ENV = "PDW_BATCH_ISA"
 """Environment variable that picks the cdm lane loop: ``scalar`` (every lane through the
 generated scalar stages), ``base`` (the structure-of-arrays step at the x86-64 baseline, SSE2),
@@ -266,7 +272,9 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
         Threads (GIL released), W lanes each, sharing the batch (each lane takes the next
         walker); default: os.cpu_count().
     lanes : int
-        Walkers per block advanced in lockstep (1 ... 64).
+        Walkers per block advanced in lockstep by one thread (1 ... 64; default `LANES` = 16;
+        a thread's share of a smaller batch takes fewer). Speed only: no walker's result
+        depends on it, nor on ``threads``.
     vector : bool
         False (default): the scalar libm sin/cos, so that every walker is bitwise its
         `simulate` run. True (cdm and rodas4): the sin/cos of a block through glibc's vector
@@ -447,13 +455,18 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
         # a batch of at most SERIAL_WALKERS walkers runs the scalar loop also with vector=True
         # (libm's trig: bitwise simulate): the lanes would cost more than they save
         lane_trig = bool(vector) and not (small_serial and n <= _batch.SERIAL_WALKERS)
-        args = (k, x, pvec, f0, hip, depth, copts, out, 0, n, lanes, lane_trig)
+        # threads: at most one per chunk of walkers; lanes: at most a thread's share of the
+        # walkers, so that a small batch does not compute empty chunks (the lanes' count
+        # changes no walker's result: each lane's arithmetic is its own)
+        used = min(threads, -(-n // min(lanes, CHUNK)))
+        width = min(lanes, -(-n // used))
+        args = (k, x, pvec, f0, hip, depth, copts, out, 0, n, width, lane_trig)
         # the threads share the batch: each lane of each takes the next walker from one
         # counter, so no lane idles while a walker waits (pdw_batch_take)
         shared = np.zeros(1, dtype=np.int_) if threads > 1 else None
         try:
             interrupt.thread_map(lambda _: _batch.run_range(*args, next_walker=shared, **opts),
-                                 range(min(threads, -(-n // lanes))), threads)
+                                 range(used), threads)
         except KeyboardInterrupt as e:
             # Ctrl-C: the walkers finished so far, the running ones as they are, the others at
             # their start; every unfinished one "interrupted"
