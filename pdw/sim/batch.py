@@ -48,10 +48,14 @@ _STATUS = {_layout.STATUS.index(c): s for c, s in (
     ("singular", "diverged"), ("periodic", "periodic"))}
 _STOP = {i: ("t_end" if i == 0 else name) for i, name in enumerate(_layout.STOP)}
 LANES = 16
-"""Default lanes per block (walkers advanced in lockstep by one thread): two vector chunks of
-the cdm lane loops (`CHUNK`), which overlap and amortize one round's fixed costs (16 lanes
-against 8: 3.1x against 2.8x the scalar loop bitwise, 5.1x against 4.7x with ``vector=True``,
-benchmarks/bench_batch.py); no walker's result depends on it (docs/ensemble.md)."""
+"""Default lanes per block (walkers advanced in lockstep by one thread) of ``method="cdm"``:
+two vector chunks of its lane loops (`CHUNK`), which share one round's fixed costs (16 lanes
+against 8: 3.05x against 2.62x the scalar loop bitwise, 5.22x against 4.62x with
+``vector=True``, benchmarks/bench_batch.py); no walker's result depends on it
+(docs/ensemble.md)."""
+LANES_OTHER = 8
+"""Default lanes per block of the other methods (rodas4's structure-of-arrays lanes: 1 % slower
+at 16 than at 8)."""
 CHUNK = 8
 """Lanes per vector chunk of the structure-of-arrays lane loops (``PDW_SOA_CHUNK``): a block of
 W lanes computes ceil(W / 8) chunks, whatever its walkers."""
@@ -234,7 +238,7 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
                    variant: Literal["paper", "consistent"] = "paper", method: str | None = None,
                    integrator: _opt.Integrator | dict | None = None,
                    stop: _opt.Stop | dict | None = None, limits: _opt.Limits | dict | None = None,
-                   flags0: ArrayLike = (0, 1), threads: int | None = None, lanes: int = LANES,
+                   flags0: ArrayLike = (0, 1), threads: int | None = None, lanes: int | None = None,
                    vector: bool = False, executor: Any = None, chunk_size: int | None = None,
                    record: Sequence[int] | None = None, record_every: int = 1,
                    progress: bool | Progress = False,
@@ -271,10 +275,10 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
     threads : int, optional
         Threads (GIL released), W lanes each, sharing the batch (each lane takes the next
         walker); default: os.cpu_count().
-    lanes : int
-        Walkers per block advanced in lockstep by one thread (1 ... 64; default `LANES` = 16;
-        a thread's share of a smaller batch takes fewer). Speed only: no walker's result
-        depends on it, nor on ``threads``.
+    lanes : int, optional
+        Walkers per block advanced in lockstep by one thread (1 ... 64; default `LANES` = 16
+        for cdm, `LANES_OTHER` = 8 for the other methods; a thread's share of a smaller batch
+        takes fewer). Speed only: no walker's result depends on it, nor on ``threads``.
     vector : bool
         False (default): the scalar libm sin/cos, so that every walker is bitwise its
         `simulate` run. True (cdm and rodas4): the sin/cos of a block through glibc's vector
@@ -336,7 +340,7 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
         "simulate_batch", _positional, _legacy, integrator=integrator, stop=stop,
         limits=limits, method=method, dt=dt, t_end=t_end,
         keywords=dict(params=(params, None), variant=(variant, "paper"), method=(method, None),
-                      flags0=(flags0, (0, 1)), threads=(threads, None), lanes=(lanes, LANES),
+                      flags0=(flags0, (0, 1)), threads=(threads, None), lanes=(lanes, None),
                       vector=(vector, False)))
     it, _, st, lim, method, dt, t_end, plain = settled
     _opt.no_record("simulate_batch", settled)
@@ -345,6 +349,8 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
     flags0 = plain.get("flags0", flags0)
     threads = plain.get("threads", threads)
     lanes = plain.get("lanes", lanes)
+    if lanes is None:
+        lanes = LANES if method == "cdm" else LANES_OTHER
     vector = plain.get("vector", vector)
     x = _rows(x0)
     n = len(x)
