@@ -59,6 +59,41 @@ at 16 than at 8)."""
 CHUNK = 8
 """Lanes per vector chunk of the structure-of-arrays lane loops (``PDW_SOA_CHUNK``): a block of
 W lanes computes ceil(W / 8) chunks, whatever its walkers."""
+WIDE_CHUNK_COST = 0.9
+"""A lane-step's cost in a block of two or more chunks relative to a block of one (the chunks
+share a round's fixed costs; benchmarks/bench_batch.py: 0.87 bitwise, 0.91 with vector sin/cos
+at 16 lanes against 8): `lane_width`'s cost model."""
+
+
+def lane_width(walkers: int, lanes: int) -> int:
+    """The lanes of a thread that runs about ``walkers`` walkers with at most ``lanes`` lanes.
+
+    A block computes ceil(W / `CHUNK`) chunks in every round, and its walkers run in about
+    ceil(walkers / W) generations (a finished walker's lane takes the next): the width of
+    the least chunk-rounds (`WIDE_CHUNK_COST` for blocks of several chunks), the wider on a
+    tie. Speed only: no walker's result depends on it (docs/ensemble.md, "Threads").
+
+    Parameters
+    ----------
+    walkers : int
+        The thread's share of the batch (>= 1).
+    lanes : int
+        The most lanes it may take (`simulate_batch`'s ``lanes``, >= 1).
+
+    Returns
+    -------
+    int
+        W in [1, min(walkers, lanes)]: e.g. with 16 lanes, 16 for 64 walkers, 8 for 24 or 40
+        (a second generation of 16 lanes would run half empty), 12 for 12.
+    """
+    widths = {min(lanes, walkers)} | {min(w, walkers) for w in range(CHUNK, lanes + 1, CHUNK)}
+
+    def cost(w: int) -> float:
+        chunks = -(-w // CHUNK)
+        return -(-walkers // w) * chunks * (1.0 if chunks == 1 else WIDE_CHUNK_COST)
+    return min(sorted(widths, reverse=True), key=cost)
+
+
 ISA_ENV = "PDW_BATCH_ISA"
 """Environment variable that picks the cdm lane loop: ``scalar`` (every lane through the
 generated scalar stages), ``base`` (the structure-of-arrays step at the x86-64 baseline, SSE2),
@@ -461,11 +496,11 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
         # a batch of at most SERIAL_WALKERS walkers runs the scalar loop also with vector=True
         # (libm's trig: bitwise simulate): the lanes would cost more than they save
         lane_trig = bool(vector) and not (small_serial and n <= _batch.SERIAL_WALKERS)
-        # threads: at most one per chunk of walkers; lanes: at most a thread's share of the
-        # walkers, so that a small batch does not compute empty chunks (the lanes' count
-        # changes no walker's result: each lane's arithmetic is its own)
+        # threads: at most one per chunk of walkers; lanes: for a thread's share of the
+        # walkers, so that a block does not compute empty chunks (the lanes' count changes no
+        # walker's result: each lane's arithmetic is its own)
         used = min(threads, -(-n // min(lanes, CHUNK)))
-        width = min(lanes, -(-n // used))
+        width = lane_width(-(-n // used), lanes)
         args = (k, x, pvec, f0, hip, depth, copts, out, 0, n, width, lane_trig)
         # the threads share the batch: each lane of each takes the next walker from one
         # counter, so no lane idles while a walker waits (pdw_batch_take)

@@ -177,3 +177,16 @@ def test_vector_results_do_not_depend_on_lanes_or_threads(method):
         np.testing.assert_array_equal(b.x_final, ref.x_final)
         np.testing.assert_array_equal(b.status, ref.status)
         np.testing.assert_array_equal(b.n_touch_down, ref.n_touch_down)
+
+
+def test_lane_width_computes_no_needless_chunk():
+    """A thread's lanes (`lane_width`): never more than asked or than its walkers, one block
+    for a share that fits, and 8 lanes where 16 would leave a generation half empty."""
+    from pdw.sim.batch import LANES, lane_width
+    assert LANES == 16
+    for walkers in range(1, 200):
+        for lanes in (1, 3, 8, 16, 64):
+            w = lane_width(walkers, lanes)
+            assert 1 <= w <= min(walkers, lanes), (walkers, lanes, w)
+    assert [lane_width(m, 16) for m in (5, 12, 16, 24, 40, 64, 1000)] == [5, 12, 16, 8, 8, 16, 16]
+    assert lane_width(24, 3) == 3
