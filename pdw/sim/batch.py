@@ -50,8 +50,8 @@ _STOP = {i: ("t_end" if i == 0 else name) for i, name in enumerate(_layout.STOP)
 LANES = 16
 """Default lanes per block (walkers advanced in lockstep by one thread) of ``method="cdm"``:
 two vector chunks of its lane loops (`CHUNK`), which share one round's fixed costs (16 lanes
-against 8: 3.05x against 2.62x the scalar loop bitwise, 5.22x against 4.62x with
-``vector=True``, benchmarks/bench_batch.py); no walker's result depends on it
+against 8: 3.18x against 2.75x the scalar loop bitwise, 5.35x against 4.88x with
+``vector=True``, benchmarks/results/batch.txt); no walker's result depends on it
 (docs/ensemble.md)."""
 LANES_OTHER = 8
 """Default lanes per block of the other methods (rodas4's structure-of-arrays lanes: 1 % slower
