@@ -47,8 +47,53 @@ _STATUS = {_layout.STATUS.index(c): s for c, s in (
     ("running", "interrupted"), ("done", "walked"), ("fell", "fell"), ("diverged", "diverged"),
     ("singular", "diverged"), ("periodic", "periodic"))}
 _STOP = {i: ("t_end" if i == 0 else name) for i, name in enumerate(_layout.STOP)}
-LANES = 8
-"""Default lanes per block (walkers advanced in lockstep by one thread)."""
+LANES = 16
+"""Default lanes per block (walkers advanced in lockstep by one thread) of ``method="cdm"``:
+two vector chunks of its lane loops (`CHUNK`), which share one round's fixed costs (16 lanes
+against 8: 3.18x against 2.75x the scalar loop bitwise, 5.35x against 4.88x with
+``vector=True``, benchmarks/results/batch.txt); no walker's result depends on it
+(docs/ensemble.md)."""
+LANES_OTHER = 8
+"""Default lanes per block of the other methods (rodas4's structure-of-arrays lanes: 1 % slower
+at 16 than at 8)."""
+CHUNK = 8
+"""Lanes per vector chunk of the structure-of-arrays lane loops (``PDW_SOA_CHUNK``): a block of
+W lanes computes ceil(W / 8) chunks, whatever its walkers."""
+WIDE_CHUNK_COST = 0.9
+"""A lane-step's cost in a block of two or more chunks relative to a block of one (the chunks
+share a round's fixed costs; benchmarks/bench_batch.py: 0.87 bitwise, 0.91 with vector sin/cos
+at 16 lanes against 8): `lane_width`'s cost model."""
+
+
+def lane_width(walkers: int, lanes: int) -> int:
+    """The lanes of a thread that runs about ``walkers`` walkers with at most ``lanes`` lanes.
+
+    A block computes ceil(W / `CHUNK`) chunks in every round, and its walkers run in about
+    ceil(walkers / W) generations (a finished walker's lane takes the next): the width of
+    the least chunk-rounds (`WIDE_CHUNK_COST` for blocks of several chunks), the wider on a
+    tie. Speed only: no walker's result depends on it (docs/ensemble.md, "Threads").
+
+    Parameters
+    ----------
+    walkers : int
+        The thread's share of the batch (>= 1).
+    lanes : int
+        The most lanes it may take (`simulate_batch`'s ``lanes``, >= 1).
+
+    Returns
+    -------
+    int
+        W in [1, min(walkers, lanes)]: e.g. with 16 lanes, 16 for 64 walkers, 8 for 24 or 40
+        (a second generation of 16 lanes would run half empty), 12 for 12.
+    """
+    widths = {min(lanes, walkers)} | {min(w, walkers) for w in range(CHUNK, lanes + 1, CHUNK)}
+
+    def cost(w: int) -> float:
+        chunks = -(-w // CHUNK)
+        return -(-walkers // w) * chunks * (1.0 if chunks == 1 else WIDE_CHUNK_COST)
+    return min(sorted(widths, reverse=True), key=cost)
+
+
 ISA_ENV = "PDW_BATCH_ISA"
 """Environment variable that picks the cdm lane loop: ``scalar`` (every lane through the
 generated scalar stages), ``base`` (the structure-of-arrays step at the x86-64 baseline, SSE2),
@@ -228,7 +273,7 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
                    variant: Literal["paper", "consistent"] = "paper", method: str | None = None,
                    integrator: _opt.Integrator | dict | None = None,
                    stop: _opt.Stop | dict | None = None, limits: _opt.Limits | dict | None = None,
-                   flags0: ArrayLike = (0, 1), threads: int | None = None, lanes: int = LANES,
+                   flags0: ArrayLike = (0, 1), threads: int | None = None, lanes: int | None = None,
                    vector: bool = False, executor: Any = None, chunk_size: int | None = None,
                    record: Sequence[int] | None = None, record_every: int = 1,
                    progress: bool | Progress = False,
@@ -265,8 +310,10 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
     threads : int, optional
         Threads (GIL released), W lanes each, sharing the batch (each lane takes the next
         walker); default: os.cpu_count().
-    lanes : int
-        Walkers per block advanced in lockstep (1 ... 64).
+    lanes : int, optional
+        Walkers per block advanced in lockstep by one thread (1 ... 64; default `LANES` = 16
+        for cdm, `LANES_OTHER` = 8 for the other methods; a thread's share of a smaller batch
+        takes fewer). Speed only: no walker's result depends on it, nor on ``threads``.
     vector : bool
         False (default): the scalar libm sin/cos, so that every walker is bitwise its
         `simulate` run. True (cdm and rodas4): the sin/cos of a block through glibc's vector
@@ -328,7 +375,7 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
         "simulate_batch", _positional, _legacy, integrator=integrator, stop=stop,
         limits=limits, method=method, dt=dt, t_end=t_end,
         keywords=dict(params=(params, None), variant=(variant, "paper"), method=(method, None),
-                      flags0=(flags0, (0, 1)), threads=(threads, None), lanes=(lanes, LANES),
+                      flags0=(flags0, (0, 1)), threads=(threads, None), lanes=(lanes, None),
                       vector=(vector, False)))
     it, _, st, lim, method, dt, t_end, plain = settled
     _opt.no_record("simulate_batch", settled)
@@ -337,6 +384,8 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
     flags0 = plain.get("flags0", flags0)
     threads = plain.get("threads", threads)
     lanes = plain.get("lanes", lanes)
+    if lanes is None:
+        lanes = LANES if method == "cdm" else LANES_OTHER
     vector = plain.get("vector", vector)
     x = _rows(x0)
     n = len(x)
@@ -447,13 +496,18 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
         # a batch of at most SERIAL_WALKERS walkers runs the scalar loop also with vector=True
         # (libm's trig: bitwise simulate): the lanes would cost more than they save
         lane_trig = bool(vector) and not (small_serial and n <= _batch.SERIAL_WALKERS)
-        args = (k, x, pvec, f0, hip, depth, copts, out, 0, n, lanes, lane_trig)
+        # threads: at most one per chunk of walkers; lanes: for a thread's share of the
+        # walkers, so that a block does not compute empty chunks (the lanes' count changes no
+        # walker's result: each lane's arithmetic is its own)
+        used = min(threads, -(-n // min(lanes, CHUNK)))
+        width = lane_width(-(-n // used), lanes)
+        args = (k, x, pvec, f0, hip, depth, copts, out, 0, n, width, lane_trig)
         # the threads share the batch: each lane of each takes the next walker from one
         # counter, so no lane idles while a walker waits (pdw_batch_take)
         shared = np.zeros(1, dtype=np.int_) if threads > 1 else None
         try:
             interrupt.thread_map(lambda _: _batch.run_range(*args, next_walker=shared, **opts),
-                                 range(min(threads, -(-n // lanes))), threads)
+                                 range(used), threads)
         except KeyboardInterrupt as e:
             # Ctrl-C: the walkers finished so far, the running ones as they are, the others at
             # their start; every unfinished one "interrupted"

@@ -157,3 +157,36 @@ def test_per_walker_friction_constants_follow_each_walker(isa, monkeypatch):
         assert b.n_steps[i] == r.n_steps, i
         assert np.array_equal(b.x_final[i], r.x_final), (i, b.x_final[i] - r.x_final)
     assert len(set(np.round(b.x_final[:, 6], 9))) > 1
+
+
+@pytest.mark.parametrize("method", ["cdm", "rodas4"])
+def test_vector_results_do_not_depend_on_lanes_or_threads(method):
+    """The default lanes (16 for cdm, 8 otherwise), a thread's lanes capped at its share of
+    the walkers, and one thread per 8 walkers are speed only: with vector=True (libmvec per
+    8-lane chunk) every walker's result is the same bits whatever the lanes and threads, and
+    the lanes do the work."""
+    x = _states(21, seed=7)
+    it = pdw.Integrator(check_step="off", **KW[method])
+    _batch.lane_steps(reset=True)
+    ref = simulate_batch(x, t_end=T_END, method=method, threads=1, vector=True, integrator=it)
+    assert _batch.lane_steps(reset=True) > 0
+    assert {"walked", "fell"} <= set(ref.status)
+    for lanes, threads in ((None, 2), (3, 1), (8, 2), (64, 2)):
+        b = simulate_batch(x, t_end=T_END, method=method, lanes=lanes, threads=threads,
+                           vector=True, integrator=it)
+        np.testing.assert_array_equal(b.x_final, ref.x_final)
+        np.testing.assert_array_equal(b.status, ref.status)
+        np.testing.assert_array_equal(b.n_touch_down, ref.n_touch_down)
+
+
+def test_lane_width_computes_no_needless_chunk():
+    """A thread's lanes (`lane_width`): never more than asked or than its walkers, one block
+    for a share that fits, and 8 lanes where 16 would leave a generation half empty."""
+    from pdw.sim.batch import LANES, lane_width
+    assert LANES == 16
+    for walkers in range(1, 200):
+        for lanes in (1, 3, 8, 16, 64):
+            w = lane_width(walkers, lanes)
+            assert 1 <= w <= min(walkers, lanes), (walkers, lanes, w)
+    assert [lane_width(m, 16) for m in (5, 12, 16, 24, 40, 64, 1000)] == [5, 12, 16, 8, 8, 16, 16]
+    assert lane_width(24, 3) == 3

@@ -30,7 +30,7 @@ from ...core import _layout, checks, paths
 from ...core.errors import InvalidInputError
 from ...core.params import Params
 from ...core.progress import progress_bar
-from ...sim.batch import simulate_batch
+from ...sim.batch import LANES, simulate_batch
 from ...sim.options import Stop
 from ..stepmap import poincare as _poincare
 from ..stepmap import section as _section
@@ -123,7 +123,7 @@ def _save(path, **arrays):
 
 def basin(params=None, phi=(0.69, 0.81, 100), thetad2=(-3.2, -0.4, 100), *, t_end=8.0,
           dt=1e-4, periodic_steps=4, periodic_tol=1e-3, match_tol=0.02, reference=None,
-          threads=None, lanes=8, vector=False, chunk_size=4096, checkpoint=None,
+          threads=None, lanes=LANES, vector=False, chunk_size=4096, checkpoint=None,
           executor=None, progress=False) -> Basin:
     """Basin of the gait reached from ``reference`` on a ``phi`` x ``thetad2`` grid.
 

@@ -343,12 +343,19 @@ static void soa_load(pdw_soa_state *S, int l, const pdw_sim *s)
         S->armed[i*PDW_SOA_STRIDE + l] = s->disc.armed[i];
     }
     S->upd[l] = s->n > 0;
+    S->n[l] = s->n;
     S->first |= s->n == 0;
 }
 
-/* The parts of lane l's pdw_sim that the SoA step advances, from S. */
+/* The parts of lane l's pdw_sim that the SoA step advances, from S: the steps it committed
+ * since the lane was loaded (n, t = n dt and n_rhs as each commit of pdw_cdm_advance sets
+ * them), the state and the arming. */
 static void soa_store(const pdw_soa_state *S, int l, pdw_sim *s)
 {
+    const long n = (long)S->n[l];
+    s->n_rhs += n - s->n;
+    s->n = n;
+    s->t = n * s->opt.dt;
     for (int i = 0; i < PDW_NX; ++i) s->x[i] = S->x[i*PDW_SOA_STRIDE + l];
     for (int i = 0; i < PDW_NQ; ++i) s->u_prev[i] = S->u_prev[i*PDW_SOA_STRIDE + l];
     for (int i = 0; i < 2; ++i) s->disc.armed[i] = (int)S->armed[i*PDW_SOA_STRIDE + l];
@@ -370,6 +377,8 @@ static int soa_start(pdw_lanes *L, long i, int l)
     for (int j = 0; j < PDW_NP; ++j) S->p[j*PDW_SOA_STRIDE + l] = s->p[j];
     S->hip[l] = s->opt.fall_hip_height;
     S->depth[l] = s->opt.fall_depth;
+    S->nend[l] = s->opt.n_steps;
+    S->live[l] = 1;
     S->kc_stale = 1;
     soa_load(S, l, s);
     return 1;
@@ -404,23 +413,33 @@ static void soa_round(pdw_lanes *L)
     const pdw_batch_job *job = L->job;
     const int W = L->W;
     long committed = 0;     /* into L->lane_steps once (a long that the stores to s may alias) */
+    /* (no restrict: a refill, pdw_lanes_retire, writes these rows through S) */
+    long long *n = S->n, *upd = S->upd, *live = S->live;
+    const long long *rare = S->rare, *nend = S->nend;
+    long long visit = 0;
     c->stepfn(c->kernel, S, W, job->opt.dt, job->opt.max_speed, c->vector);
+    for (int l = 0; l < W; ++l) visit |= live[l] & (rare[l] | (n[l] + 1 >= nend[l]));
+    if (!visit) {
+        /* the common round: every walker commits an ordinary step that is not its last */
+        for (int l = 0; l < W; ++l) {
+            n[l] += live[l];
+            upd[l] |= live[l];
+        }
+        L->lane_steps += L->running;
+        return;
+    }
     for (int l = 0; l < W; ++l) {
         if (L->walker[l] < 0) continue;
         pdw_sim *s = &L->sims[l];
         int more;
-        if (!S->rare[l]) {
-            /* the common case: commit the step */
-            const long n = s->n + 1;
-            s->n = n;
-            s->t = n * s->opt.dt;
-            s->n_rhs++;
+        if (!rare[l]) {
+            /* the common case: commit the step (pdw_sim's counters at soa_store) */
             committed++;
-            S->upd[l] = 1;
-            if (n < s->opt.n_steps) continue;
+            upd[l] = 1;
+            if (++n[l] < nend[l]) continue;
             /* final flags at t_end (scalar trig), as step() */
             soa_store(S, l, s);
-            if (pdw_update_flags(s, n * s->opt.dt) == 0) s->status = PDW_STATUS_DONE;
+            if (pdw_update_flags(s, s->n * s->opt.dt) == 0) s->status = PDW_STATUS_DONE;
             more = 0;
         } else {
             /* the scalar step from the same state and trig: it takes the event, the fall
@@ -431,7 +450,10 @@ static void soa_round(pdw_lanes *L)
             more = step(s);
             if (more) soa_load(S, l, s);
         }
-        if (!more) pdw_lanes_retire(L, l);
+        if (!more) {
+            pdw_lanes_retire(L, l);     /* a refill loads the lane (soa_start) */
+            live[l] = L->walker[l] >= 0;
+        }
     }
     L->lane_steps += committed;
 }

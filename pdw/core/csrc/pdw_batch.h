@@ -81,6 +81,11 @@ typedef struct pdw_soa_state {
      * width (int32 rows halve it on AVX-512) */
     long long flags[2*PDW_SOA_STRIDE], armed[2*PDW_SOA_STRIDE], armed_next[2*PDW_SOA_STRIDE];
     long long upd[PDW_SOA_STRIDE];  /* 1: past the first step (the flags are updated first) */
+    /* the lanes' step counters (the pdw_sim's n, t and n_rhs are brought up to date from n
+     * when the lane leaves the vector path), each lane's n_steps, and 1 where the lane has a
+     * walker: a round in which no walker has a rare step or its last commits with one vector
+     * loop, without visiting the pdw_sim */
+    long long n[PDW_SOA_STRIDE], nend[PDW_SOA_STRIDE], live[PDW_SOA_STRIDE];
     long long rare[PDW_SOA_STRIDE]; /* out: 1 = nothing committed, run the scalar step */
     double trig[PDW_NTRIG*PDW_SOA_STRIDE];
     double contact[2*PDW_NCONTACT*PDW_SOA_STRIDE];
