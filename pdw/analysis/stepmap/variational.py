@@ -9,7 +9,10 @@ One step of the touch-down map (`pdw.analysis.stepmap.poincare.step`) from secti
                        paper's Eq. 5) > 0: where g_i passes 0 first, the foot stays support,
                        without penetration force, until v_i passes 0 (or g_i returns below 0);
                        touch-down, Eq. 18b: an armed swing foot's height g_i < 0 AND v_i < 0
-                       (armed: above the ground while ahead of the other foot); where g_i
+                       (armed: above the ground while ahead of the other foot, as the
+                       compiled loop's pdw_update_flags: armed when its contact point passes
+                       the other one's forwards, or at a lift-off ahead of it; disarmed when
+                       it passes back behind it, events of both engines); where g_i
                        passes 0 downwards with v_i >= 0 (the paper's v_i is not dg_i/dt) the
                        foot stays swing, without forces, until v_i passes 0 (or g_i returns
                        above 0)), and
@@ -242,7 +245,32 @@ def _specs(flags, pending, armed, gate_dir, sunk):
             out.append((_EV_HEIGHT, leg, 1.0 if sunk[leg] else -1.0))
         else:
             out.append((_EV_NONE, leg, -1.0))
+    for leg in (0, 1):
+        out.append((_EV_AHEAD if _disarmable(flags, armed, leg) else _EV_NONE, leg, -1.0))
     return out
+
+
+def _ahead(x, leg, p):
+    """Whether leg's contact point is ahead of the other one's (pdw_discrete.c's arming)."""
+    return _foot(x, leg, p)[2] > _foot(x, 1 - leg, p)[2]
+
+
+def _pass(flags, armed, sunk, ahead, t, events):
+    """The contact points pass each other at time t, leg ``ahead``'s now in front: it is
+    armed if swing, the other one disarmed if an armed swing foot ("disarm" in ``events``)."""
+    if not flags[ahead]:
+        armed[ahead] = True
+    other = 1 - ahead
+    if _disarmable(flags, armed, other):
+        armed[other] = sunk[other] = False
+        events.append((t, "disarm", other + 1))
+
+
+def _disarmable(flags, armed, leg):
+    """Whether leg's swing foot is armed, so that its passing back behind the other foot
+    (their contact points level, pdw_discrete.c: x_D,i <= x_D,j) disarms it: the compiled
+    loop's rule (pdw_update_flags), an event of both engines (slots 6, 7)."""
+    return not flags[leg] and armed[leg]
 
 
 #: pdw_cvar.h's event kinds
@@ -333,7 +361,8 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
         ``z`` (z' (nz,)), ``M`` (nz, nz) dP/dz, ``T`` (the step time [s]), ``events`` (list of
         (t, kind, leg) of the flag switches and gates), ``saltations`` (their S_k, (n, n) with
         n = 8, or 10 with approach speeds), ``x`` (the state at the touch-down, legs not
-        relabelled), ``dx_dz`` (n, nz) and ``Phi`` (n, n).
+        relabelled), ``dx_dz`` (n, nz), ``Phi`` (n, n) and ``flags`` (the support flags just
+        before the touch-down).
     """
     if engine not in ("compiled", "python"):
         raise InvalidInputError("variational step_jacobian: engine must be 'compiled' or "
@@ -366,7 +395,8 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
         if -v2 > 0.0:
             E[N + 1, :] = -gv2 @ E[:N, :]
     Phi = np.eye(n)
-    t0, events, salts = 0.0, [], []
+    t0, salts = 0.0, []
+    events: list[tuple] = []
     flags = F.flags
 
     def aug_rhs(t, yy):
@@ -421,6 +451,11 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
             d_back = 1.0 if sunk[leg] else -1.0
             evs.append(_event(lambda t, xx, leg=leg, on=pending[leg] or sunk[leg], d=d_back:
                               _foot(xx, leg, p)[0] if on else d, d_back))
+        for leg in (0, 1):          # an armed swing foot back behind the other one: disarmed
+            on = _disarmable(flags, armed, leg)
+            evs.append(_event(lambda t, xx, leg=leg, on=on:
+                              _foot(xx, leg, p)[2] - _foot(xx, 1 - leg, p)[2] if on else 1.0,
+                              -1.0))
         if engine == "compiled":
             t_ev, k_ev, h_next = _compiled_interval(
                 F, p, _specs(flags, pending, armed, gate_dir, sunk), t0, y, Phi, h_next, t_max, rtol,
@@ -430,6 +465,13 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
                                                   atol, 1e-10 if phi_rtol is None else phi_rtol)
         leg = k_ev % 2
         t0 = t_ev
+        if k_ev >= 6 or (k_ev < 2 and not flags[leg] and not armed[leg]):
+            # the contact points pass each other: the one now ahead, if swing, is armed (its
+            # height crossing then counts from above the ground) and the one now behind, if
+            # an armed swing foot, disarmed (the compiled loop's rule, pdw_discrete.c; both
+            # at once: each is the other's event). No flag switch, f unchanged, no saltation
+            _pass(flags, armed, sunk, 1 - leg if k_ev >= 6 else leg, t_ev, events)
+            continue
         if k_ev >= 4 and sunk[leg]:
             # a sunk swing foot back above the ground before its rate turned negative: no
             # flag switch, f unchanged (a swing foot has no forces), no saltation
@@ -441,7 +483,7 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
             if k_ev < 2:
                 h, grad = _rate(y, leg, p)
                 change = switch(leg, 0)
-                armed[leg] = False
+                armed[leg] = _ahead(y, leg, p)
                 events.append((t_ev, "lift_off", leg + 1))
             else:
                 h, grad, _ = _foot(y, leg, p)
@@ -460,9 +502,6 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
             events.append((t_ev, "gate", leg + 1))
             gate_dir[leg] = 1.0 if y[6 + leg] < 0 else -1.0
             salts.append(S)
-            continue
-        if not flags[leg] and not armed[leg]:       # armed: no flag switch, no saltation
-            armed[leg] = True
             continue
         if not flags[leg] and sunk[leg]:
             # the sunk foot's normal rate through 0 downwards: the touch-down (Eq. 18b) on
@@ -489,7 +528,8 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
                 R[6, N + 1] = 1.0   # the trailing foot's approach speed: leg 2's held one
             M = R @ S @ Phi @ E
             return {"z": R @ y, "M": M, "T": t_ev, "events": events, "saltations": salts,
-                    "x": y[:N].copy(), "dx_dz": S @ Phi @ E, "Phi": Phi}
+                    "x": y[:N].copy(), "dx_dz": S @ Phi @ E, "Phi": Phi,
+                    "flags": (flags[0], flags[1])}
         if flags[leg] and _rate(y, leg, p)[0] <= 0.0:
             # above the ground but not yet rising (Eq. 18a): the penetration force ends, the
             # flag stays 1 until v > 0
@@ -501,9 +541,30 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
             continue
         on = 0 if flags[leg] else 1
         S, y = _saltation(F, y, grad, h, switch(leg, on))
-        armed[leg] = False
+        # a lifted-off foot already ahead of the other one is armed at once (the compiled
+        # loop arms a swing foot above the ground and ahead at its next update)
+        armed[leg] = False if on else _ahead(y, leg, p)
         Phi = S @ Phi
         events.append((t_ev, "touch_down" if on else "lift_off", leg + 1))
         salts.append(S)
     raise InvalidInputError("variational step_jacobian: more than %d flag switches in one step"
                             % max_events)
+
+
+def step_summary(res: dict, params: Params | None = None) -> dict:
+    """`pdw.analysis.stepmap.poincare.step`'s descriptors of the step that `step_jacobian`
+    integrated (``res``), by the map's definitions: ``status`` ("ok", or "flight" where leg 2
+    was off the ground at the touch-down), ``z``, ``period`` [s], ``double_support`` (until
+    leg 1's first lift-off [s]), ``swing_period`` [s], ``step_length`` (leg 1's contact point
+    at the touch-down [m]) and ``n_events`` (the flag switches, the touch-down included: a
+    pending foot's "rise", a "reentry" and Eq. 11's gates switch no flag). The continuation's
+    exact evaluation (`gait_maps.ContinuousProblem`) takes them from here instead of a second
+    integration of the same step."""
+    p = _section._params(params)
+    x, T = res["x"], float(res["T"])
+    lo = next(t for t, kind, leg in res["events"] if kind == "lift_off" and leg == 1)
+    return {"status": "ok" if res["flags"][1] == 1 else "flight", "z": res["z"],
+            "period": T, "double_support": float(lo), "swing_period": T - float(lo),
+            "step_length": float(x[0] + (p.l - p.r) * math.sin(x[2])),
+            "n_events": 1 + sum(1 for _, kind, _ in res["events"]
+                                if kind in ("lift_off", "touch_down"))}
