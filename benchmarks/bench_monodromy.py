@@ -12,8 +12,9 @@ lankarani_nikravesh the default gait's z with an approach speed of 0.3 m/s, one 
 * ``exact Py``: the same with engine "python" (SciPy Radau + LSODA, the reference).
 
 and, for the default law and flores, one branch point of `continue_gait` in k_hip
-(`ContinuousProblem.evaluate`, monodromy "differences" against "exact": the map at z, its
-parameter differences and M). Process CPU time, medians of ROUNDS rounds interleaved (each
+(`ContinuousProblem.evaluate`, monodromy "differences" against "exact": P(z), its parameter
+differences and M; with "exact" P(z), M and the step's descriptors come from one variational
+integration and dP/dk_hip from two maps, the ensemble engine's lanes where it takes them). Process CPU time, medians of ROUNDS rounds interleaved (each
 round runs every case once, in turn); the load average is printed before and after (a shared
 machine: read the ratios, taken in the same rounds). The multipliers' largest difference to the
 Python version's (``|dm|``) is printed for both fd and exact C.

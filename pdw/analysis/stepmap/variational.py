@@ -553,8 +553,12 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
 
 def step_summary(res: dict, params: Params | None = None) -> dict:
     """`pdw.analysis.stepmap.poincare.step`'s descriptors of the step that `step_jacobian`
-    integrated (``res``), by the map's definitions: ``status`` ("ok", or "flight" where leg 2
-    was off the ground at the touch-down), ``z``, ``period`` [s], ``double_support`` (until
+    integrated (``res``), by the map's definitions: ``status`` ("ok"; "flight" where leg 2
+    was off the ground at the touch-down; "fell" where the state at the touch-down fails the
+    map's fall limits, `pdw.Limits`' defaults: the hip below 0.5 l, a foot deeper than 0.25 l;
+    "diverged" with a speed above 1e3; the map checks them at every step of the way, this only
+    at the end),
+    ``z``, ``period`` [s], ``double_support`` (until
     leg 1's first lift-off [s]), ``swing_period`` [s], ``step_length`` (leg 1's contact point
     at the touch-down [m]) and ``n_events`` (the flag switches, the touch-down included: a
     pending foot's "rise", a "reentry" and Eq. 11's gates switch no flag). The continuation's
@@ -563,7 +567,10 @@ def step_summary(res: dict, params: Params | None = None) -> dict:
     p = _section._params(params)
     x, T = res["x"], float(res["T"])
     lo = next(t for t, kind, leg in res["events"] if kind == "lift_off" and leg == 1)
-    return {"status": "ok" if res["flags"][1] == 1 else "flight", "z": res["z"],
+    fell = x[1] < 0.5 * p.l or min(_foot(x, 0, p)[0], _foot(x, 1, p)[0]) < -0.25 * p.l
+    status = ("diverged" if np.max(np.abs(x[4:N])) > 1e3 else "fell" if fell
+              else "ok" if res["flags"][1] == 1 else "flight")
+    return {"status": status, "z": res["z"],
             "period": T, "double_support": float(lo), "swing_period": T - float(lo),
             "step_length": float(x[0] + (p.l - p.r) * math.sin(x[2])),
             "n_events": 1 + sum(1 for _, kind, _ in res["events"]

@@ -1,0 +1,86 @@
+"""One branch point of the continuous model with the exact monodromy (issue #24 "Speed":
+`ContinuousProblem.evaluate` with ``monodromy = "exact"``): P(z), M and the step's
+descriptors from one variational integration (`variational.step_jacobian`,
+`variational.step_summary`) instead of a map and the variational step beside it; dP/dlambda
+still from two maps. The descriptors by the map's definitions, so that the admissibility
+functions and the corrector's statuses are the same as with finite differences."""
+import numpy as np
+import pytest
+
+import pdw
+from pdw.analysis.stepmap import limit_cycle as LC
+from pdw.analysis.stepmap import poincare
+from pdw.analysis.stepmap import variational as V
+from pdw.analysis.stepmap.gait_maps import ContinuousProblem
+
+pytest.importorskip("scipy")
+
+P = pdw.Params.paper_steady()
+LAWS = {"hunt_crossley": None, "flores": pdw.Contact("flores", e=0.18),
+        "kelvin_voigt": pdw.Contact("kelvin_voigt")}
+
+
+#: Kelvin-Voigt's gait at paper_steady (`LC.find_gait(P, contact=...)`, 80 s: its long walks)
+Z_KV = np.array([-0.3506236417361184, 0.35055921795943923, 0.8372792655045687,
+                 -0.17383873615168385, -1.7262514325957738, -1.5799953318450257])
+
+
+def _gait(c):
+    if c is not None and c.normal == "kelvin_voigt":
+        return LC.find_gait(P, contact=c, guess=Z_KV, workers=1).details["z"]
+    return LC.find_gait(P, contact=c, workers=1).details["z"]
+
+
+@pytest.fixture(scope="module", params=sorted(LAWS))
+def law_gait(request):
+    c = LAWS[request.param]
+    return c, _gait(c)
+
+
+def test_the_exact_branch_point_equals_the_map_and_its_differences(law_gait):
+    """Measured at each law's paper_steady gait: P(z) to 3e-10, period, step length and
+    double support to 2e-11, the same event count and admissibility, dP/dk_hip the same two
+    maps' difference (equal), M to 1.7e-4 of the differences' (their own resolution)."""
+    c, z = law_gait
+    ev = {}
+    for mono in ("differences", "exact"):
+        prob = ContinuousProblem(P, "k_hip", workers=1, options={"contact": c})
+        prob.monodromy = mono
+        ev[mono] = prob.evaluate(z, P.k_hip)
+        assert ev[mono].ok, ev[mono].status
+    a, b = ev["differences"], ev["exact"]
+    assert np.max(np.abs(a.Pz - b.Pz)) < 1e-9
+    for key in ("period", "step_length", "double_support"):
+        assert a.info[key] == pytest.approx(b.info[key], abs=1e-9)
+    assert a.info["n_events"] == b.info["n_events"]
+    for key in a.admissible:
+        assert a.admissible[key] == pytest.approx(b.admissible[key], abs=1e-9)
+    np.testing.assert_allclose(b.P_lam, a.P_lam, atol=1e-12)
+    assert np.max(np.abs(a.M - b.M)) < 1e-3 * np.abs(a.M).max()
+
+
+def test_step_summary_follows_the_map_through_a_pending_lift_off():
+    """Kelvin-Voigt's gait: its feet rise before they lift off (pending, "rise" events that
+    switch no flag), which the map's event count does not see either."""
+    c = LAWS["kelvin_voigt"]
+    z = _gait(c)
+    r = V.step_jacobian(z, P, contact=c)
+    assert "rise" in [kind for _, kind, _ in r["events"]]
+    s, m = V.step_summary(r, P), poincare.step(z, P, contact=c)
+    assert s["status"] == "ok" and s["n_events"] == m["n_events"]
+    assert s["swing_period"] == pytest.approx(m["swing_period"], abs=1e-9)
+
+
+def test_a_fall_is_the_maps_status():
+    """A state from which the walker falls over backwards (hip rising at 0.5 m/s, legs
+    swinging back): the variational step still reaches a "touch-down" (at 1.35 s, the walker
+    upside down, theta -3.5 rad), the map says "fell"; so does the exact branch point."""
+    z = LC.find_gait(P, workers=1).details["z"].copy()
+    z[3:] = (0.5, -4.0, -3.0)
+    r = V.step_jacobian(z, P, max_events=80)
+    assert V.step_summary(r, P)["status"] == "fell"
+    assert poincare.step(z, P)["status"] == "fell"
+    prob = ContinuousProblem(P, "k_hip", workers=1)
+    prob.monodromy = "exact"
+    ev = prob.evaluate(z, P.k_hip)
+    assert not ev.ok and ev.status == "fell"
