@@ -25,6 +25,10 @@ relative step ``lam_rel`` (1e-6 hybrid, 1e-4 continuous) of the continuation's s
 Every evaluation also returns the gait's descriptors and its *admissibility* functions:
 quantities that must stay positive for the gait to exist as modelled (the end of a family when
 one crosses zero), see `HybridProblem.ADMISSIBLE` and `ContinuousProblem.ADMISSIBLE`.
+
+Over 500 lines: the two problems share the parameter handling of `_Problem`, and the
+continuous one's three ways to its Jacobians (differences, the exact step, the cross-check)
+read the same options and descriptors.
 """
 from __future__ import annotations
 
@@ -395,20 +399,33 @@ class ContinuousProblem(_Problem):
         M = np.column_stack([(vals[1 + k] - vals[1 + n + k]) / (2 * h) for k in range(n)])
         return Pz, steps, M, (vals[1 + 2 * n] - vals[2 + 2 * n]) / (up - down)
 
+    #: ``monodromy = "exact"``: df/dmu of the variational step's parameter column is the
+    #: difference of f between mu +- this relative step (of the coordinate mu, lambda or log
+    #: lambda; 1e-2 of ``lam_step`` at mu = 0; one-sided where `lam_offsets` is): f's
+    #: truncation error ~1e-12, its rounding ~1e-10 (relative)
+    SENS_REL = 1e-6
+
     def _exact(self, z, mu, P, contact):
         """(P(z), its step dict, the exact M, dP/dlambda) or a failed `Evaluation`, period 1:
         P(z), M and the step's descriptors from one variational integration
         (`variational.step_jacobian`, `variational.step_summary`: z' equals the map's to
-        ~1e-10), dP/dlambda from central differences of the map (2 maps, through the ensemble
-        engine where it takes them). Where the variational step fails the map at z says why
+        ~1e-10) and dP/dlambda from the same integration's parameter column
+        (`variational.param_column`: a parameter that only f reads; `SENS_REL`), else
+        from central differences of the map (2 maps, through the ensemble engine where it
+        takes them: l, r, a change of contact law). Where the variational step fails the map at z says why
         (its status: "fell", "no_touch_down", ...)."""
         from . import variational
         up, down = self.lam_offsets(mu)
         if up == down:
             return Evaluation(False, "invalid parameter: no room for a difference")
+        h = self.SENS_REL * abs(mu) if mu != 0.0 else 1e-2 * self.lam_step
+        lo, hi = mu - h if down else mu, mu + h if up else mu
+        models = [self.point_at(hi), self.point_at(lo)]
+        column = variational.param_column(P, contact, *models)
         try:
-            res = variational.step_jacobian(z, P, contact=contact, **{
-                k: self.opts[k] for k in ("rtol", "atol") if k in self.opts})
+            res = variational.step_jacobian(
+                z, P, contact=contact, dparam=(*models, hi - lo) if column else None,
+                **{k: self.opts[k] for k in ("rtol", "atol") if k in self.opts})
             step = variational.step_summary(res, P)
         except InvalidInputError as e:
             Pz, steps = self._run([(z, mu)])[0]
@@ -420,6 +437,8 @@ class ContinuousProblem(_Problem):
         if step["status"] != "ok":
             return Evaluation(False, step["status"])
         self.t_hint = step["period"]
+        if column:
+            return step["z"], [step], res["M"], res["dz_dparam"]
         models = [self.point_at(mu + up), self.point_at(mu + down)]
         vals = self._images([z, z], models)
         self.n_maps += 2

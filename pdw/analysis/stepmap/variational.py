@@ -67,11 +67,14 @@ They agree to 2e-8 on paper_steady's multipliers (2e-9 at rtol 1e-12, phi_rtol 1
 ~1e-7 for the other laws, to 2e-5 for Kelvin-Voigt's calibrated gait, whose rises' saltations
 move by 1e-3 with a 1e-11 s shift of the event (the Python version itself moves by 2.5e-5
 between rtol 1e-10 and 1e-11). Cost (benchmarks/bench_monodromy.py, CPU): compiled 0.16-0.5 x
-the finite differences (13-15 maps through the ensemble engine), Python 6-26 x; a branch point
-of `continue_gait` with the exact M costs 1.06 x the differences' for the default law (their 12
-extra maps ride almost free in the engine's lanes) and 0.35 x for flores. Not the
-continuation's default (the lead's decision); it is the cross-check of `GaitMap.crosscheck` and
-of a user's doubts near a kink.
+the finite differences (13-15 maps through the ensemble engine), Python 6-26 x. ``dparam``
+adds a parameter mu to the state (the compiled engine only): its column of A is a central
+difference of f between two models (relative step 1e-6 in the continuation), and dz'/dmu comes
+from the same integration; a branch point of `continue_gait` (P(z), M, dP/dmu and the map's
+descriptors, `step_summary`) then costs one variational step, 0.6-0.7 x the differences' for
+the default law and 0.2-0.3 x for the laws the ensemble engine does not run (docs/continuation.md).
+Not the continuation's default (its documented branches are the differences'); it is the
+cross-check of `GaitMap.crosscheck` and of a user's doubts near a kink.
 
 Over 500 lines: Eq. 18's flag rules, the saltations and the event loop that both engines share
 belong together (split, each part would read the others' state).
@@ -145,8 +148,9 @@ class _Field:
     """f and df/dy of the state y = (x, v_in1, v_in2) (the approach speeds only where the law
     uses them, ``na`` = 2; else y = x): v_in' = 0, f reads v_in as held speeds."""
 
-    def __init__(self, f, na, params):
-        self.f, self.na, self.n, self.params = f, na, N + na, params
+    def __init__(self, f, na, params, pm=None):
+        self.f, self.na, self.n, self.params = f, na, N + na + (pm is not None), params
+        self.pm = pm        # (f at mu + dmu/2, f at mu - dmu/2, dmu): y carries mu last
         self.flags = [1, 1]
 
     def _set(self, y):
@@ -155,10 +159,10 @@ class _Field:
                                 (float(y[N]), float(y[N + 1])))
 
     def __call__(self, t, y):
-        if not self.na:
+        if self.n == N:
             return self.f(t, y)
         self._set(y)
-        return np.concatenate([self.f(t, y[:N]), np.zeros(self.na)])
+        return np.concatenate([self.f(t, np.ascontiguousarray(y[:N])), np.zeros(self.n - N)])
 
     def jac(self, t, y):
         if not self.na:
@@ -286,9 +290,11 @@ PHI_TOL = 1e-8
 
 def _compiled_interval(F, p, specs, t0, y, Phi, h, t_max, rtol, atol, phi_tol):
     """(t_ev, k_ev, next step): y and Phi advanced in place to the first event (pdw_cvar.c)."""
+    fp, fm, dmu = F.pm if F.pm is not None else (None, None, 0.0)
     rc, t_ev, k_ev, h = _core.cvar_interval(F.f, p.l, p.r, F.na, specs, t0, y, Phi, h, t_max,
                                             rtol=rtol, atol=atol, phi_rtol=phi_tol,
-                                            phi_atol=phi_tol, phi_error=True, a_hermite=True)
+                                            phi_atol=phi_tol, phi_error=True, a_hermite=True,
+                                            f_plus=fp, f_minus=fm, dmu=dmu)
     if rc == 1:
         raise InvalidInputError("variational step_jacobian: no touch-down by t_max = %g s"
                                 % t_max)
@@ -326,7 +332,7 @@ def _python_interval(F, aug_rhs, evs, t0, y, Phi, t_max, rtol, atol, phi_rtol):
 def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
                   contact=None, rtol: float = 1e-10, atol: float = 1e-12,
                   phi_rtol: float | None = None, t_max: float = 2.5,
-                  max_events: int = 40, engine: str = "compiled") -> dict:
+                  max_events: int = 40, engine: str = "compiled", dparam=None) -> dict:
     """One step of the touch-down map and its exact Jacobian (module docstring).
 
     Parameters
@@ -354,6 +360,12 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
         ``"compiled"`` (default): x and Phi together by RODAS4 in C (pdw/core/csrc/pdw_cvar.c,
         `rtol`, `atol` on x), the events located there; ``"python"``: SciPy's Radau for x and
         LSODA for (x, Phi), the reference (module docstring).
+    dparam : ((Params, contact), (Params, contact), float), optional
+        The model at mu + dmu/2 and at mu - dmu/2 of a parameter mu, and dmu (``engine``
+        "compiled" only; `param_column`): the state carries mu (mu' = 0), df/dmu is the
+        difference of the two models' f over dmu (central, O(dmu^2)), and ``dz_dparam`` is
+        dz'/dmu, from the same integration. The two may differ from ``params`` only where
+        f reads them (not in l, r: the section and the event functions; the same law).
 
     Returns
     -------
@@ -361,7 +373,8 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
         ``z`` (z' (nz,)), ``M`` (nz, nz) dP/dz, ``T`` (the step time [s]), ``events`` (list of
         (t, kind, leg) of the flag switches and gates), ``saltations`` (their S_k, (n, n) with
         n = 8, or 10 with approach speeds), ``x`` (the state at the touch-down, legs not
-        relabelled), ``dx_dz`` (n, nz), ``Phi`` (n, n) and ``flags`` (the support flags just
+        relabelled), ``dx_dz`` (n, nz), ``Phi`` (n, n) and ``flags``; with ``dparam`` also
+        ``dz_dparam`` (nz,) (and n counts mu) (the support flags just
         before the touch-down).
     """
     if engine not in ("compiled", "python"):
@@ -383,10 +396,20 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
     nz = len(z)
     f = ode_function(p, variant, flags=(1, 1), contact=law,
                      approach_speeds=v_in0 if na else (0.0, 0.0))
-    F = _Field(f, na, p)
+    pm = None
+    if dparam is not None:
+        if engine != "compiled" or not param_column(p, law, *dparam[:2]):
+            raise InvalidInputError("variational step_jacobian: dparam needs engine='compiled' "
+                                    "and models that differ only where f reads them (not in "
+                                    "l, r or the law)")
+        pm = tuple(ode_function(_section._params(P), variant, flags=(1, 1), contact=c)
+                   for P, c in dparam[:2]) + (float(dparam[2]),)
+    F = _Field(f, na, p, pm)
     n = F.n
-    y = np.concatenate([x0, v_in0]) if na else x0.copy()
-    E = np.zeros((n, nz))
+    y = np.concatenate([x0] + ([v_in0] if na else []) + ([np.zeros(1)] if pm else []))
+    E = np.zeros((n, nz + (pm is not None)))
+    if pm:
+        E[n - 1, nz] = 1.0
     E[:N, :6] = _embed_jac(z, p)
     if na:
         if z[6] > 0.0:
@@ -527,9 +550,12 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
             if na:
                 R[6, N + 1] = 1.0   # the trailing foot's approach speed: leg 2's held one
             M = R @ S @ Phi @ E
-            return {"z": R @ y, "M": M, "T": t_ev, "events": events, "saltations": salts,
-                    "x": y[:N].copy(), "dx_dz": S @ Phi @ E, "Phi": Phi,
-                    "flags": (flags[0], flags[1])}
+            out = {"z": R @ y, "M": M[:, :nz], "T": t_ev, "events": events,
+                   "saltations": salts, "x": y[:N].copy(), "dx_dz": S @ Phi @ E[:, :nz],
+                   "Phi": Phi, "flags": (flags[0], flags[1])}
+            if pm:
+                out["dz_dparam"] = M[:, nz]
+            return out
         if flags[leg] and _rate(y, leg, p)[0] <= 0.0:
             # above the ground but not yet rising (Eq. 18a): the penetration force ends, the
             # flag stays 1 until v > 0
@@ -549,6 +575,20 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
         salts.append(S)
     raise InvalidInputError("variational step_jacobian: more than %d flag switches in one step"
                             % max_events)
+
+
+def param_column(params, contact, plus, minus) -> bool:
+    """Whether `step_jacobian`'s ``dparam`` takes the models ``plus`` and ``minus`` ((Params,
+    contact) each) around (``params``, ``contact``): the same leg length and foot radius (the
+    section's embedding and the event functions read them) and the same contact law (one
+    kernel); the rest of the parameters only f reads."""
+    law = Contact.coerce(contact)
+    for P, c in (plus, minus):
+        q, other = _section._params(P), Contact.coerce(c)
+        if (q.l, q.r) != (params.l, params.r) or (other.normal, other.friction) != (
+                law.normal, law.friction):
+            return False
+    return True
 
 
 def step_summary(res: dict, params: Params | None = None) -> dict:

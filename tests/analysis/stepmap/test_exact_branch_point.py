@@ -1,9 +1,9 @@
 """One branch point of the continuous model with the exact monodromy (issue #24 "Speed":
-`ContinuousProblem.evaluate` with ``monodromy = "exact"``): P(z), M and the step's
-descriptors from one variational integration (`variational.step_jacobian`,
-`variational.step_summary`) instead of a map and the variational step beside it; dP/dlambda
-still from two maps. The descriptors by the map's definitions, so that the admissibility
-functions and the corrector's statuses are the same as with finite differences."""
+`ContinuousProblem.evaluate` with ``monodromy = "exact"``): P(z), M, dP/dlambda and the step's
+descriptors from one variational integration (`variational.step_jacobian` with a parameter
+column, `variational.step_summary`) instead of three maps and the variational step beside
+them. The descriptors by the map's definitions, so that the admissibility functions and the
+corrector's statuses are the same as with finite differences."""
 import numpy as np
 import pytest
 
@@ -37,10 +37,20 @@ def law_gait(request):
     return c, _gait(c)
 
 
+def _map_difference(prob, z, mu, rel):
+    """dP/dmu by central differences of the map, relative step ``rel`` of mu."""
+    h = rel * abs(mu)
+    a, b = prob.images([(z, prob.point_at(mu + h)), (z, prob.point_at(mu - h))])
+    return (a - b) / (2 * h)
+
+
 def test_the_exact_branch_point_equals_the_map_and_its_differences(law_gait):
     """Measured at each law's paper_steady gait: P(z) to 3e-10, period, step length and
-    double support to 2e-11, the same event count and admissibility, dP/dk_hip the same two
-    maps' difference (equal), M to 1.7e-4 of the differences' (their own resolution)."""
+    double support to 2e-11, the same event count and admissibility, M to 1.7e-4 of the
+    differences' (their own resolution), dP/dk_hip (the parameter column) to 8e-6 of its
+    size from central differences of the map with relative steps 1e-3 (whose own change to
+    steps 1e-4 is 5e-7 .. 4e-6). The default continuation's dP/dk_hip (lam_rel 1e-4 of a
+    scale of 1: steps 1e-4 of k_hip) is 1e-5 off."""
     c, z = law_gait
     ev = {}
     for mono in ("differences", "exact"):
@@ -55,8 +65,41 @@ def test_the_exact_branch_point_equals_the_map_and_its_differences(law_gait):
     assert a.info["n_events"] == b.info["n_events"]
     for key in a.admissible:
         assert a.admissible[key] == pytest.approx(b.admissible[key], abs=1e-9)
-    np.testing.assert_allclose(b.P_lam, a.P_lam, atol=1e-12)
+    ref = _map_difference(prob, z, P.k_hip, 1e-3)
+    assert np.max(np.abs(b.P_lam - ref)) < 3e-5 * np.abs(ref).max()
     assert np.max(np.abs(a.M - b.M)) < 1e-3 * np.abs(a.M).max()
+
+
+@pytest.mark.parametrize("parameter", ["d_n", "gamma", "m_h"])
+def test_the_parameter_column_against_map_differences(parameter):
+    """Parameters of f alone (a damping, the slope, a mass): the variational step's column
+    against central differences of the map with relative steps 1e-3 (measured 1e-6, 1.7e-6,
+    5.8e-7 of its size; the differences' own spread to steps 1e-4: 3.5e-6, 1.8e-6, 4.2e-7)."""
+    z = LC.find_gait(P, workers=1).details["z"]
+    prob = ContinuousProblem(P, parameter, workers=1)
+    prob.monodromy = "exact"
+    mu = prob.coord(prob.start_value())
+    ev = prob.evaluate(z, mu)
+    assert ev.ok, ev.status
+    ref = _map_difference(prob, z, mu, 1e-3)
+    assert np.max(np.abs(ev.P_lam - ref)) < 1e-5 * np.abs(ref).max()
+
+
+def test_a_parameter_of_the_section_takes_map_differences():
+    """The leg length moves the section's embedding and the event functions, which the
+    parameter column does not differentiate: dP/dl then comes from two maps, the same as the
+    finite-difference branch point's (bitwise: the same maps)."""
+    z = LC.find_gait(P, workers=1).details["z"]
+    ev = {}
+    for mono in ("differences", "exact"):
+        prob = ContinuousProblem(P, "l", workers=1)
+        prob.monodromy = mono
+        ev[mono] = prob.evaluate(z, P.l)
+        assert ev[mono].ok, ev[mono].status
+    np.testing.assert_array_equal(ev["exact"].P_lam, ev["differences"].P_lam)
+    with pytest.raises(pdw.InvalidInputError, match="dparam"):
+        V.step_jacobian(z, P, dparam=((P.replace(l=P.l + 1e-6), None),
+                                      (P.replace(l=P.l - 1e-6), None), 2e-6))
 
 
 def test_step_summary_follows_the_map_through_a_pending_lift_off():
