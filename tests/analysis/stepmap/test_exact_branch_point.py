@@ -49,8 +49,7 @@ def test_the_exact_branch_point_equals_the_map_and_its_differences(law_gait):
     double support to 2e-11, the same event count and admissibility, M to 1.7e-4 of the
     differences' (their own resolution), dP/dk_hip (the parameter column) to 8e-6 of its
     size from central differences of the map with relative steps 1e-3 (whose own change to
-    steps 1e-4 is 5e-7 .. 4e-6). The default continuation's dP/dk_hip (lam_rel 1e-4 of a
-    scale of 1: steps 1e-4 of k_hip) is 1e-5 off."""
+    steps 1e-4, continue_gait's relative step, is 5e-7 .. 4e-6)."""
     c, z = law_gait
     ev = {}
     for mono in ("differences", "exact"):
