@@ -419,9 +419,16 @@ class ContinuousProblem(_Problem):
         if up == down:
             return Evaluation(False, "invalid parameter: no room for a difference")
         h = self.SENS_REL * abs(mu) if mu != 0.0 else 1e-2 * self.lam_step
-        lo, hi = mu - h if down else mu, mu + h if up else mu
-        models = [self.point_at(hi), self.point_at(lo)]
-        column = variational.param_column(P, contact, *models)
+        ends = []
+        for side, off in ((1.0, up), (-1.0, down)):
+            try:                    # one-sided at the edge of the parameter's range
+                ends.append((mu + side * h, self.point_at(mu + side * h)) if off else
+                            (mu, (P, contact)))
+            except InvalidInputError:
+                ends.append((mu, (P, contact)))
+        (hi, plus), (lo, minus) = ends
+        models = [plus, minus]
+        column = hi != lo and variational.param_column(P, contact, *models)
         try:
             res = variational.step_jacobian(
                 z, P, contact=contact, dparam=(*models, hi - lo) if column else None,

@@ -126,3 +126,20 @@ def test_a_fall_is_the_maps_status():
     prob.monodromy = "exact"
     ev = prob.evaluate(z, P.k_hip)
     assert not ev.ok and ev.status == "fell"
+
+
+def test_the_parameter_column_at_the_edge_of_the_range_is_one_sided():
+    """The hip damper at d_hip = 0, the edge of its range (d_hip >= 0): the column takes the
+    models at 0 and 1e-8 (one-sided, 1e-2 of the problem's difference step at mu = 0). The
+    map's one-sided differences approach it as O(h): 1.5e-3, 1.5e-4, 1.5e-5 of its size at
+    steps 1e-3, 1e-4, 1e-5 (measured)."""
+    P0 = P.replace(d_hip=0.0)
+    z = LC.find_gait(P, workers=1).details["z"]
+    prob = ContinuousProblem(P0, "d_hip", workers=1)
+    prob.monodromy = "exact"
+    assert prob.lam_offsets(0.0)[1] == 0.0
+    ev = prob.evaluate(z, 0.0)
+    assert ev.ok, ev.status
+    a, b = prob.images([(z, prob.point_at(1e-5)), (z, prob.point_at(0.0))])
+    ref = (a - b) / 1e-5
+    assert np.max(np.abs(ev.P_lam - ref)) < 5e-5 * np.abs(ref).max()
