@@ -18,7 +18,8 @@ eigenvalues are the Floquet multipliers) and ``d P^n / d lambda``. Two models:
   executor (threads by default; the compiled loop releases the GIL); 2 dim + 2 with dim = len(z).
   With ``monodromy = "exact"`` (period 1, paper variant, Coulomb friction) P(z), M and the
   step's descriptors come from one variational integration (`variational.step_jacobian`,
-  `variational.step_summary`), d P / d lambda from two maps.
+  `variational.step_summary`), d P / d lambda from its parameter column (two maps for l, r
+  or a change of law).
 
 ``d P^n / d lambda`` is a central difference in the (internal) parameter coordinate for both, of
 relative step ``lam_rel`` (1e-6 hybrid, 1e-4 continuous) of the continuation's scale.
