@@ -11,9 +11,10 @@ lankarani_nikravesh the default gait's z with an approach speed of 0.3 m/s, one 
 * ``C 1e-9``: exact C with x's tolerances loosened to rtol 1e-9, atol 1e-11 (Phi's unchanged);
 * ``exact Py``: the same with engine "python" (SciPy Radau + LSODA, the reference).
 
-and, for the default law and flores, one branch point of `continue_gait` in k_hip
-(`ContinuousProblem.evaluate`, monodromy "differences" against "exact": the map at z, its
-parameter differences and M). Process CPU time, medians of ROUNDS rounds interleaved (each
+and one branch point of `continue_gait` (`ContinuousProblem.evaluate`, monodromy "differences"
+against "exact": P(z), dP/dparameter, M and the step's descriptors; with "exact" all from one
+variational integration with a parameter column) for the default law in k_hip and d_n, flores
+in k_hip, kelvin_voigt in contact.d and lankarani_nikravesh in contact.e, at the case's z. Process CPU time, medians of ROUNDS rounds interleaved (each
 round runs every case once, in turn); the load average is printed before and after (a shared
 machine: read the ratios, taken in the same rounds). The multipliers' largest difference to the
 Python version's (``|dm|``) is printed for both fd and exact C.
@@ -67,11 +68,13 @@ def main():
                                                  atol=LC.TIGHT["atol"])["M"],
     }
     probs = {}
-    for name, c, z in cases[:2]:
+    branch = [(cases[0], "k_hip"), (cases[0], "d_n"), (cases[1], "k_hip"),
+              (cases[2], "contact.d"), (cases[3], "contact.e")]
+    for (name, c, z), par in branch:
         for mono in ("differences", "exact"):
-            prob = ContinuousProblem(P, "k_hip", workers=1, options={"contact": c})
+            prob = ContinuousProblem(P, par, workers=1, options={"contact": c})
             prob.monodromy = mono
-            probs[(name, mono)] = (prob, z)
+            probs[(name + " in " + par, mono)] = (prob, z)
     cpu = {}
     got = {}
     for _ in range(ROUNDS):
@@ -81,8 +84,9 @@ def main():
                 got[(name, way)] = f(c, z)
                 cpu.setdefault((name, way), []).append(time.process_time() - c0)
         for key, (prob, z) in probs.items():
+            mu = prob.coord(prob.start_value())
             c0 = time.process_time()
-            ev = prob.evaluate(z, P.k_hip)
+            ev = prob.evaluate(z, mu)
             cpu.setdefault(("branch point",) + key, []).append(time.process_time() - c0)
             assert ev.ok, ev.status
             got[("branch point",) + key] = ev.M
@@ -103,15 +107,16 @@ def main():
                      % (name, t["fd"], t["exact C"], t["exact C 1e-9"], t["exact Py"],
                         t["exact C"] / t["fd"], t["exact C 1e-9"] / t["fd"],
                         t["exact Py"] / t["fd"], d["fd"], d["exact C"], d["exact C 1e-9"]))
-    lines.append("one branch point of continue_gait in k_hip (ContinuousProblem.evaluate: the map,"
-                 " its 2 parameter differences and M), CPU s:")
-    for name, _, _ in cases[:2]:
-        tb = {m: statistics.median(cpu[("branch point", name, m)])
+    lines.append("one branch point of continue_gait (ContinuousProblem.evaluate: P(z), "
+                 "dP/dparameter, M, descriptors), CPU s:")
+    for (name, _, _), par in branch:
+        key = name + " in " + par
+        tb = {m: statistics.median(cpu[("branch point", key, m)])
               for m in ("differences", "exact")}
-        dm = float(np.max(np.abs(_mult(got[("branch point", name, "exact")])
-                                 - _mult(got[("branch point", name, "differences")]))))
-        lines.append("  %-26s differences %.4f, exact %.4f (exact/differences %.2f); "
-                     "multipliers differ by %.1e" % (name, tb["differences"], tb["exact"],
+        dm = float(np.max(np.abs(_mult(got[("branch point", key, "exact")])
+                                 - _mult(got[("branch point", key, "differences")]))))
+        lines.append("  %-38s differences %.4f, exact %.4f (exact/differences %.2f); "
+                     "multipliers differ by %.1e" % (key, tb["differences"], tb["exact"],
                                                      tb["exact"] / tb["differences"], dm))
     publish("monodromy.txt", lines)
 

@@ -14,6 +14,10 @@ cdef extern from "pdw_cvar.h":
         double anchors[4]
         int na
         double l, r
+        int np
+        const double *p_plus
+        const double *p_minus
+        double dmu
     ctypedef struct pdw_cvar_opts:
         double rtol, atol, phi_rtol, phi_atol, t_max, dir_step
         int phi_error
@@ -33,7 +37,8 @@ cdef extern from "pdw_cvar.h":
 def cvar_interval(OdeFunction f not None, double l, double r, int na, events, double t,
                   double[::1] y, double[:, ::1] Phi, double h, double t_max, *,
                   double rtol=1e-10, double atol=1e-12, double phi_rtol=1e-10,
-                  double phi_atol=1e-10, double dir_step=1e-7,
+                  double phi_atol=1e-10, double dir_step=1e-7, OdeFunction f_plus=None,
+                  OdeFunction f_minus=None, double dmu=0.0,
                   bint phi_error=False, bint one_sided=False, bint a_hermite=True, long max_steps=200000, stats=None):
     """Integrate (y, Phi) of f (its flags and anchors held) from t to the first crossing of
     ``events`` (a sequence of (kind, leg, dir): pdw_cvar.h's PDW_CVAR_EV_* codes, leg 0 or 1,
@@ -41,7 +46,10 @@ def cvar_interval(OdeFunction f not None, double l, double r, int na, events, do
     2 (approach speeds after x). l, r: leg length and foot radius [m]. Returns (status, t,
     index of the event or -1, next step h): status 0 an event, 1 t_max, -1 the step size
     failed, -2 max_steps. ``a_hermite`` (default): A at the inner stage times from its cubic
-    Hermite interpolant (pdw_cvar.h); ``one_sided``: forward differences for dA/dt. ``stats`` (a list of 4 ints, optional) accumulates steps, rejections,
+    Hermite interpolant (pdw_cvar.h); ``one_sided``: forward differences for dA/dt.
+    ``f_plus``, ``f_minus`` (the same kernel as f, other parameters) and ``dmu`` (their
+    parameters' distance): y carries a parameter mu last (y (9 + na,), Phi (9 + na, 9 + na)),
+    df/dmu the difference of their f over dmu (pdw_cvar.h's np). ``stats`` (a list of 4 ints, optional) accumulates steps, rejections,
     f and Jacobian evaluations."""
     cdef pdw_cvar_model m
     cdef pdw_cvar_opts o
@@ -49,7 +57,8 @@ def cvar_interval(OdeFunction f not None, double l, double r, int na, events, do
     cdef pdw_cvar_event ev[PDW_CVAR_MAXEV]
     cdef double work[PDW_NWORK]
     cdef int n_ev = len(events), k_ev = -1, rc, i
-    cdef int n = PDW_NX + na
+    cdef int npar = 0 if f_plus is None else 1
+    cdef int n = PDW_NX + na + npar
     if f.nx != PDW_NX:
         raise InvalidInputError("cvar_interval: a Coulomb-friction kernel (nx = %d), got nx = %d"
                                 % (PDW_NX, f.nx))
@@ -72,6 +81,16 @@ def cvar_interval(OdeFunction f not None, double l, double r, int na, events, do
     m.na = na
     m.l = l
     m.r = r
+    m.np = npar
+    m.p_plus = m.p_minus = NULL
+    m.dmu = dmu
+    if npar:
+        if f_minus is None or f_plus.kern != f.kern or f_minus.kern != f.kern:
+            raise ValueError("f_plus and f_minus: both, with f's kernel")
+        if not dmu != 0.0:
+            raise ValueError("dmu must be nonzero")
+        m.p_plus = f_plus.p
+        m.p_minus = f_minus.p
     o.rtol, o.atol, o.t_max, o.dir_step = rtol, atol, t_max, dir_step
     o.phi_rtol, o.phi_atol = phi_rtol, phi_atol
     o.phi_error = phi_error

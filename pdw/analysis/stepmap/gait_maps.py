@@ -16,12 +16,20 @@ eigenvalues are the Floquet multipliers) and ``d P^n / d lambda``. Two models:
   1e-12, step ``fd_step`` = 1e-5): the map is reproducible to ~1e-10, so M is good to ~1e-5
   (multipliers below ~1e-4 in modulus are not resolved). The 12 + 2 evaluations run on an
   executor (threads by default; the compiled loop releases the GIL); 2 dim + 2 with dim = len(z).
+  With ``monodromy = "exact"`` (period 1, paper variant, Coulomb friction) P(z), M and the
+  step's descriptors come from one variational integration (`variational.step_jacobian`,
+  `variational.step_summary`), d P / d lambda from its parameter column (two maps for l, r
+  or a change of law).
 
 ``d P^n / d lambda`` is a central difference in the (internal) parameter coordinate for both, of
 relative step ``lam_rel`` (1e-6 hybrid, 1e-4 continuous) of the continuation's scale.
 Every evaluation also returns the gait's descriptors and its *admissibility* functions:
 quantities that must stay positive for the gait to exist as modelled (the end of a family when
 one crosses zero), see `HybridProblem.ADMISSIBLE` and `ContinuousProblem.ADMISSIBLE`.
+
+Over 500 lines: the two problems share the parameter handling of `_Problem`, and the
+continuous one's three ways to its Jacobians (differences, the exact step, the cross-check)
+read the same options and descriptors.
 """
 from __future__ import annotations
 
@@ -344,42 +352,13 @@ class ContinuousProblem(_Problem):
             P, contact = self.point_at(mu)
         except InvalidInputError as e:
             return Evaluation(False, "invalid parameter: %s" % e)
-        tasks = [(z, mu)]
-        exact = jac and self.monodromy == "exact"
-        if jac:
-            h = self.fd_step
-            up, down = self.lam_offsets(mu)
-            if up == down:
-                return Evaluation(False, "invalid parameter: no room for a difference")
-            E = np.eye(self.dim) * h
-            if not exact:
-                tasks += [(z + e, mu) for e in E] + [(z - e, mu) for e in E]
-            tasks += [(z, mu + up), (z, mu + down)]
-        outs = self._run(tasks)
-        self.n_maps += self.period * len(tasks)
-        Pz, steps = outs[0]
-        if Pz is None:
-            return Evaluation(False, steps[-1]["status"] if steps else "failed")
-        self.t_hint = steps[0]["period"]
-        M = P_lam = None
-        if jac:
-            vals = [o[0] for o in outs]
-            if any(v is None for v in vals):
-                bad = next(o[1][-1]["status"] for o in outs if o[0] is None)
-                return Evaluation(False, "finite-difference neighbour: " + bad)
-            n = self.dim
-            if exact:
-                from . import variational
-                try:
-                    M = variational.step_jacobian(z, P, contact=contact, **{
-                        k: self.opts[k] for k in ("rtol", "atol") if k in self.opts})["M"]
-                except InvalidInputError as e:
-                    return Evaluation(False, "exact monodromy: %s" % e)
-                P_lam = (vals[1] - vals[2]) / (up - down)
-            else:
-                M = np.column_stack([(vals[1 + k] - vals[1 + n + k]) / (2 * h)
-                                     for k in range(n)])
-                P_lam = (vals[1 + 2 * n] - vals[2 + 2 * n]) / (up - down)
+        if jac and self.monodromy == "exact":
+            got = self._exact(z, mu, P, contact)
+        else:
+            got = self._differences(z, mu, jac)
+        if isinstance(got, Evaluation):
+            return got
+        Pz, steps, M, P_lam = got
         info = {"period": float(sum(s["period"] for s in steps)),
                 "step_length": float(np.mean([s["step_length"] for s in steps])),
                 "double_support": float(np.mean([s["double_support"] for s in steps])),
@@ -392,6 +371,107 @@ class ContinuousProblem(_Problem):
                "swing_period": min(s["swing_period"] for s in steps),
                "event_sequence": 0.5 - abs(info["n_events"] - self.ref_events)}
         return Evaluation(True, "ok", Pz, M, P_lam, info, adm)
+
+    def _differences(self, z, mu, jac):
+        """(P^n(z), its step dicts, M and dP/dlambda by central differences (None without
+        ``jac``)) or a failed `Evaluation`: 1 + 2 dim + 2 maps."""
+        tasks = [(z, mu)]
+        if jac:
+            h = self.fd_step
+            up, down = self.lam_offsets(mu)
+            if up == down:
+                return Evaluation(False, "invalid parameter: no room for a difference")
+            E = np.eye(self.dim) * h
+            tasks += [(z + e, mu) for e in E] + [(z - e, mu) for e in E]
+            tasks += [(z, mu + up), (z, mu + down)]
+        outs = self._run(tasks)
+        self.n_maps += self.period * len(tasks)
+        Pz, steps = outs[0]
+        if Pz is None:
+            return Evaluation(False, steps[-1]["status"] if steps else "failed")
+        self.t_hint = steps[0]["period"]
+        if not jac:
+            return Pz, steps, None, None
+        vals = [o[0] for o in outs]
+        if any(v is None for v in vals):
+            bad = next(o[1][-1]["status"] for o in outs if o[0] is None)
+            return Evaluation(False, "finite-difference neighbour: " + bad)
+        n = self.dim
+        M = np.column_stack([(vals[1 + k] - vals[1 + n + k]) / (2 * h) for k in range(n)])
+        return Pz, steps, M, (vals[1 + 2 * n] - vals[2 + 2 * n]) / (up - down)
+
+    #: ``monodromy = "exact"``: df/dmu of the variational step's parameter column is the
+    #: difference of f between mu +- this relative step (of the coordinate mu, lambda or log
+    #: lambda; 1e-2 of ``lam_step`` at mu = 0; one-sided where `lam_offsets` is): f's
+    #: truncation error ~1e-12, its rounding ~1e-10 (relative)
+    SENS_REL = 1e-6
+
+    def _exact(self, z, mu, P, contact):
+        """(P(z), its step dict, the exact M, dP/dlambda) or a failed `Evaluation`, period 1:
+        P(z), M and the step's descriptors from one variational integration
+        (`variational.step_jacobian`, `variational.step_summary`: z' equals the map's to
+        ~1e-10) and dP/dlambda from the same integration's parameter column
+        (`variational.param_column`: a parameter that only f reads; `SENS_REL`), else
+        from central differences of the map (2 maps, through the ensemble engine where it
+        takes them: l, r, a change of contact law). Where the variational step fails the map at z says why
+        (its status: "fell", "no_touch_down", ...)."""
+        from . import variational
+        up, down = self.lam_offsets(mu)
+        if up == down:
+            return Evaluation(False, "invalid parameter: no room for a difference")
+        h = self.SENS_REL * abs(mu) if mu != 0.0 else 1e-2 * self.lam_step
+        ends = []
+        for side, off in ((1.0, up), (-1.0, down)):
+            try:                    # one-sided at the edge of the parameter's range
+                ends.append((mu + side * h, self.point_at(mu + side * h)) if off else
+                            (mu, (P, contact)))
+            except InvalidInputError:
+                ends.append((mu, (P, contact)))
+        (hi, plus), (lo, minus) = ends
+        models = [plus, minus]
+        column = hi != lo and variational.param_column(P, contact, *models)
+        try:
+            res = variational.step_jacobian(
+                z, P, contact=contact, dparam=(*models, hi - lo) if column else None,
+                **{k: self.opts[k] for k in ("rtol", "atol") if k in self.opts})
+            step = variational.step_summary(res, P)
+        except InvalidInputError as e:
+            Pz, steps = self._run([(z, mu)])[0]
+            self.n_maps += 1
+            if Pz is None:
+                return Evaluation(False, steps[-1]["status"] if steps else "failed")
+            return Evaluation(False, "exact monodromy: %s" % e)
+        self.n_maps += 1
+        if step["status"] != "ok":
+            return Evaluation(False, step["status"])
+        self.t_hint = step["period"]
+        if column:
+            return step["z"], [step], res["M"], res["dz_dparam"]
+        models = [self.point_at(mu + up), self.point_at(mu + down)]
+        vals = self._images([z, z], models)
+        self.n_maps += 2
+        for v in vals:
+            if isinstance(v, str):
+                return Evaluation(False, "finite-difference neighbour: " + v)
+        return step["z"], [step], res["M"], (vals[0] - vals[1]) / (up - down)
+
+    def _images(self, zs, models):
+        """P(z) of every (z, (Params, contact)), or the failed step's status: through the
+        ensemble engine (`step_maps.images`, bitwise `step`'s z') where it takes them all,
+        else (and for every point it leaves) as `_compose_all`."""
+        contacts = [c for _, c in models]
+        opts = self._options(contacts[0])
+        out: list = [None] * len(zs)
+        if (self.executor is None and all(c == contacts[0] for c in contacts)
+                and _maps.batchable(self.method, self.period, opts)):
+            out = list(_maps.images(zs, [m[0] for m in models], self.variant, self.method,
+                                    opts, threads=1))
+        left = [i for i, v in enumerate(out) if v is None]
+        if left:
+            for i, (v, steps) in zip(left, self._compose_all([zs[i] for i in left],
+                                                             [models[i] for i in left])):
+                out[i] = v if v is not None else (steps[-1]["status"] if steps else "failed")
+        return out
 
     #: the second difference step of the cross-check, a multiple of ``fd_step``
     CHECK_FACTOR = 10.0

@@ -9,7 +9,10 @@ One step of the touch-down map (`pdw.analysis.stepmap.poincare.step`) from secti
                        paper's Eq. 5) > 0: where g_i passes 0 first, the foot stays support,
                        without penetration force, until v_i passes 0 (or g_i returns below 0);
                        touch-down, Eq. 18b: an armed swing foot's height g_i < 0 AND v_i < 0
-                       (armed: above the ground while ahead of the other foot); where g_i
+                       (armed: above the ground while ahead of the other foot, as the
+                       compiled loop's pdw_update_flags: armed when its contact point passes
+                       the other one's forwards, or at a lift-off ahead of it; disarmed when
+                       it passes back behind it, events of both engines); where g_i
                        passes 0 downwards with v_i >= 0 (the paper's v_i is not dg_i/dt) the
                        foot stays swing, without forces, until v_i passes 0 (or g_i returns
                        above 0)), and
@@ -64,11 +67,14 @@ They agree to 2e-8 on paper_steady's multipliers (2e-9 at rtol 1e-12, phi_rtol 1
 ~1e-7 for the other laws, to 2e-5 for Kelvin-Voigt's calibrated gait, whose rises' saltations
 move by 1e-3 with a 1e-11 s shift of the event (the Python version itself moves by 2.5e-5
 between rtol 1e-10 and 1e-11). Cost (benchmarks/bench_monodromy.py, CPU): compiled 0.16-0.5 x
-the finite differences (13-15 maps through the ensemble engine), Python 6-26 x; a branch point
-of `continue_gait` with the exact M costs 1.06 x the differences' for the default law (their 12
-extra maps ride almost free in the engine's lanes) and 0.35 x for flores. Not the
-continuation's default (the lead's decision); it is the cross-check of `GaitMap.crosscheck` and
-of a user's doubts near a kink.
+the finite differences (13-15 maps through the ensemble engine), Python 6-26 x. ``dparam``
+adds a parameter mu to the state (the compiled engine only): its column of A is a central
+difference of f between two models (relative step 1e-6 in the continuation), and dz'/dmu comes
+from the same integration; a branch point of `continue_gait` (P(z), M, dP/dmu and the map's
+descriptors, `step_summary`) then costs one variational step, 0.6-0.7 x the differences' for
+the default law and 0.2-0.3 x for the laws the ensemble engine does not run (docs/continuation.md).
+Not the continuation's default (its documented branches are the differences'); it is the
+cross-check of `GaitMap.crosscheck` and of a user's doubts near a kink.
 
 Over 500 lines: Eq. 18's flag rules, the saltations and the event loop that both engines share
 belong together (split, each part would read the others' state).
@@ -142,10 +148,12 @@ class _Field:
     """f and df/dy of the state y = (x, v_in1, v_in2) (the approach speeds only where the law
     uses them, ``na`` = 2; else y = x): v_in' = 0, f reads v_in as held speeds."""
 
-    def __init__(self, f, na, params):
-        self.f, self.na, self.n, self.params = f, na, N + na, params
+    def __init__(self, f, na, params, pm=None):
+        self.f, self.na, self.n, self.params = f, na, N + na + (pm is not None), params
+        self.pm = pm        # (f at mu + dmu/2, f at mu - dmu/2, dmu): y carries mu last
         self.flags = [1, 1]
-        self.n_par = 0      # constant parameters after x and v_in (variational_ground's)
+        # constant parameters after x and v_in: mu (``pm``) or variational_ground's heights
+        self.n_par = int(pm is not None)
 
     def height_grad(self, leg):
         """d(leg's height event)/d(the parameters) (n_par,): none here (a subclass's hook)."""
@@ -157,10 +165,10 @@ class _Field:
                                 (float(y[N]), float(y[N + 1])))
 
     def __call__(self, t, y):
-        if not self.na:
+        if len(y) == N:
             return self.f(t, y)
-        self._set(y)
-        return np.concatenate([self.f(t, y[:N]), np.zeros(self.na)])
+        self._set(y)        # v_in and the constant parameters: zero rates
+        return np.concatenate([self.f(t, np.ascontiguousarray(y[:N])), np.zeros(len(y) - N)])
 
     def jac(self, t, y):
         if not self.na:
@@ -251,7 +259,32 @@ def _specs(flags, pending, armed, gate_dir, sunk):
             out.append((_EV_HEIGHT, leg, 1.0 if sunk[leg] else -1.0))
         else:
             out.append((_EV_NONE, leg, -1.0))
+    for leg in (0, 1):
+        out.append((_EV_AHEAD if _disarmable(flags, armed, leg) else _EV_NONE, leg, -1.0))
     return out
+
+
+def _ahead(x, leg, p):
+    """Whether leg's contact point is ahead of the other one's (pdw_discrete.c's arming)."""
+    return _foot(x, leg, p)[2] > _foot(x, 1 - leg, p)[2]
+
+
+def _pass(flags, armed, sunk, ahead, t, events):
+    """The contact points pass each other at time t, leg ``ahead``'s now in front: it is
+    armed if swing, the other one disarmed if an armed swing foot ("disarm" in ``events``)."""
+    if not flags[ahead]:
+        armed[ahead] = True
+    other = 1 - ahead
+    if _disarmable(flags, armed, other):
+        armed[other] = sunk[other] = False
+        events.append((t, "disarm", other + 1))
+
+
+def _disarmable(flags, armed, leg):
+    """Whether leg's swing foot is armed, so that its passing back behind the other foot
+    (their contact points level, pdw_discrete.c: x_D,i <= x_D,j) disarms it: the compiled
+    loop's rule (pdw_update_flags), an event of both engines (slots 6, 7)."""
+    return not flags[leg] and armed[leg]
 
 
 #: pdw_cvar.h's event kinds
@@ -267,9 +300,11 @@ PHI_TOL = 1e-8
 
 def _compiled_interval(F, p, specs, t0, y, Phi, h, t_max, rtol, atol, phi_tol):
     """(t_ev, k_ev, next step): y and Phi advanced in place to the first event (pdw_cvar.c)."""
+    fp, fm, dmu = F.pm if F.pm is not None else (None, None, 0.0)
     rc, t_ev, k_ev, h = _core.cvar_interval(F.f, p.l, p.r, F.na, specs, t0, y, Phi, h, t_max,
                                             rtol=rtol, atol=atol, phi_rtol=phi_tol,
-                                            phi_atol=phi_tol, phi_error=True, a_hermite=True)
+                                            phi_atol=phi_tol, phi_error=True, a_hermite=True,
+                                            f_plus=fp, f_minus=fm, dmu=dmu)
     if rc == 1:
         raise InvalidInputError("variational step_jacobian: no touch-down by t_max = %g s"
                                 % t_max)
@@ -307,7 +342,8 @@ def _python_interval(F, aug_rhs, evs, t0, y, Phi, t_max, rtol, atol, phi_rtol):
 def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
                   contact=None, rtol: float = 1e-10, atol: float = 1e-12,
                   phi_rtol: float | None = None, t_max: float = 2.5,
-                  max_events: int = 40, engine: str = "compiled", field=None) -> dict:
+                  max_events: int = 40, engine: str = "compiled", field=None,
+                  dparam=None) -> dict:
     """One step of the touch-down map and its exact Jacobian (module docstring).
 
     Parameters
@@ -339,6 +375,12 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
         ``field(f, na, params)`` -> a `_Field` whose state carries ``n_par`` constant
         parameters after x (and v_in): their columns are appended to ``M``, ``dx_dz`` and
         ``dT`` (`pdw.analysis.stepmap.variational_ground`; the Python engine only).
+    dparam : ((Params, contact), (Params, contact), float), optional
+        The model at mu + dmu/2 and at mu - dmu/2 of a parameter mu, and dmu (``engine``
+        "compiled" only; `param_column`): the state carries mu (mu' = 0), df/dmu is the
+        difference of the two models' f over dmu (central, O(dmu^2)), and ``dz_dparam`` is
+        dz'/dmu, from the same integration. The two may differ from ``params`` only where
+        f reads them (not in l, r: the section and the event functions; the same law).
 
     Returns
     -------
@@ -347,7 +389,9 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
         dT/dz, ``events`` (list of
         (t, kind, leg) of the flag switches and gates), ``saltations`` (their S_k, (n, n) with
         n = 8, or 10 with approach speeds), ``x`` (the state at the touch-down, legs not
-        relabelled), ``dx_dz`` (n, nz) and ``Phi`` (n, n).
+        relabelled), ``dx_dz`` (n, nz), ``Phi`` (n, n) and ``flags``; with ``dparam`` also
+        ``dz_dparam`` (nz,) (and n counts mu) (the support flags just
+        before the touch-down).
     """
     if engine not in ("compiled", "python"):
         raise InvalidInputError("variational step_jacobian: engine must be 'compiled' or "
@@ -368,12 +412,22 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
     nz = len(z)
     f = ode_function(p, variant, flags=(1, 1), contact=law,
                      approach_speeds=v_in0 if na else (0.0, 0.0))
-    F = _Field(f, na, p) if field is None else field(f, na, p)
-    if F.n_par and engine != "python":
+    pm = None
+    if dparam is not None:
+        if field is not None:
+            raise InvalidInputError("variational step_jacobian: give field or dparam, not both")
+        if engine != "compiled" or not param_column(p, law, *dparam[:2]):
+            raise InvalidInputError("variational step_jacobian: dparam needs engine='compiled' "
+                                    "and models that differ only where f reads them (not in "
+                                    "l, r or the law)")
+        pm = tuple(ode_function(_section._params(P), variant, flags=(1, 1), contact=c)
+                   for P, c in dparam[:2]) + (float(dparam[2]),)
+    F = _Field(f, na, p, pm) if field is None else field(f, na, p)
+    if field is not None and F.n_par and engine != "python":
         raise InvalidInputError("variational step_jacobian: a field with parameters needs "
                                 "engine='python'")
     n = F.n
-    y = np.concatenate([x0, v_in0 if na else [], np.zeros(F.n_par)])
+    y = np.concatenate([x0] + ([v_in0] if na else []) + [np.zeros(F.n_par)])
     E = np.zeros((n, nz + F.n_par))
     E[n - F.n_par:, nz:] = np.eye(F.n_par)
     E[:N, :6] = _embed_jac(z, p)
@@ -384,7 +438,8 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
         if -v2 > 0.0:
             E[N + 1, :] = -gv2 @ E[:N, :]
     Phi = np.eye(n)
-    t0, events, salts = 0.0, [], []
+    t0, salts = 0.0, []
+    events: list[tuple] = []
     flags = F.flags
 
     def aug_rhs(t, yy):
@@ -439,6 +494,11 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
             d_back = 1.0 if sunk[leg] else -1.0
             evs.append(_event(lambda t, xx, leg=leg, on=pending[leg] or sunk[leg], d=d_back:
                               _foot(xx, leg, p)[0] if on else d, d_back))
+        for leg in (0, 1):          # an armed swing foot back behind the other one: disarmed
+            on = _disarmable(flags, armed, leg)
+            evs.append(_event(lambda t, xx, leg=leg, on=on:
+                              _foot(xx, leg, p)[2] - _foot(xx, 1 - leg, p)[2] if on else 1.0,
+                              -1.0))
         if engine == "compiled":
             t_ev, k_ev, h_next = _compiled_interval(
                 F, p, _specs(flags, pending, armed, gate_dir, sunk), t0, y, Phi, h_next, t_max, rtol,
@@ -448,6 +508,13 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
                                                   atol, 1e-10 if phi_rtol is None else phi_rtol)
         leg = k_ev % 2
         t0 = t_ev
+        if k_ev >= 6 or (k_ev < 2 and not flags[leg] and not armed[leg]):
+            # the contact points pass each other: the one now ahead, if swing, is armed (its
+            # height crossing then counts from above the ground) and the one now behind, if
+            # an armed swing foot, disarmed (the compiled loop's rule, pdw_discrete.c; both
+            # at once: each is the other's event). No flag switch, f unchanged, no saltation
+            _pass(flags, armed, sunk, 1 - leg if k_ev >= 6 else leg, t_ev, events)
+            continue
         if k_ev >= 4 and sunk[leg]:
             # a sunk swing foot back above the ground before its rate turned negative: no
             # flag switch, f unchanged (a swing foot has no forces), no saltation
@@ -460,7 +527,7 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
             if k_ev < 2:
                 h, grad = _rate(y, leg, p)
                 change = switch(leg, 0)
-                armed[leg] = False
+                armed[leg] = _ahead(y, leg, p)
                 events.append((t_ev, "lift_off", leg + 1))
             else:
                 h, grad, _ = _foot(y, leg, p)
@@ -479,9 +546,6 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
             events.append((t_ev, "gate", leg + 1))
             gate_dir[leg] = 1.0 if y[6 + leg] < 0 else -1.0
             salts.append(S)
-            continue
-        if not flags[leg] and not armed[leg]:       # armed: no flag switch, no saltation
-            armed[leg] = True
             continue
         if not flags[leg] and sunk[leg]:
             # the sunk foot's normal rate through 0 downwards: the touch-down (Eq. 18b) on
@@ -511,9 +575,14 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
             if na:
                 R[6, N + 1] = 1.0   # the trailing foot's approach speed: leg 2's held one
             M = R @ S @ Phi @ E
-            return {"z": R @ y, "M": M, "T": t_ev, "dT": -(g @ Phi @ E) / (g @ f_minus),
-                    "events": events, "saltations": salts,
-                    "x": y[:N].copy(), "dx_dz": S @ Phi @ E, "Phi": Phi}
+            dT = -(g @ Phi @ E) / (g @ f_minus)
+            dx = S @ Phi @ E
+            out = {"z": R @ y, "M": M, "T": t_ev, "dT": dT, "events": events,
+                   "saltations": salts, "x": y[:N].copy(), "dx_dz": dx, "Phi": Phi,
+                   "flags": (flags[0], flags[1])}
+            if pm:              # mu's column apart: M, dT, dx_dz stay the state's
+                out.update(M=M[:, :nz], dT=dT[:nz], dx_dz=dx[:, :nz], dz_dparam=M[:, nz])
+            return out
         if flags[leg] and _rate(y, leg, p)[0] <= 0.0:
             # above the ground but not yet rising (Eq. 18a): the penetration force ends, the
             # flag stays 1 until v > 0
@@ -525,9 +594,51 @@ def step_jacobian(z, params: Params | None = None, *, variant: str = "paper",
             continue
         on = 0 if flags[leg] else 1
         S, y = _saltation(F, y, grad, h, switch(leg, on), hl)
-        armed[leg] = False
+        # a lifted-off foot already ahead of the other one is armed at once (the compiled
+        # loop arms a swing foot above the ground and ahead at its next update)
+        armed[leg] = False if on else _ahead(y, leg, p)
         Phi = S @ Phi
         events.append((t_ev, "touch_down" if on else "lift_off", leg + 1))
         salts.append(S)
     raise InvalidInputError("variational step_jacobian: more than %d flag switches in one step"
                             % max_events)
+
+
+def param_column(params, contact, plus, minus) -> bool:
+    """Whether `step_jacobian`'s ``dparam`` takes the models ``plus`` and ``minus`` ((Params,
+    contact) each) around (``params``, ``contact``): the same leg length and foot radius (the
+    section's embedding and the event functions read them) and the same contact law (one
+    kernel); the rest of the parameters only f reads."""
+    law = Contact.coerce(contact)
+    for P, c in (plus, minus):
+        q, other = _section._params(P), Contact.coerce(c)
+        if (q.l, q.r) != (params.l, params.r) or (other.normal, other.friction) != (
+                law.normal, law.friction):
+            return False
+    return True
+
+
+def step_summary(res: dict, params: Params | None = None) -> dict:
+    """`pdw.analysis.stepmap.poincare.step`'s descriptors of the step that `step_jacobian`
+    integrated (``res``), by the map's definitions: ``status`` ("ok"; "flight" where leg 2
+    was off the ground at the touch-down; "fell" where the state at the touch-down fails the
+    map's fall limits, `pdw.Limits`' defaults: the hip below 0.5 l, a foot deeper than 0.25 l;
+    "diverged" with a speed above 1e3; the map checks them at every step of the way, this only
+    at the end),
+    ``z``, ``period`` [s], ``double_support`` (until
+    leg 1's first lift-off [s]), ``swing_period`` [s], ``step_length`` (leg 1's contact point
+    at the touch-down [m]) and ``n_events`` (the flag switches, the touch-down included: a
+    pending foot's "rise", a "reentry" and Eq. 11's gates switch no flag). The continuation's
+    exact evaluation (`gait_maps.ContinuousProblem`) takes them from here instead of a second
+    integration of the same step."""
+    p = _section._params(params)
+    x, T = res["x"], float(res["T"])
+    lo = next(t for t, kind, leg in res["events"] if kind == "lift_off" and leg == 1)
+    fell = x[1] < 0.5 * p.l or min(_foot(x, 0, p)[0], _foot(x, 1, p)[0]) < -0.25 * p.l
+    status = ("diverged" if np.max(np.abs(x[4:N])) > 1e3 else "fell" if fell
+              else "ok" if res["flags"][1] == 1 else "flight")
+    return {"status": status, "z": res["z"],
+            "period": T, "double_support": float(lo), "swing_period": T - float(lo),
+            "step_length": float(x[0] + (p.l - p.r) * math.sin(x[2])),
+            "n_events": 1 + sum(1 for _, kind, _ in res["events"]
+                                if kind in ("lift_off", "touch_down"))}

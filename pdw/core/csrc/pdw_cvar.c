@@ -15,7 +15,9 @@
  * augmented system (y, Phi), whose Jacobian [[A, 0], [dA[.] Phi, A]] needs dA along every
  * stage increment, took twice the Jacobians for the same accuracy.) With the approach speeds
  * (na = 2) the columns df/dv_in are central differences of f (step 1e-6 max(1, |v_in|)), as
- * variational.py's, and their dA[u] a mixed second difference (steps 1e-4).
+ * variational.py's, and their dA[u] a mixed second difference (steps 1e-4); a parameter
+ * state (np = 1) likewise, its column the difference of f between the caller's parameter
+ * vectors p_plus and p_minus over dmu.
  * Steps: the error estimates of y and (phi_error) of Phi, an I controller (h_new = h clamp(0.9
  * err^(-1/4), 0.2, 6), no increase right after a rejection); without Phi's estimate the stiff
  * modes that Phi(0) = I and each saltation excite are not resolved (Phi off by 1e-4). Events:
@@ -52,15 +54,21 @@ typedef struct cv_ctx {
     int at_valid;
 } cv_ctx;
 
-static void cv_f(cv_ctx *c, const double *y, double *f)
+/* f at y with the parameter vector p */
+static void cv_f_p(cv_ctx *c, const double *y, const double *p, double *f)
 {
     const pdw_cvar_model *m = c->m;
     double an[PDW_NANCHOR];
     memcpy(an, m->anchors, sizeof an);
     if (m->na) { an[PDW_ANCHOR_V_IN1] = y[PDW_NX]; an[PDW_ANCHOR_V_IN2] = y[PDW_NX + 1]; }
-    m->kernel->rhs(y, m->p, m->flags, an, f, c->work);
+    m->kernel->rhs(y, p, m->flags, an, f, c->work);
     for (int i = PDW_NX; i < c->n; ++i) f[i] = 0.0;
     c->st->n_rhs++;
+}
+
+static void cv_f(cv_ctx *c, const double *y, double *f)
+{
+    cv_f_p(c, y, c->m->p, f);
 }
 
 /* f at y with approach speed j replaced by v (na = 2) */
@@ -98,6 +106,13 @@ static void cv_jac(cv_ctx *c, const double *y, double *A)
         cv_f_v(c, y, j, v - hv, fm);
         for (int i = 0; i < PDW_NX; ++i) A[i * n + PDW_NX + j] = (fp[i] - fm[i]) / (2.0 * hv);
     }
+    if (c->m->np) {                             /* df/dmu: between p_plus and p_minus */
+        double fp[NMAX], fm[NMAX];
+        const int j = PDW_NX + c->m->na;
+        cv_f_p(c, y, c->m->p_plus, fp);
+        cv_f_p(c, y, c->m->p_minus, fm);
+        for (int i = 0; i < PDW_NX; ++i) A[i * n + j] = (fp[i] - fm[i]) / c->m->dmu;
+    }
 }
 
 /* D = dA[u] at y (n x n): central differences along u (one_sided: forward, from Ay = A(y)) */
@@ -121,6 +136,18 @@ static void cv_dA(cv_ctx *c, const pdw_cvar_opts *o, const double *y, const doub
         for (int i = 0; i < PDW_NX; ++i)
             for (int j = 0; j < PDW_NX; ++j)
                 D[i * n + j] = (D[i * n + j] - Jm[i * n + j]) / (2.0 * eps);
+    }
+    if (c->m->np) {                 /* d(df/dmu)[u]: a mixed second difference */
+        double a[NMAX], b[NMAX], cc[NMAX], d[NMAX];
+        const double e2 = 1e-4 / umax;
+        const int j = PDW_NX + c->m->na;
+        for (int i = 0; i < n; ++i) { yp[i] = y[i] + e2 * u[i]; ym[i] = y[i] - e2 * u[i]; }
+        cv_f_p(c, yp, c->m->p_plus, a);
+        cv_f_p(c, yp, c->m->p_minus, b);
+        cv_f_p(c, ym, c->m->p_plus, cc);
+        cv_f_p(c, ym, c->m->p_minus, d);
+        for (int i = 0; i < PDW_NX; ++i)
+            D[i * n + j] = ((a[i] - b[i]) - (cc[i] - d[i])) / (2.0 * e2 * c->m->dmu);
     }
     if (!c->m->na) return;
     eps = 1e-4 / umax;              /* the mixed second differences of the df/dv_in columns */
@@ -382,9 +409,14 @@ static double cv_step_phi(cv_ctx *c, const pdw_cvar_opts *o, const double *Phi, 
                           const double *y_n, const double *f_n, const double *ynew,
                           const double *fnew, double *Phinew, double *Anew, double *Atnew)
 {
-    return c->n == PDW_NX
-        ? cv_step_phi_n(c, o, Phi, h, y_n, f_n, ynew, fnew, Phinew, Anew, Atnew, PDW_NX)
-        : cv_step_phi_n(c, o, Phi, h, y_n, f_n, ynew, fnew, Phinew, Anew, Atnew, NMAX);
+#define CV_PHI(N_) cv_step_phi_n(c, o, Phi, h, y_n, f_n, ynew, fnew, Phinew, Anew, Atnew, N_)
+    switch (c->n) {                 /* n a constant in each: the loops unroll */
+    case PDW_NX: return CV_PHI(PDW_NX);
+    case PDW_NX + 1: return CV_PHI(PDW_NX + 1);
+    case PDW_NX + 2: return CV_PHI(PDW_NX + 2);
+    default: return CV_PHI(NMAX);
+    }
+#undef CV_PHI
 }
 
 /* event function k at y (shifted) and, if grad is not NULL, its gradient (n) */
@@ -454,7 +486,7 @@ int pdw_cvar_interval(const pdw_cvar_model *m, const pdw_cvar_opts *o, const pdw
                       pdw_cvar_stats *st, double *work)
 {
     cv_ctx c;
-    const int n = PDW_NX + m->na;
+    const int n = PDW_NX + m->na + m->np;
     double f_n[NMAX], ynew[NMAX], fnew[NMAX], ys[NMAX], fs[NMAX], grad[NMAX];
     double Phinew[NMAX * NMAX], Anew[NMAX * NMAX], Atnew[NMAX * NMAX];
     double g_old[PDW_CVAR_MAXEV], g_new[PDW_CVAR_MAXEV];

@@ -5,8 +5,10 @@
  * approach speeds the state is y = (x, v_in1, v_in2), v_in' = 0) together with its fundamental
  * matrix Phi' = A(y) Phi (A = df/dy) by RODAS4 (pdw_tableau_rodas4) applied to the augmented
  * system, from t until the first crossing of one of a list of event functions, located to
- * rounding and reached by a last step that ends on it. Nothing allocates; the caller gives every
- * array. */
+ * rounding and reached by a last step that ends on it. With np = 1 the state carries one
+ * parameter mu last (mu' = 0, its column of A a difference of f between two parameter
+ * vectors): Phi's last column is then the step's sensitivity to mu. Nothing allocates; the
+ * caller gives every array. */
 #ifndef PDW_CVAR_H
 #define PDW_CVAR_H
 
@@ -21,7 +23,7 @@ enum {
     PDW_CVAR_EV_AHEAD = 3,      /* (l - r)(sin th - sin th_other): the foot ahead of the other [m] */
     PDW_CVAR_EV_THETA = 4       /* th [rad] (Eq. 11's gate) */
 };
-enum { PDW_CVAR_MAXEV = 8, PDW_CVAR_NA = 2, PDW_CVAR_NMAX = PDW_NX + PDW_CVAR_NA };
+enum { PDW_CVAR_MAXEV = 8, PDW_CVAR_NA = 2, PDW_CVAR_NMAX = PDW_NX + PDW_CVAR_NA + 1 };
 #define PDW_CVAR_EVENT_SHIFT 1e-14
 
 /* returns of pdw_cvar_interval */
@@ -45,6 +47,13 @@ typedef struct pdw_cvar_model {
     double anchors[PDW_NANCHOR];/* anchors; the approach speeds are taken from y when na = 2 */
     int na;                     /* 0, or 2: y carries (v_in1, v_in2) after x */
     double l, r;                /* leg length and foot radius [m] (the event functions) */
+    int np;                     /* 0, or 1: y carries a parameter mu last (mu' = 0), whose
+                                 * column of A, df/dmu = (f(y; p_plus) - f(y; p_minus)) / dmu,
+                                 * is the central difference of f between the parameter
+                                 * vectors at mu +- dmu / 2 (f itself reads p): Phi's column
+                                 * of mu is the step's sensitivity to the parameter */
+    const double *p_plus, *p_minus;
+    double dmu;
 } pdw_cvar_model;
 
 typedef struct pdw_cvar_opts {
@@ -66,7 +75,7 @@ typedef struct pdw_cvar_stats {
     long n_steps, n_rejected, n_rhs, n_jac;
 } pdw_cvar_stats;
 
-/* From (t, y, Phi) (n = PDW_NX + na; Phi n x n row-major) to the first crossing of events
+/* From (t, y, Phi) (n = PDW_NX + na + np; Phi n x n row-major) to the first crossing of events
  * ev[0 .. n_ev) (ties: the lowest index). h: the first trial step on entry, the next step on
  * return. work: PDW_NWORK doubles. Returns PDW_CVAR_*. */
 int pdw_cvar_interval(const pdw_cvar_model *m, const pdw_cvar_opts *o, const pdw_cvar_event *ev,
