@@ -106,3 +106,36 @@ def test_the_family_goes_on_through_the_event_sequence_change_and_ends_at_its_fo
     i = int(np.argmin(np.abs(b.values - 1.01 * lp[0].value)))
     assert _walk(b.z[i], P.replace(d_n=1.01 * lp[0].value))[0] == "settled"
     assert _walk(lp[0].z, P.replace(d_n=0.99 * lp[0].value))[0] == "fell"
+
+
+@pytest.mark.slow
+def test_a_walker_neimark_sacker_point_against_long_walks():
+    """k_n = 1.5e5: paper_steady's family, continued down in d_n from 6e4, loses stability at
+    a Neimark-Sacker point (d_n ~ 56704, a complex pair through |mu| = 1 at arg ~1.3 rad).
+    Long walks of the step map from the NS point's gait: 1 % above it the step-to-step change
+    decays (by more than 3x from steps 50-150 to 300-400), 1 % below it does not (a torus)
+    and the walker does not fall."""
+    P = pdw.Params.paper_steady().replace(k_n=1.5e5, d_n=6e4)
+    b = continue_gait(P, "d_n", 5e4, log=True, start=pdw.find_gait(P), max_points=30,
+                      workers=2)
+    ns = b.of_kind("neimark_sacker")
+    assert ns and ns[0].located and 5.5e4 < ns[0].value < 5.8e4
+    m = ns[0].multipliers
+    pair = m[np.argmin(np.abs(np.abs(m) - 1.0))]
+    assert abs(abs(pair) - 1.0) < 1e-3 and 0.5 < abs(np.angle(pair)) < 2.5
+    z = ns[0].z
+    above, below = (_amplitudes(z, P.replace(d_n=f * ns[0].value)) for f in (1.01, 0.99))
+    assert above[1] < 0.3 * above[0]             # decays: a stable focus
+    assert below[1] > 0.8 * below[0] > 0          # does not decay, and the walker walks on
+
+
+def _amplitudes(z, P, n=400):
+    """The largest step-to-step change of z over steps 50..150 and over the last 100 of n
+    (the walker must not fall)."""
+    d = []
+    for _ in range(n):
+        s = poincare.step(z, P)
+        assert s["status"] == "ok"
+        d.append(np.max(np.abs(s["z"] - z)))
+        z = s["z"]
+    return max(d[50:150]), max(d[-100:])
