@@ -692,17 +692,18 @@ def _edge_text(f, inner):
 
 
 def _region(P, outer, inner, kns, d_lo, d_hi, kg, dg, log, t_walk, units, name,
-            curves=(), start=None, row_points=40):
+            curves=(), start=None, row_points=40, follow=None):
     """The existence and stability region of P's family in (outer, inner): `_columns` at kns
     (each edge labelled), a brute-force grid (kg x dg) of walks of t_walk s on the ensemble
     engine compared with the columns' first edges below and above P's ``inner`` value, and
     the figure continuation_<name>.png; ``curves``: (label, values (N, 2) = (inner, outer))
-    drawn over it."""
+    drawn over it; ``follow(cols)``: more such curves, from the columns' bifurcations."""
     s0 = getattr(P, inner)
     w0, c0 = time.perf_counter(), time.process_time()
     cols = _columns(P, kns, d_lo, d_hi, outer=outer, inner=inner, log=log, start=start,
                     row_points=row_points)
     kns = np.array([k for k, _ in cols])
+    curves = list(curves) + (list(follow(cols)) if follow is not None else [])
     say("%d columns of %s continuations (down to %.3g, up to %.3g, from %s = %.3g): %.1f s "
         "wall, %.1f s CPU (2 threads)" % (len(cols), inner, d_lo, d_hi, inner, s0,
                                           time.perf_counter() - w0, time.process_time() - c0))
@@ -854,8 +855,9 @@ def _region(P, outer, inner, kns, d_lo, d_hi, kg, dg, log, t_walk, units, name,
     ax.plot([], [], "-", color="C2", lw=3, label="stable (columns: continue_gait in %s)"
             % inner)
     ax.plot([], [], "-", color="0.6", lw=1, label="unstable")
-    for lab, v in curves:
-        ax.plot(v[:, 1], v[:, 0], "C3-", lw=1.5, label=lab)
+    for i, (lab, v) in enumerate(curves):
+        ax.plot(v[:, 1], v[:, 0], "C3-", lw=1.5, label=lab if i == 0 or lab != curves[0][0]
+                else None)
     ax.plot([getattr(pdw.Params.paper_steady(), outer)],
             [getattr(pdw.Params.paper_steady(), inner)], "k*", ms=10, label="paper_steady")
     if log:
@@ -902,10 +904,43 @@ def part_region_kn(n_cols=11, n_rows=41, t_walk=60.0):
                                                   time.process_time() - c0))
     fc = np.vstack([fcs[1].values[::-1], fcs[0].values[1:]])
     d_lo, d_hi = 5e3, 1e7
+
+    def follow(cols):
+        """The first-edge folds of the columns at k_n = 6.31e4 and 2e5 followed in k_n both
+        ways (the low-k_n fold and the upper sheet's fold)."""
+        out = []
+        for k_at, stops in ((6.31e4, (3e4, 1e5)), (1.995e5, (1.4e5, 3.3e5))):
+            k, parts = min(cols, key=lambda c: abs(np.log(c[0] / k_at)))
+            f = _first_edge(parts["down"])
+            if f is None or f.kind != "fold" or not f.located:
+                say("column k_n = %.4g: no located fold to follow" % k)
+                continue
+            w0, c0 = time.perf_counter(), time.process_time()
+            vs = []
+            for stop in stops:
+                cv = continue_bifurcation(f, "k_n", stop, fd_step=1e-4, max_points=40,
+                                          skip=("event_sequence",))
+                vs.append(cv.values)
+                say("fold d_n = %.7g at k_n = %.4g followed to %.3g: %d points, k_n %.4g -> "
+                    "%.4g, d_n %.6g -> %.6g; UZ %s; stop: %s" % (
+                        f.value, k, stop, len(cv), cv.values[0, 1], cv.values[-1, 1],
+                        cv.values[0, 0], cv.values[-1, 0],
+                        ["%.4g" % g.value for g in cv.branch.bifurcations
+                         if g.kind == "event"], cv.stop_reason))
+                for kv in (4e4, 5e4, 8e4, 1.5e5, 2.5e5, 3e5):
+                    try:
+                        say("    at k_n = %.4g: d_n = %.7g" % (kv, cv.at(kv)))
+                    except pdw.InvalidInputError:
+                        pass
+            say("  %.1f s wall, %.1f s CPU" % (time.perf_counter() - w0,
+                                              time.process_time() - c0))
+            out.append(("fold curve (continue_bifurcation)",
+                        np.vstack([vs[0][::-1], vs[1][1:]])))
+        return out
     _region(P, "k_n", "d_n", kns, d_lo, d_hi, 10 ** np.linspace(4.5, 5.5, 2 * n_cols - 1),
             10 ** np.linspace(np.log10(d_lo) + 0.15, np.log10(d_hi), n_rows), True, t_walk,
             ("N/m^1.5", "N s/m^2.5"), "region_kn",
-            curves=[("fold curve (continue_bifurcation)", fc)])
+            curves=[("fold curve (continue_bifurcation)", fc)], follow=follow)
 
 
 def part_region_hip_continuous(n_cols=13, n_rows=25, t_walk=60.0):

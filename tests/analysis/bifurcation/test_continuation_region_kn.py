@@ -139,3 +139,29 @@ def _amplitudes(z, P, n=400):
         d.append(np.max(np.abs(s["z"] - z)))
         z = s["z"]
     return max(d[50:150]), max(d[-100:])
+
+
+@pytest.mark.slow
+def test_the_fold_curve_passes_the_event_sequence_change_and_matches_a_column():
+    """paper_steady's d_n fold (41685.5 at k_n = 1e5) followed in k_n with
+    skip=("event_sequence",) passes the change of the event sequence near k_n = 1.14e5 (UZ;
+    without skip the curve ended at 1.07e5) and, at k_n = 1.2e5, equals the fold that a
+    one-parameter d_n continuation from d_n = 1e6 locates there (1e-3 relative). Walks of
+    the step map from the fold's gait: 2 % above it the walker walks on, 2 % below it falls."""
+    from pdw.analysis.bifurcation.codim2 import continue_bifurcation
+    P = pdw.Params.paper_steady()
+    fold = continue_gait(P, "d_n", 1e3, log=True, max_points=25, workers=2).of_kind("fold")[0]
+    cv = continue_bifurcation(fold, "k_n", 1.2e5, fd_step=1e-4, max_points=30,
+                              skip=("event_sequence",))
+    assert cv.values[-1, 1] == pytest.approx(1.2e5)
+    uz = [f for f in cv.branch.bifurcations if f.kind == "event"]
+    assert uz and 1.1e5 < uz[0].value < 1.18e5
+    col = continue_gait(P.replace(k_n=1.2e5), "d_n", 1e4, log=True, max_points=40, workers=2,
+                        detect=("fold", "period_doubling", "neimark_sacker"),
+                        events=[TF.AdmissibleEnd(skip=("event_sequence",)),
+                                TF.SequenceChange()])
+    lp = col.of_kind("fold")[0]
+    assert lp.located and cv.values[-1, 0] == pytest.approx(lp.value, rel=1e-3)
+    Pk = P.replace(k_n=1.2e5)
+    assert _walk(lp.z, Pk.replace(d_n=1.02 * lp.value))[0] != "fell"
+    assert _walk(lp.z, Pk.replace(d_n=0.98 * lp.value))[0] == "fell"
