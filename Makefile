@@ -120,6 +120,7 @@ study: $(STAMP)
 	$(PY) benchmarks/robustness_tuning.py $(UPDATE_DOCS)
 	$(PY) benchmarks/terrain_rigid_limit.py $(UPDATE_DOCS)
 	$(PY) benchmarks/markov_vs_mc.py $(UPDATE_DOCS)
+	$(PY) benchmarks/continuation.py region_kn region_hip_continuous $(UPDATE_DOCS)
 
 ## sanitize: the compiled core built with AddressSanitizer + UndefinedBehaviorSanitizer (in
 ## build/sanitize, the normal build untouched), and the tests of the compiled boundary, the loops

@@ -15,6 +15,8 @@ docs/figures/; `make bench` runs the issue's two codim-2 speed benchmarks, codim
     python benchmarks/continuation.py goswami   # compass regions in (slope, b/a), (slope, m_H/m)
     python benchmarks/continuation.py region_hip  # paper walker (hybrid): region in (k_hip, d_hip)
     python benchmarks/continuation.py fold_kn   # continuous: paper walker's d_n fold in (k_n, d_n)
+    python benchmarks/continuation.py region_kn # continuous: its whole region in (k_n, d_n), checked
+    python benchmarks/continuation.py region_hip_continuous  # the same in (k_hip, d_hip)
     python benchmarks/continuation.py codim2_schemes  # continuous fold curve: why it stalled
     python benchmarks/continuation.py ns_search # complex multiplier pairs: any Neimark-Sacker?
     python benchmarks/continuation.py chaos     # orbit diagram, Lyapunov exponents, Feigenbaum
@@ -598,6 +600,366 @@ def part_fold_kn():
     say("wrote docs/figures/continuation_fold_kn.png")
 
 
+def _columns(P, kns, d_lo, d_hi, max_points=50, outer="k_n", inner="d_n", log=True,
+             start=None, row_points=40):
+    """One-parameter continuations in ``inner`` (d_n) of the family of P at each ``outer``
+    value in kns (k_n; started on the family's gait at P's ``inner``, reached by a continuation
+    in ``outer`` from P's value both ways), down to d_lo and up to d_hi; ``log``: both axes
+    logarithmic. A change of the step's event sequence is reported (UZ), not taken as the
+    family's end."""
+    from pdw.analysis.bifurcation import testfunctions as TF
+    det = ("fold", "period_doubling", "neimark_sacker")
+    k0 = getattr(P, outer)
+    rows = [continue_gait(P, outer, s, log=log, at=[k for k in kns if (k < k0) == (s < k0)],
+                          max_points=row_points, workers=2, start=start)
+            for s in ((kns.min() * 0.9, kns.max() * 1.1) if log else (kns.min(), kns.max()))]
+    cols = []
+    for k in kns:
+        r = rows[0] if k < k0 else rows[1]
+        i = int(np.argmin(np.abs(np.log(r.values / k)) if log else np.abs(r.values - k)))
+        if abs(r.values[i] - k) > 1e-6 * max(abs(k), 1.0):
+            say("%s = %.4g: no column, the %s continuation at %s = %.4g ended at %.6g (%s)"
+                % (outer, k, outer, inner, getattr(P, inner), r.values[i], r.stop_reason))
+            continue
+        z0 = r.z[i]
+        Pk = P.replace(**{outer: float(r.values[i])})
+        parts = {}
+        for name, stop in (("down", d_lo), ("up", d_hi)):
+            parts[name] = continue_gait(
+                Pk, inner, stop, log=log, start=z0, workers=2,
+                max_points=max_points if name == "down" else 25,
+                detect=det, events=[TF.AdmissibleEnd(skip=("event_sequence",)),
+                                    TF.SequenceChange()])
+        cols.append((float(r.values[i]), parts))
+    return cols
+
+
+def _first_edge(b):
+    """The first bifurcation along a branch from its start that ends the stable family: the
+    first fold, doubling, NS or end (a UZ is not an edge), or None."""
+    for f in b.bifurcations:
+        if f.kind in ("fold", "period_doubling", "neimark_sacker", "end"):
+            return f
+    return None
+
+
+def _stable_set(b):
+    """Intervals of d_n where the branch has a stable point: runs of stable points, each
+    extended to the bifurcation (fold, doubling, NS) of the step that leaves the run."""
+    v, st = b.values, b.stable
+    out, i = [], 0
+    while i < len(v):
+        if not st[i]:
+            i += 1
+            continue
+        j = i
+        while j + 1 < len(v) and st[j + 1]:
+            j += 1
+        lo, hi = min(v[i], v[j]), max(v[i], v[j])
+        for f in b.bifurcations:
+            if f.kind != "event" and f.index in (i - 1, j):
+                lo, hi = min(lo, f.value), max(hi, f.value)
+        out.append((lo, hi))
+        i = j + 1
+    return out
+
+
+def _classify_walks(res):
+    """0 fell, 1 settled on a period-1 gait, 2 on a period-2 gait, 3 walks on unsettled, from
+    the last 8 step lengths of each walker of a batch (10 um)."""
+    out = np.zeros(len(res), dtype=int)
+    for i in range(len(res)):
+        if res.status[i] not in ("walked", "periodic"):
+            continue
+        L = res.steps(i)["L"][-8:]
+        if len(L) < 8 or not np.isfinite(L).all():
+            out[i] = 3
+        elif np.ptp(L) < 1e-5:
+            out[i] = 1
+        elif np.ptp(L[::2]) < 1e-5 and np.ptp(L[1::2]) < 1e-5:
+            out[i] = 2
+        else:
+            out[i] = 3
+    return out
+
+
+def _edge_text(f, inner):
+    if f is None:
+        return "none"
+    return "%s %s at %s = %.7g (%s)" % (
+        f.label, f.kind, inner, f.value, "+-%.2g" % f.tolerance if f.located else
+        "detected, not located: [%.7g, %.7g]" % f.bracket)
+
+
+def _region(P, outer, inner, kns, d_lo, d_hi, kg, dg, log, t_walk, units, name,
+            curves=(), start=None, row_points=40, follow=None):
+    """The existence and stability region of P's family in (outer, inner): `_columns` at kns
+    (each edge labelled), a brute-force grid (kg x dg) of walks of t_walk s on the ensemble
+    engine compared with the columns' first edges below and above P's ``inner`` value, and
+    the figure continuation_<name>.png; ``curves``: (label, values (N, 2) = (inner, outer))
+    drawn over it; ``follow(cols)``: more such curves, from the columns' bifurcations."""
+    s0 = getattr(P, inner)
+    w0, c0 = time.perf_counter(), time.process_time()
+    cols = _columns(P, kns, d_lo, d_hi, outer=outer, inner=inner, log=log, start=start,
+                    row_points=row_points)
+    kns = np.array([k for k, _ in cols])
+    curves = list(curves) + (list(follow(cols)) if follow is not None else [])
+    say("%d columns of %s continuations (down to %.3g, up to %.3g, from %s = %.3g): %.1f s "
+        "wall, %.1f s CPU (2 threads)" % (len(cols), inner, d_lo, d_hi, inner, s0,
+                                          time.perf_counter() - w0, time.process_time() - c0))
+    say("per column: the first edge below and above %s = %.3g (label at value, bracket), the "
+        "stable intervals, every special point below (UZ: the event sequence changes, "
+        "bracketed), the stop" % (inner, s0))
+    edges, ups, stab = [], [], []
+    for k, parts in cols:
+        dn, up = parts["down"], parts["up"]
+        f, fu = _first_edge(dn), _first_edge(up)
+        edges.append(f)
+        ups.append(fu)
+        ints = _stable_set(dn) + _stable_set(up)
+        stab.append(ints)
+        say("%s = %.4g: first edge %s; above: %s; stable %s in %s" % (
+            outer, k, _edge_text(f, inner),
+            "no edge up to %.3g" % up.values.max() if fu is None else _edge_text(fu, inner),
+            inner, " ".join("[%.4g, %.4g]" % iv for iv in ints)))
+        for g in dn.bifurcations:
+            say("    %s" % g.describe())
+        say("    down: %d points, %s down to %.5g, stop: %s" % (len(dn), inner, dn.values.min(),
+                                                             dn.stop_reason))
+        if fu is not None:
+            say("    up: %d points, stop: %s" % (len(up), up.stop_reason))
+    # brute force: walks of t_walk s on the ensemble engine (rodas4), each cell started on
+    # the family's gait of the nearest column at the nearest value of the sheet connected to
+    # the start (each run up to its first fold)
+    dist = (lambda a, b: np.abs(np.log(a / b))) if log else (lambda a, b: np.abs(a - b))
+    x0, plist = [], []
+    for k in kg:
+        ic = int(np.argmin(dist(kns, k)))
+        parts = cols[ic][1]
+        keep_v, keep_x = [], []
+        for nm, f in (("down", edges[ic]), ("up", ups[ic])):
+            br = parts[nm]
+            n = len(br) if f is None or f.kind != "fold" else f.index + 1
+            keep_v.append(br.values[:n])
+            keep_x.append(br.state[:n])
+        vals, states = np.concatenate(keep_v), np.vstack(keep_x)
+        for d in dg:
+            x0.append(states[int(np.argmin(dist(vals, d)))])
+            plist.append(P.replace(**{outer: float(k), inner: float(d)}))
+    w0, c0 = time.perf_counter(), time.process_time()
+    res = pdw.simulate_batch(np.array(x0), t_walk, params=plist, flags0=(1, 1), threads=2,
+                             integrator=pdw.Integrator(method="rodas4", rtol=1e-9,
+                                                       atol=1e-11, dt=1e-4))
+    grid = _classify_walks(res).reshape(len(kg), len(dg))
+    say("brute force: %d x %d walks of %.0f s (%s %.4g .. %.4g, %s %.4g .. %.4g; "
+        "simulate_batch, rodas4 rtol 1e-9): %d settle on a period-1 gait, %d period 2, %d walk "
+        "on unsettled, %d fall; %.1f s wall, %.1f s CPU" % (
+            len(kg), len(dg), t_walk, outer, kg[0], kg[-1], inner, dg[0], dg[-1],
+            (grid == 1).sum(), (grid == 2).sum(), (grid == 3).sum(), (grid == 0).sum(),
+            time.perf_counter() - w0, time.process_time() - c0))
+    say("first edge below %s = %.3g, by column: %s" % (inner, s0, "; ".join(
+        "%.4g: %s" % (k, "-" if f is None else "%s %.6g" % (f.label[:2], f.value))
+        for (k, _), f in zip(cols, edges))))
+    say("first edge above it, by column: %s" % "; ".join(
+        "%.4g: %s" % (k, "-" if f is None else "%s %.6g" % (f.label[:2], f.value))
+        for (k, _), f in zip(cols, ups)))
+    # the cells against the columns: a walk starts on the sheet of the family connected to
+    # P's gait, so it is predicted to settle where the value is in that sheet's stable
+    # interval (the one containing s0: between the column's first edges). Cells in the
+    # column's other stable intervals (another stable gait of the family: bistable) are
+    # counted apart. Cells between two columns: compared where both neighbours agree.
+    def on_start(lo, hi):           # (the down and up runs start at s0 to rounding)
+        return lo <= s0 * (1 + 1e-9) and hi >= s0 * (1 - 1e-9)
+
+    def main(ic, d):
+        return any(lo <= d <= hi for lo, hi in stab[ic] if on_start(lo, hi))
+
+    def other(ic, d):
+        return any(lo <= d <= hi for lo, hi in stab[ic] if not on_start(lo, hi))
+    wrong, skipped, ncmp, islands = [], 0, 0, []
+    outside = [(k, d, "FS2U"[grid[a, j]]) for a, k in enumerate(kg) for j, d in enumerate(dg)
+               if not kns.min() <= k <= kns.max()]
+    if outside:
+        say("cells beyond the last column (not compared): %d, walks there: %s" % (
+            len(outside), " ".join("%.4g/%.4g:%s" % c for c in outside)))
+    for a, k in enumerate(kg):
+        if not kns.min() <= k <= kns.max():
+            continue
+        near = np.argsort(dist(kns, k))[:2]
+        on = dist(kns[near[0]], k) < 1e-9 * max(1.0, abs(k))
+        for j, d in enumerate(dg):
+            ics = [near[0]] if on else list(near)
+            pa = main(ics[0], d)
+            if any(main(ic, d) != pa for ic in ics):
+                skipped += 1
+                continue
+            if not pa and any(other(ic, d) for ic in ics):
+                islands.append((k, d, "FS2U"[grid[a, j]]))
+                continue
+            ncmp += 1
+            if pa != (grid[a, j] == 1):
+                wrong.append((k, d, "FS2U"[grid[a, j]], pa))
+    say("cells outside the start's stable interval where the column has another stable gait "
+        "(bistable; the walk starts on the start's sheet): %d, walks there (F fell, S "
+        "settled, U unsettled): %s" % (len(islands), " ".join("%.4g/%.4g:%s" % c
+                                                              for c in islands)))
+    say("cells compared: %d (on the columns and between two agreeing ones; %d between "
+        "disagreeing columns not compared); disagreeing with the first edges: %d"
+        % (ncmp, skipped, len(wrong)))
+    for k, d, g, pa in wrong:
+        say("  %s = %.4g %s = %.4g: walk %s (F fell, S settled, U unsettled), predicted %s"
+            % (outer, k, inner, d, g, "to settle" if pa else "not to settle"))
+    say("load average after: %s" % (os.getloadavg(),))
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(7.6, 5.6), layout="constrained")
+    kk, dd = np.meshgrid(kg, dg, indexing="ij")
+    for v, mk, lab in ((1, "C2o", "walk settles (period 1)"), (2, "C1.", "period 2"),
+                       (3, "C0^", "walks, unsettled"), (0, "kx", "the walker falls")):
+        m = grid == v
+        if m.any():
+            ax.plot(kk[m], dd[m], mk, ms=3, alpha=0.55, label=lab)
+    for k, parts in cols:
+        for nm in ("down", "up"):
+            br = parts[nm]
+            for i in range(len(br) - 1):
+                st = br.stable[i] and br.stable[i + 1]
+                ax.plot([k, k], br.values[i:i + 2], "-", color="C2" if st else "0.6",
+                        lw=3.0 if st else 1.0, solid_capstyle="butt")
+            for f in br.bifurcations:
+                mk = {"fold": "C3v", "neimark_sacker": "C4D", "period_doubling": "C1s",
+                      "end": "ks", "event": "k|"}[f.kind]
+                ax.plot([k], [f.value], mk, ms=6 if f.kind != "event" else 9,
+                        mfc=mk[:2] if f.located else "none")
+    # the edges of the stable family connected to P's gait: each column's first edges, where
+    # the gait at the start value is stable (the shaded interval)
+    lo_e = np.array([d_lo if f is None else f.value for f in edges])
+    hi_e = np.array([d_hi if f is None else f.value for f in ups])
+    kc = np.array([k for k, _ in cols])
+    ok = np.array([any(on_start(lo, hi) for lo, hi in iv) for iv in stab])
+    ax.fill_between(kc, lo_e, hi_e, where=ok, color="C2", alpha=0.10, lw=0)
+    for e, f_list in ((lo_e, edges), (hi_e, ups)):
+        sel = [i for i, f in enumerate(f_list) if f is not None and ok[i]]
+        if sel:
+            ax.plot(kc[sel], e[sel], "k--", lw=1.0)
+            for i in sel:
+                ax.annotate(f_list[i].label, (kc[i], e[i]), textcoords="offset points",
+                            xytext=(4, -9), fontsize=7)
+    ax.plot([], [], "k--", lw=1.0, label="first edges from the start (%s = %.3g), where "
+            "stable" % (inner, s0))
+    for lab, mk in (("LP fold", "C3v"), ("NS Neimark-Sacker", "C4D"),
+                    ("PD period doubling", "C1s"), ("EP end", "ks"),
+                    ("UZ event sequence changes (not an edge)", "k|")):
+        ax.plot([], [], mk, label=lab)
+    ax.plot([], [], "-", color="C2", lw=3, label="stable (columns: continue_gait in %s)"
+            % inner)
+    ax.plot([], [], "-", color="0.6", lw=1, label="unstable")
+    for i, (lab, v) in enumerate(curves):
+        ax.plot(v[:, 1], v[:, 0], "C3-", lw=1.5, label=lab if i == 0 or lab != curves[0][0]
+                else None)
+    ax.plot([getattr(pdw.Params.paper_steady(), outer)],
+            [getattr(pdw.Params.paper_steady(), inner)], "k*", ms=10, label="paper_steady")
+    if log:
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_ylim(dg[0] / 1.3, d_hi * 1.3)
+    else:
+        ax.set_ylim(min(dg[0], d_lo), d_hi)
+    ax.set_xlabel("%s [%s]" % (outer, units[0]))
+    ax.set_ylabel("%s [%s]" % (inner, units[1]))
+    ax.set_title("paper_steady (continuous, paper variant): existence and stability in "
+                 "(%s, %s)" % (outer, inner), fontsize=9)
+    ax.legend(fontsize=6.5, loc="upper left" if log else "upper right", ncol=2)
+    ax.grid(alpha=0.3, which="both")
+    fig.savefig(FIGS / ("continuation_%s.png" % name), dpi=150)
+    say("wrote docs/figures/continuation_%s.png" % name)
+
+
+def part_region_kn(n_cols=11, n_rows=41, t_walk=60.0):
+    """The continuous paper walker's (paper_steady, paper variant) existence and stability
+    region in (k_n, d_n): columns of one-parameter d_n continuations at n_cols k_n (every
+    edge labelled: LP, PD, NS, EP; changes of the event sequence UZ), the followed fold curve,
+    and a brute-force grid of long walks on the ensemble engine, compared cell by cell."""
+    from pdw.analysis.bifurcation.codim2 import continue_bifurcation
+    say("== paper_steady (continuous, paper variant): existence and stability in (k_n, d_n) ==")
+    say("load average before: %s" % (os.getloadavg(),))
+    P = pdw.Params.paper_steady()
+    # the fold of the d_n family at k_n = 1e5 (paper_steady's), followed in k_n both ways
+    w0, c0 = time.perf_counter(), time.process_time()
+    b = continue_gait(P, "d_n", 1e3, log=True, max_points=25, workers=2)
+    fold = b.of_kind("fold")[0]
+    kns = 10 ** np.linspace(4.5, 5.5, n_cols)
+    fcs = []
+    for stop in (kns.max(), kns.min()):
+        cv = continue_bifurcation(fold, "k_n", stop, fd_step=1e-4, max_points=40,
+                                  skip=("event_sequence",))
+        fcs.append(cv)
+        say("fold d_n = %.7g at k_n = 1e5 followed to %.3g: %d points, k_n %.4g -> %.4g, d_n "
+            "%.6g -> %.6g; UZ %s; stop: %s" % (
+                fold.value, stop, len(cv), cv.values[0, 1], cv.values[-1, 1], cv.values[0, 0],
+                cv.values[-1, 0], ["%.4g" % f.value for f in cv.branch.bifurcations
+                                   if f.kind == "event"], cv.stop_reason))
+    say("fold curves: %.1f s wall, %.1f s CPU" % (time.perf_counter() - w0,
+                                                  time.process_time() - c0))
+    fc = np.vstack([fcs[1].values[::-1], fcs[0].values[1:]])
+    d_lo, d_hi = 5e3, 1e7
+
+    def follow(cols):
+        """The first-edge folds of the columns at k_n = 6.31e4 and 2e5 followed in k_n both
+        ways (the low-k_n fold and the upper sheet's fold)."""
+        out = []
+        for k_at, stops in ((6.31e4, (3e4, 1e5)), (1.995e5, (1.4e5, 3.3e5))):
+            k, parts = min(cols, key=lambda c: abs(np.log(c[0] / k_at)))
+            f = _first_edge(parts["down"])
+            if f is None or f.kind != "fold" or not f.located:
+                say("column k_n = %.4g: no located fold to follow" % k)
+                continue
+            w0, c0 = time.perf_counter(), time.process_time()
+            vs = []
+            for stop in stops:
+                cv = continue_bifurcation(f, "k_n", stop, fd_step=1e-4, max_points=40,
+                                          skip=("event_sequence",))
+                vs.append(cv.values)
+                say("fold d_n = %.7g at k_n = %.4g followed to %.3g: %d points, k_n %.4g -> "
+                    "%.4g, d_n %.6g -> %.6g; UZ %s; stop: %s" % (
+                        f.value, k, stop, len(cv), cv.values[0, 1], cv.values[-1, 1],
+                        cv.values[0, 0], cv.values[-1, 0],
+                        ["%.4g" % g.value for g in cv.branch.bifurcations
+                         if g.kind == "event"], cv.stop_reason))
+                for kv in (4e4, 5e4, 8e4, 1.5e5, 2.5e5, 3e5):
+                    try:
+                        say("    at k_n = %.4g: d_n = %.7g" % (kv, cv.at(kv)))
+                    except pdw.InvalidInputError:
+                        pass
+            say("  %.1f s wall, %.1f s CPU" % (time.perf_counter() - w0,
+                                              time.process_time() - c0))
+            out.append(("fold curve (continue_bifurcation)",
+                        np.vstack([vs[0][::-1], vs[1][1:]])))
+        return out
+    _region(P, "k_n", "d_n", kns, d_lo, d_hi, 10 ** np.linspace(4.5, 5.5, 2 * n_cols - 1),
+            10 ** np.linspace(np.log10(d_lo) + 0.15, np.log10(d_hi), n_rows), True, t_walk,
+            ("N/m^1.5", "N s/m^2.5"), "region_kn",
+            curves=[("fold curve (continue_bifurcation)", fc)], follow=follow)
+
+
+def part_region_hip_continuous(n_cols=13, n_rows=25, t_walk=60.0):
+    """The continuous paper walker's existence and stability region in (k_hip, d_hip), as
+    `part_region_kn` (the hybrid model's: `part_region_hip`): columns in d_hip from 0.002 at
+    n_cols k_hip in [0, 6], against a brute-force grid."""
+    say("== paper_steady (continuous, paper variant): existence and stability in (k_hip, "
+        "d_hip) ==")
+    say("load average before: %s" % (os.getloadavg(),))
+    P5 = continue_gait(pdw.Params.paper_steady(), "d_hip", 0.002, max_points=30, workers=2)
+    P = pdw.Params.paper_steady().replace(d_hip=0.002)
+    say("paper_steady's family continued to d_hip = 0.002: %d points, stop: %s"
+        % (len(P5), P5.stop_reason))
+    kns = np.linspace(0.0, 6.0, n_cols)
+    _region(P, "k_hip", "d_hip", kns, 0.0, 0.03, np.linspace(0.0, 6.0, 2 * n_cols - 1),
+            np.linspace(0.0005, 0.03, n_rows), False, t_walk, ("N m/rad", "N m s/rad"),
+            "region_hip_continuous", start=P5.z[-1], row_points=120)
+
+
 def part_codim2_schemes():
     """The continuous fold curve's two derivative schemes interleaved (8 points each, two
     rounds), and sigma_tol = tol = 1e-9: the stall of the last round."""
@@ -736,7 +1098,11 @@ if __name__ == "__main__":
          "rigid_paper": part_rigid_paper, "fig11": part_fig11,
          "simplest_limit": part_simplest_limit, "kelvin_voigt": part_kelvin_voigt,
          "codim2": part_codim2, "goswami": part_goswami, "region_hip": part_region_hip,
-         "fold_kn": part_fold_kn, "codim2_schemes": part_codim2_schemes,
+         "fold_kn": part_fold_kn, "region_kn": part_region_kn,
+         "region_kn_coarse": lambda: part_region_kn(3, 9, 30.0),
+         "region_hip_continuous": part_region_hip_continuous,
+         "region_hip_continuous_coarse": lambda: part_region_hip_continuous(4, 9, 30.0),
+         "codim2_schemes": part_codim2_schemes,
          "ns_search": part_ns_search, "chaos": part_chaos,
          "monodromy": part_monodromy}[part]()
         say("(%s: %.1f s wall; python benchmarks/continuation.py %s)"

@@ -463,7 +463,7 @@ def continue_bifurcation(bifurcation: Bifurcation, parameter: str, stop: float, 
                          tol: float = 1e-9, max_newton: int = 10, fd_step: float = 1e-6,
                          params_of: Any = None, value: float | None = None,
                          second: str = "auto", sigma_tol: float | None = None,
-                         **kw: Any) -> BifurcationCurve:
+                         skip: Any = (), **kw: Any) -> BifurcationCurve:
     """Follow a located fold, period doubling or end of a branch in a second parameter.
 
     Parameters
@@ -502,6 +502,11 @@ def continue_bifurcation(bifurcation: Bifurcation, parameter: str, stop: float, 
         parameter is applied on top of it.
     value : float, optional
         The start's ``parameter`` (needed with ``params_of``; default: the base's field).
+    skip : sequence of str, optional
+        Admissibility functions of the problem that do not end the curve (e.g.
+        ``("event_sequence",)``: a change of the continuous model's sequence of support
+        events, where its step map is continuous, is then reported as a UZ point of
+        ``curve.branch`` instead, `testfunctions.SequenceChange`).
     **kw
         `run_continuation`'s other options (``max_newton``, ``step_max``, ``at``, ...).
 
@@ -534,9 +539,21 @@ def continue_bifurcation(bifurcation: Bifurcation, parameter: str, stop: float, 
         raise InvalidInputError("sigma_tol must be in (0, 1), got %r" % (sigma_tol,))
     aug.kappa = float(tol) / float(sigma_tol)
     x0 = np.append(np.asarray(bifurcation.z, dtype=float), bifurcation.mu)
+    detect: tuple = ("end",)
+    if isinstance(skip, str) or any(k not in getattr(prob, "ADMISSIBLE", {}) for k in skip):
+        raise InvalidInputError("skip must be a sequence of the problem's admissibility "
+                                "functions (%s), got %r"
+                                % (", ".join(getattr(prob, "ADMISSIBLE", {})), skip))
+    if skip:
+        from . import testfunctions as TF
+        events: list = [TF.AdmissibleEnd(skip=skip)]
+        if "event_sequence" in skip:
+            events.append(TF.SequenceChange())
+        kw["events"] = events + list(kw.get("events", ()))
+        detect = ()
     b = run_continuation(aug, x0, aug.start2, stop, step=step,
                          max_points=max_points, tol=tol, max_newton=max_newton,
-                         detect=("end",), **kw)
+                         detect=detect, **kw)
     vals = np.column_stack([[prob.value(m) for m in b.z[:, -1]], b.values])
     mult = []
     for x, mu2 in zip(b.z, b.values):

@@ -14,6 +14,7 @@ class              label  scalar(s) (zero at the special point)
 `BranchPoint`      BP     det of the bordered Jacobian [DG; t_prev^T] (a simple branch point)
 `AdmissibleEnd`    EP     each admissibility function of the problem (> 0 on a valid gait)
 `Event`            UZ     quantity - level (e.g. ``Event("step_length", 0.4)``)
+`SequenceChange`   UZ     0.5 - |n_events - n_events at the start| (a step function: bracketed)
 =================  =====  ==========================================================
 
 The list of kinds (`KINDS`) and labels (`LABELS`) derives from these classes. A user's own test
@@ -115,11 +116,20 @@ class NeimarkSacker(TestFunction):
         return {"neimark_sacker": float(np.real(ns))}
 
     def describe(self, engine, pt, name):
-        cx = [v for v in pt.mult if abs(v.imag) > 1e-8 and abs(abs(v) - 1.0) < 1e-3]
+        # a neutral saddle (a real mu_i mu_j = 1) is rejected; a complex pair that is not on
+        # the circle at the returned point is still reported (its location failed, and
+        # `continuation_engine.locate` says so), never dropped
+        cx = [v for v in pt.mult if abs(v.imag) > 1e-8]
+        re = [float(v.real) for v in pt.mult if abs(v.imag) <= 1e-8]
+        saddle = min([abs(a * b - 1.0) for i, a in enumerate(re) for b in re[i + 1:]],
+                     default=np.inf)
         if not cx:
             return None
+        c = min(cx, key=lambda v: abs(abs(v) - 1.0))
+        if saddle < abs(abs(c) - 1.0):
+            return None
         return ("a complex pair through the unit circle (|mu| = %.6g, arg %.4g rad)"
-                % (abs(cx[0]), abs(np.angle(cx[0]))), None)
+                % (abs(c), abs(np.angle(c))), None)
 
 
 class BranchPoint(TestFunction):
@@ -139,12 +149,28 @@ class BranchPoint(TestFunction):
 
 class AdmissibleEnd(TestFunction):
     """The end of the family as modelled: an admissibility function of the problem
-    (``prob.ADMISSIBLE``) through 0 from above."""
+    (``prob.ADMISSIBLE``) through 0 from above.
+
+    Parameters
+    ----------
+    skip : sequence of str, optional
+        Admissibility functions not watched (e.g. ``("event_sequence",)``, with
+        `SequenceChange` reporting the changes instead of ending the branch there). The
+        built-in instance watches all; give ``AdmissibleEnd(skip=...)`` in ``events=`` and
+        leave "end" out of ``detect``.
+    """
 
     kind, label = "end", "EP"
 
+    def __init__(self, skip: Any = ()):
+        if isinstance(skip, str) or not all(isinstance(k, str) for k in skip):
+            raise InvalidInputError("AdmissibleEnd: skip must be a sequence of admissibility "
+                                    "names, got %r" % (skip,))
+        self.skip = tuple(skip)
+
     def values(self, engine, pt):
-        return {"end:" + k: float(v) for k, v in pt.ev.admissible.items()}
+        return {"end:" + k: float(v) for k, v in pt.ev.admissible.items()
+                if k not in self.skip}
 
     def crossed(self, name, fa, fb):
         return bool(fa > 0.0 >= fb)
@@ -152,6 +178,40 @@ class AdmissibleEnd(TestFunction):
     def describe(self, engine, pt, name):
         adm = name[4:]
         return "%s -> 0: %s" % (adm, engine.prob.ADMISSIBLE.get(adm, adm)), None
+
+
+class SequenceChange(TestFunction):
+    """A change of the step's sequence of support events (the continuous model: the count of
+    lift-offs and touch-downs per period, ``info["n_events"]``) reported as a point of the
+    branch (kind ``"event"``, label UZ) instead of its end.
+
+    Where the extra events are a lift-off and a re-touch-down of a foot that carries no force
+    in between (paper_steady's stance foot rising 3 mm above the ground early in single
+    support, docs/continuation.md), the step map is continuous across the change, so the
+    family goes on; whether it does is checked by the corrector converging beyond it and by
+    long walks. The scalar, 0.5 - |n - n_0| with n_0 the count at the first point this
+    instance sees, is a step function: its crossings are bracketed to ``locate_tol`` and
+    reported as detected, not located (`continuation_engine.locate`). A return to n_0 is a
+    crossing too; a change between two counts both different from n_0 is not seen.
+    """
+
+    kind, label = "event", "UZ"
+
+    def __init__(self):
+        self.ref: int | None = None
+
+    def values(self, engine, pt):
+        n = pt.ev.info.get("n_events")
+        if n is None:
+            return {}
+        if self.ref is None:
+            self.ref = int(n)
+        return {"event_sequence": 0.5 - abs(int(n) - self.ref)}
+
+    def describe(self, engine, pt, name):
+        return ("the step's sequence of support events changes (%d events per period at the "
+                "start): a foot lifts off and touches down again within the step, or stops "
+                "doing so" % self.ref, None)
 
 
 #: the gait descriptors an `Event` can name (a problem evaluation's ``info``)

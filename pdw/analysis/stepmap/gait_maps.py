@@ -102,6 +102,10 @@ class _Problem:
 
     # parameter coordinate: mu = log(lambda) or lambda
     def value(self, mu):
+        if self.log and not mu < 709.0:
+            # a predictor far off on a logarithmic axis: an invalid parameter (the corrector
+            # fails and the step is cut), never an OverflowError
+            raise InvalidInputError("%s = exp(%r) is out of range" % (self.parameter, mu))
         return float(math.exp(mu)) if self.log else float(mu)
 
     def coord(self, value):
