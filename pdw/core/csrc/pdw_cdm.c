@@ -65,7 +65,7 @@ typedef char pdw_cdm_dblock_check[
  * every value is the dense loop's (an exactly-zero term changes a sum only in the sign of a zero
  * result); the lane loop of pdw_batch_soa.inc gives the same bits. */
 static inline int cdm_update(pdw_sim *s, const double *M, const double *C, const double *QmG,
-                             double t)
+                             const double *moment, double t)
 {
     const double dt = s->opt.dt;
     if (dt != s->cdm_dt || dt == 0.0) {  /* 1/dt^2 and 1/(2 dt): computed once per run */
@@ -92,7 +92,11 @@ static inline int cdm_update(pdw_sim *s, const double *M, const double *C, const
             if (mz) mu += M[ij] * s->x[j];
             if (mz || cz) ku += km * s->u_prev[j];
         }
-        b[i] = QmG[i] + 2.0*idt2*mu - ku;
+        /* a shaped ground's moments (pdw_terrain_cdm_terms_split): added to Q_f - G first, as
+         * pdw_terrain_cdm_terms adds them, here where b waits on them (no store and reload) */
+        const double q = moment && (i == PDW_X_THETA1 || i == PDW_X_THETA2)
+                         ? QmG[i] + moment[i - PDW_X_THETA1] : QmG[i];
+        b[i] = q + 2.0*idt2*mu - ku;
     }
     /* 1/K[2][2] and 1/K[3][3]: the diagonal block is M's (C's is zero), which in the walker's
      * mechanics depends on the parameters only; the last step's inverses are reused while the
@@ -130,7 +134,7 @@ static inline int cdm_update(pdw_sim *s, const double *M, const double *C, const
 /* The shared entry (pdw_batch.c); pdw_cdm_advance below has the update inline. */
 int pdw_cdm_update(pdw_sim *s, const double *M, const double *C, const double *QmG, double t)
 {
-    return cdm_update(s, M, C, QmG, t);
+    return cdm_update(s, M, C, QmG, NULL, t);
 }
 
 int pdw_cdm_advance(pdw_sim *s)
@@ -139,7 +143,7 @@ int pdw_cdm_advance(pdw_sim *s)
     const double dt = s->opt.dt;
     double *trig = s->work + PDW_WORK_TRIG, *kin = s->work + PDW_WORK_KIN;
     double *contact = s->work + PDW_WORK_CONTACT, *M = s->work + PDW_WORK_M;
-    double C[PDW_NQ*PDW_NQ], QmG[PDW_NQ];
+    double C[PDW_NQ*PDW_NQ], QmG[PDW_NQ], moment[2];
 
     s->status = PDW_STATUS_RUNNING;
     if (!s->started) {
@@ -164,13 +168,14 @@ int pdw_cdm_advance(pdw_sim *s)
         if (pdw_check_feet(s, t)) return s->status;
         if (s->ground) {            /* shaped ground (pdw_terrain.c) */
             pdw_sim_contact(s, s->work);
-            pdw_terrain_cdm_terms(k, s->x, trig, s->p, contact, s->work + PDW_WORK_GROUND, M, C, QmG);
+            pdw_terrain_cdm_terms_split(k, s->x, trig, s->p, contact, s->work + PDW_WORK_GROUND,
+                                        M, C, QmG, moment);
         } else {
             k->contact(kin, s->disc.flags, s->p, contact);
             k->cdm_terms(s->x, trig, s->p, contact, M, C, QmG);
         }
         if (s->n > 0) pdw_record(s, t);  /* sample 0 was recorded at the start */
-        if (cdm_update(s, M, C, QmG, t)) return s->status;
+        if (cdm_update(s, M, C, QmG, s->ground ? moment : NULL, t)) return s->status;
     }
     /* final sample: flags and forces at t_end */
     const int r = pdw_update_flags(s, s->n * dt);

@@ -150,8 +150,8 @@ static inline int swing_decided(const pdw_ground *g, const double *x, double cos
 /* The flag update's kinematics with support foot j (a constant) and swing foot i = 1 - j: 0 if
  * foot i's rules need its ground (e_j, foot j's sample, is then set for the caller), else 1
  * with kin and gnd written: foot j's exactly as pdw_terrain_kinematics writes them (the same
- * generated expressions: the two-foot kinematics into a local array, of which only foot j's
- * outputs are kept, so the compiler drops foot i's arithmetic), foot i's as a swing foot the
+ * generated expressions: the two-foot kinematics, whose outputs for foot i are overwritten
+ * at once, so the compiler drops foot i's arithmetic), foot i's as a swing foot the
  * rules read the same way (x_D = s_A, g = lb, no rate, no slip) on level ground (h' = +0,
  * 1/N = 1, h'/N = +0: the forces of its zero contact forces are +0, as with its own ground). */
 #if defined(__GNUC__)
@@ -170,16 +170,15 @@ static inline int one_support(const pdw_kernel *k, const pdw_ground *g, const do
                            sA[j], fall_depth, &lb)))
         return 0;
     const double level[3] = {g->h_top, 0.0, NAN};
-    double gl[2*PDW_NGROUND], kl[2*PDW_NKIN];
+    double gl[2*PDW_NGROUND];
     const double c = inv_norm(e_j[1]);      /* inv_normals' bits for foot j */
     double sig = 0.0, al = 0.0;
     if (consistent) { sig = pdw_ground_arc(g, sA[j]); al = atan(e_j[1]); }
     put_ground(gl + j*PDW_NGROUND, e_j, sig, al, c);
     put_ground(gl + i*PDW_NGROUND, level, 0.0, 0.0, 1.0);
-    if (consistent) pdw_consistent_ground_kinematics(x, trig, p, anchors, gl, kl);
-    else pdw_paper_ground_kinematics(x, trig, p, anchors, gl, kl);
-    for (int f = 0; f < PDW_NKIN; ++f) kin[j*PDW_NKIN + f] = kl[j*PDW_NKIN + f];
-    double *ki = kin + i*PDW_NKIN;
+    if (consistent) pdw_consistent_ground_kinematics(x, trig, p, anchors, gl, kin);
+    else pdw_paper_ground_kinematics(x, trig, p, anchors, gl, kin);
+    double *ki = kin + i*PDW_NKIN;      /* foot i's values overwritten (its stores are dead) */
     ki[PDW_KIN_X_D] = sA[i];
     ki[PDW_KIN_Y_D] = lb;
     ki[PDW_KIN_V_X] = ki[PDW_KIN_V_Y] = ki[PDW_KIN_S] = ki[PDW_KIN_XI] = 0.0;
@@ -428,6 +427,15 @@ void pdw_terrain_jacobian(const pdw_kernel *k, const pdw_ground *g, const double
         for (int i = 0; i < nx; ++i) J[i*nx + j] = (fp[i] - fm[i]) / (hp + hm);
     }
     pdw_terrain_rhs(k, g, x, p, flags, anchors, fp, work);
+}
+
+void pdw_terrain_cdm_terms_split(const pdw_kernel *k, const double *x, const double *trig,
+                                 const double *p, const double *contact, const double *gnd,
+                                 double *M, double *C, double *QmG, double *moment)
+{
+    double cw[2*PDW_NCONTACT];
+    terrain_forces(contact, gnd, p, cw, moment);
+    k->cdm_terms(x, trig, p, cw, M, C, QmG);
 }
 
 void pdw_terrain_cdm_terms(const pdw_kernel *k, const double *x, const double *trig,

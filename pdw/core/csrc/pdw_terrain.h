@@ -59,4 +59,11 @@ void pdw_terrain_cdm_terms(const pdw_kernel *k, const double *x, const double *t
                            const double *p, const double *contact, const double *gnd, double *M,
                            double *C, double *QmG);
 
+/* pdw_terrain_cdm_terms with the moments moment[0..1] returned, not added: QmG holds Q_f - G
+ * of the slope-frame forces, and QmG[theta_i] + moment[i] is pdw_terrain_cdm_terms's QmG (the
+ * central difference update adds them where it uses them: pdw_cdm.c). */
+void pdw_terrain_cdm_terms_split(const pdw_kernel *k, const double *x, const double *trig,
+                                 const double *p, const double *contact, const double *gnd,
+                                 double *M, double *C, double *QmG, double *moment);
+
 #endif /* PDW_TERRAIN_H */
