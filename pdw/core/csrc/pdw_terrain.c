@@ -23,6 +23,13 @@
 #define INVN_C4 0.2734375
 #define INVN_C5 (-0.24609375)
 
+/* For q <= INVN_Q4MAX (|h'| <= 2^-7) the series' last sum adds nothing: r = (1 + c1 q) +
+ * q^2 (c2 + c3 q) lies in [1 - 2^-15, 1] (its ulp below 1 is 2^-53) and the last term
+ * |q^4 (c4 + c5 q)| <= 2^-56 * 0.274 < 2^-54, below half an ulp of r, so r + that term rounds
+ * to r (round to nearest, no tie): the same bits without its two levels of latency
+ * (tests/core/test_terrain_invn.py checks it against the full series' floating-point sums). */
+#define INVN_Q4MAX 0x1p-14
+
 static inline double inv_norm_series(double q)
 {
     const double q2 = q*q, q4 = q2*q2;
@@ -32,6 +39,7 @@ static inline double inv_norm_series(double q)
 static inline double inv_norm(double dh)
 {
     const double q = dh*dh;
+    if (q <= INVN_Q4MAX) return (1.0 + INVN_C1*q) + (q*q)*(INVN_C2 + INVN_C3*q);
     return q <= INVN_QMAX ? inv_norm_series(q) : 1.0 / sqrt(1.0 + q);
 }
 
@@ -41,6 +49,16 @@ static inline void inv_normals(double dh0, double dh1, double *n0, double *n1)
 {
 #if defined(__SSE2__)
     const __m128d d = _mm_set_pd(dh1, dh0), q = _mm_mul_pd(d, d);
+    if (_mm_movemask_pd(_mm_cmple_pd(q, _mm_set1_pd(INVN_Q4MAX))) == 3) {
+        /* both in inv_norm's short range: its sums, the bits of the full series */
+        const __m128d q2 = _mm_mul_pd(q, q);
+        const __m128d p01 = _mm_add_pd(_mm_set1_pd(1.0), _mm_mul_pd(_mm_set1_pd(INVN_C1), q));
+        const __m128d p23 = _mm_add_pd(_mm_set1_pd(INVN_C2), _mm_mul_pd(_mm_set1_pd(INVN_C3), q));
+        const __m128d r = _mm_add_pd(p01, _mm_mul_pd(q2, p23));
+        *n0 = _mm_cvtsd_f64(r);
+        *n1 = _mm_cvtsd_f64(_mm_unpackhi_pd(r, r));
+        return;
+    }
     if (_mm_movemask_pd(_mm_cmple_pd(q, _mm_set1_pd(INVN_QMAX))) == 3) {
         const __m128d q2 = _mm_mul_pd(q, q), q4 = _mm_mul_pd(q2, q2);
         const __m128d p01 = _mm_add_pd(_mm_set1_pd(1.0), _mm_mul_pd(_mm_set1_pd(INVN_C1), q));
