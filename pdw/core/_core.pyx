@@ -25,7 +25,7 @@ cdef extern from "pdw_model.h":
         PDW_WORK_TRIG, PDW_WORK_KIN, PDW_WORK_CONTACT, PDW_WORK_M, PDW_WORK_F, PDW_WORK_QDD
         PDW_STATUS_RUNNING, PDW_STATUS_EVENTS_FULL
         PDW_NSTEP, PDW_STEP_RING, PDW_NANCHOR, PDW_ANCHOR_V_IN1, PDW_ANCHOR_V_IN2
-        PDW_NX_MAX
+        PDW_NX_MAX, PDW_NTRIG, PDW_NGROUND
         PDW_STATUS_RECORDS_FULL, PDW_STATUS_POLL  # derive/layout.py RESUME
         PDW_RECORD_CHUNK, PDW_RECORD_EXACT_MAX, PDW_POLL_EVERY
     ctypedef struct pdw_kernel:
@@ -122,6 +122,14 @@ cdef extern from "pdw_sim.h":
                               const double *p, const int *flags, const double *anchors,
                               double *J, double *work) noexcept nogil
     void pdw_terrain_inv_normals(long n, const double *dh, double *inv_n) noexcept nogil
+    void pdw_terrain_kinematics(const pdw_kernel *k, const pdw_ground *g, const double *x,
+                                const double *trig, const double *p, const double *anchors,
+                                double *kin, double *gnd, double *cell) noexcept nogil
+    void pdw_terrain_flag_kinematics(const pdw_kernel *k, const pdw_ground *g, const double *x,
+                                     const double *trig, const double *p,
+                                     const double *anchors, const int *flags,
+                                     double fall_depth, double *kin, double *gnd,
+                                     double *cell) noexcept nogil
 
 
 cdef extern from "pdw_tableaus.h":
@@ -714,6 +722,36 @@ def ground_inv_normals(const double[::1] dh):
     if n:
         pdw_terrain_inv_normals(n, &dh[0], &o[0])
     return out
+
+
+@_named_buffers
+def ground_kinematics(int k, CGround ground not None, const double[::1] x, const double[::1] p,
+                      int f1, int f2, const double[::1] anchors, fall_depth=None):
+    """(kin (2, NKIN), gnd (2, NGROUND)) of kernel k's shaped-ground kinematics at x, for tests:
+    pdw_terrain_kinematics, or with fall_depth [m] pdw_terrain_flag_kinematics with support flags
+    (f1, f2) (the time loops' flag update, pdw_terrain.c)."""
+    cdef const pdw_kernel *kern = _kernel(k)
+    cdef int flags[2]
+    cdef double trig[PDW_NTRIG]
+    cdef double cell[2]
+    _len("x", x.shape[0], kern.nx)
+    _len("p", p.shape[0], PDW_NP)
+    _len("anchors", anchors.shape[0], PDW_NANCHOR)
+    flags[0] = f1
+    flags[1] = f2
+    cell[0] = cell[1] = -1.0
+    kin = np.zeros((2, PDW_NKIN))
+    gnd = np.zeros((2, PDW_NGROUND))
+    cdef double[:, ::1] vk = kin
+    cdef double[:, ::1] vg = gnd
+    pdw_trig(&x[0], trig)
+    if fall_depth is None:
+        pdw_terrain_kinematics(kern, &ground.g, &x[0], trig, &p[0], &anchors[0], &vk[0, 0],
+                               &vg[0, 0], cell)
+    else:
+        pdw_terrain_flag_kinematics(kern, &ground.g, &x[0], trig, &p[0], &anchors[0], flags,
+                                    float(fall_depth), &vk[0, 0], &vg[0, 0], cell)
+    return kin, gnd
 
 
 @_named_buffers

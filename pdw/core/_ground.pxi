@@ -23,6 +23,7 @@ cdef extern from "pdw_ground.h":
         double blend
         int n_zones
         const double *zones
+    void pdw_ground_set_bounds(pdw_ground *g) noexcept nogil
 
 
 cdef class CGround:
@@ -80,3 +81,4 @@ cdef class CGround:
         if zones.shape[0]:
             vz = zones
             self.g.zones = &vz[0]
+        pdw_ground_set_bounds(&self.g)

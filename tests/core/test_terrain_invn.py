@@ -59,3 +59,28 @@ def test_pairs_and_odd_lengths_agree():
     pairs = _core.ground_inv_normals(dh)
     single = np.array([_core.ground_inv_normals(np.array([v]))[0] for v in dh])
     assert np.array_equal(pairs, single)
+
+
+def _full_series(dh):
+    """The full series of pdw_terrain.c inv_norm_series, the same IEEE sums in NumPy."""
+    c1, c2, c3, c4, c5 = -0.5, 0.375, -0.3125, 0.2734375, -0.24609375
+    q = dh * dh
+    q2 = q * q
+    q4 = q2 * q2
+    return ((1.0 + c1 * q) + q2 * (c2 + c3 * q)) + q4 * (c4 + c5 * q)
+
+
+def test_short_series_is_the_full_series_bitwise():
+    """For h'^2 <= 2^-14 the kernel drops the series' last sum (below half an ulp, so it never
+    changes the result): the same bits as the full series, alone and in pairs, up to the
+    switch and just past it (where the full series is taken)."""
+    rng = np.random.default_rng(11)
+    edge = 2.0 ** -7                                       # sqrt(INVN_Q4MAX)
+    dh = np.concatenate([rng.uniform(0.0, edge, 3000), rng.uniform(0.0, 1e-3, 1000),
+                         np.nextafter(edge, [0.0, 1.0]), [edge, 0.0],
+                         rng.uniform(edge, np.sqrt(QMAX), 500)])
+    dh = np.concatenate([dh, -dh])
+    full = _full_series(dh)
+    assert _core.ground_inv_normals(dh).tobytes() == full.tobytes()
+    single = np.array([_core.ground_inv_normals(np.array([v]))[0] for v in dh[:800]])
+    assert single.tobytes() == full[:800].tobytes()

@@ -64,8 +64,11 @@ typedef char pdw_cdm_dblock_check[
  * remaining terms in the dense loop's order (j ascending) and start from -0.0 (-0.0 + a = a), so
  * every value is the dense loop's (an exactly-zero term changes a sum only in the sign of a zero
  * result); the lane loop of pdw_batch_soa.inc gives the same bits. */
-static inline int cdm_update(pdw_sim *s, const double *M, const double *C, const double *QmG,
-                             double t)
+#if defined(__GNUC__)
+__attribute__((always_inline))  /* one copy each in cdm_update and cdm_update_ground */
+#endif
+static inline int cdm_update_impl(pdw_sim *s, const double *M, const double *C,
+                                  const double *QmG, const double *moment, double t)
 {
     const double dt = s->opt.dt;
     if (dt != s->cdm_dt || dt == 0.0) {  /* 1/dt^2 and 1/(2 dt): computed once per run */
@@ -92,7 +95,11 @@ static inline int cdm_update(pdw_sim *s, const double *M, const double *C, const
             if (mz) mu += M[ij] * s->x[j];
             if (mz || cz) ku += km * s->u_prev[j];
         }
-        b[i] = QmG[i] + 2.0*idt2*mu - ku;
+        /* a shaped ground's moments (pdw_terrain_cdm_terms_split): added to Q_f - G first, as
+         * pdw_terrain_cdm_terms adds them, here where b waits on them (no store and reload) */
+        const double q = moment && (i == PDW_X_THETA1 || i == PDW_X_THETA2)
+                         ? QmG[i] + moment[i - PDW_X_THETA1] : QmG[i];
+        b[i] = q + 2.0*idt2*mu - ku;
     }
     /* 1/K[2][2] and 1/K[3][3]: the diagonal block is M's (C's is zero), which in the walker's
      * mechanics depends on the parameters only; the last step's inverses are reused while the
@@ -127,7 +134,27 @@ static inline int cdm_update(pdw_sim *s, const double *M, const double *C, const
     return 0;
 }
 
-/* The shared entry (pdw_batch.c); pdw_cdm_advance below has the update inline. */
+/* The update on flat ground, and on a shaped ground with its moments (moment[0..1], added to
+ * Q_f - G of theta_1, theta_2 first): two functions, so that the flat one is the update as it
+ * was (moment NULL compiled out, called as before). */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static int cdm_update(pdw_sim *s, const double *M, const double *C, const double *QmG, double t)
+{
+    return cdm_update_impl(s, M, C, QmG, NULL, t);
+}
+
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static int cdm_update_ground(pdw_sim *s, const double *M, const double *C, const double *QmG,
+                             const double *moment, double t)
+{
+    return cdm_update_impl(s, M, C, QmG, moment, t);
+}
+
+/* The shared entry (pdw_batch.c). */
 int pdw_cdm_update(pdw_sim *s, const double *M, const double *C, const double *QmG, double t)
 {
     return cdm_update(s, M, C, QmG, t);
@@ -139,7 +166,7 @@ int pdw_cdm_advance(pdw_sim *s)
     const double dt = s->opt.dt;
     double *trig = s->work + PDW_WORK_TRIG, *kin = s->work + PDW_WORK_KIN;
     double *contact = s->work + PDW_WORK_CONTACT, *M = s->work + PDW_WORK_M;
-    double C[PDW_NQ*PDW_NQ], QmG[PDW_NQ];
+    double C[PDW_NQ*PDW_NQ], QmG[PDW_NQ], moment[2];
 
     s->status = PDW_STATUS_RUNNING;
     if (!s->started) {
@@ -164,13 +191,15 @@ int pdw_cdm_advance(pdw_sim *s)
         if (pdw_check_feet(s, t)) return s->status;
         if (s->ground) {            /* shaped ground (pdw_terrain.c) */
             pdw_sim_contact(s, s->work);
-            pdw_terrain_cdm_terms(k, s->x, trig, s->p, contact, s->work + PDW_WORK_GROUND, M, C, QmG);
+            pdw_terrain_cdm_terms_split(k, s->x, trig, s->p, contact, s->work + PDW_WORK_GROUND,
+                                        M, C, QmG, moment);
         } else {
             k->contact(kin, s->disc.flags, s->p, contact);
             k->cdm_terms(s->x, trig, s->p, contact, M, C, QmG);
         }
         if (s->n > 0) pdw_record(s, t);  /* sample 0 was recorded at the start */
-        if (cdm_update(s, M, C, QmG, t)) return s->status;
+        if (s->ground ? cdm_update_ground(s, M, C, QmG, moment, t) : cdm_update(s, M, C, QmG, t))
+            return s->status;
     }
     /* final sample: flags and forces at t_end */
     const int r = pdw_update_flags(s, s->n * dt);

@@ -156,7 +156,7 @@ int pdw_update_flags_trig(pdw_sim *s, double t)
     double *kin = s->work + PDW_WORK_KIN;
     int changed = 0, stop = PDW_STOP_NONE;
     if (!pdw_events_room(s, 2)) return -1;
-    pdw_sim_kinematics(s, s->x, d->anchors, s->work);
+    pdw_sim_flag_kinematics(s, s->work);
     for (int i = 0; i < 2; ++i) {
         const double *ki = kin + i*PDW_NKIN, *kj = kin + (1 - i)*PDW_NKIN;
         const double y = ki[PDW_KIN_Y_D], vy = ki[PDW_KIN_V_Y];
@@ -183,8 +183,8 @@ int pdw_update_flags_trig(pdw_sim *s, double t)
         }
     }
     /* a new anchor changes xi: refresh the kinematics (trig stays valid) */
-    if (changed) pdw_sim_kinematics(s, s->x, d->anchors, s->work);
-    if (s->ground)
+    if (changed) pdw_sim_flag_kinematics(s, s->work);
+    if (s->ground && s->ground->n_zones > 0)    /* else both stay -1 (pdw_discrete_init) */
         for (int i = 0; i < 2; ++i) d->zone[i] = zone_of(s->ground, d->flags[i], kin + i*PDW_NKIN,
                                                 d->zone[i]);
     if (stop != PDW_STOP_NONE) {

@@ -33,6 +33,10 @@ typedef struct pdw_ground {
     double blend;               /* patch-edge blend width [m] */
     int n_zones;
     const double *zones;        /* (n_zones,) sorted blend-zone boundaries [m] (events) */
+    /* bounds over the defined extent (pdw_ground_set_bounds; bounded = 0: none, e.g. a struct
+     * zeroed by its caller): h(s) <= h_top, |h'(s)| <= dh_max, 1/N >= inv_n_min */
+    int bounded;
+    double h_top, dh_max, inv_n_min;
 } pdw_ground;
 
 /* The cell containing s (the end cells beyond the extent). */
@@ -92,6 +96,48 @@ static inline void pdw_ground_eval_cell(const pdw_ground *g, long k, double s, d
     out[0] = (a[0] + a[1]*d) + d2*(a[2] + a[3]*d) + d4*(a[4] + a[5]*d);
     out[1] = (a[1] + 2.0*a[2]*d) + d2*(3.0*a[3] + 4.0*a[4]*d) + d4*(5.0*a[5]);
     out[2] = (2.0*a[2] + 6.0*a[3]*d) + d2*(12.0*a[4] + 20.0*a[5]*d);
+}
+
+/* h, h' at s in cell k into out[0..1]: pdw_ground_eval_cell's expressions (the same bits)
+ * without h'', which only the Jacobian reads. */
+static inline void pdw_ground_eval_cell_dh(const pdw_ground *g, long k, double s, double *out)
+{
+    const double *c = g->cells + k*PDW_NGCELL;
+    const double d = s - c[PDW_GCELL_S];
+    const double *a = c + PDW_GCELL_A0;
+    const double d2 = d*d, d4 = d2*d2;
+    out[0] = (a[0] + a[1]*d) + d2*(a[2] + a[3]*d) + d4*(a[4] + a[5]*d);
+    out[1] = (a[1] + 2.0*a[2]*d) + d2*(3.0*a[3] + 4.0*a[4]*d) + d4*(5.0*a[5]);
+}
+
+/* Set g's bounds over the defined extent [s_min, s_max] (g->bounded = 1 when they are finite),
+ * from the cells' coefficients: on cell k, d = s - s_k lies in [0, w_k] (w_k the distance to the
+ * next knot, or to s_max for the last cell, widened by 1e-12 relative for the rounding of d), so
+ *     h <= a_0 + sum_j |a_j| w_k^j,     |h'| <= sum_j j |a_j| w_k^(j-1),
+ * rigorous upper bounds (each widened by 1e-12 relative and 1e-15 m), whatever the polynomial;
+ * 1/N = 1/sqrt(1 + h'^2) >= inv_n_min (1/sqrt(1 + dh_max^2), lowered by 1e-12 relative). Call
+ * once after the other fields are set. */
+static inline void pdw_ground_set_bounds(pdw_ground *g)
+{
+    double top = -INFINITY, dmax = 0.0;
+    for (long k = 0; k < g->n_cells; ++k) {
+        const double *c = g->cells + k*PDW_NGCELL, *a = c + PDW_GCELL_A0;
+        const double end = k + 1 < g->n_cells ? c[PDW_NGCELL + PDW_GCELL_S] : g->s_max;
+        const double w = fmax(end - c[PDW_GCELL_S], 0.0) * (1.0 + 1e-12);
+        double hb = a[0], db = 0.0, wj = 1.0;          /* wj = w^(j-1) */
+        for (int j = 1; j < 6; ++j) {
+            db += j * fabs(a[j]) * wj;
+            wj *= w;
+            hb += fabs(a[j]) * wj;
+        }
+        top = fmax(top, hb);
+        dmax = fmax(dmax, db);
+    }
+    g->h_top = top + 1e-12 * fabs(top) + 1e-15;
+    g->dh_max = dmax * (1.0 + 1e-12) + 1e-15;
+    g->inv_n_min = (1.0 / sqrt(1.0 + g->dh_max * g->dh_max)) * (1.0 - 1e-12);
+    g->bounded = g->n_cells > 0 && isfinite(g->h_top) && isfinite(g->dh_max)
+                 && isfinite(g->s_min) && isfinite(g->s_max);
 }
 
 /* h, h', h'' at s into out[0..2]. */

@@ -152,12 +152,26 @@ static inline void pdw_sim_kinematics(const pdw_sim *s, const double *x, const d
     else s->kernel->kinematics(x, work + PDW_WORK_TRIG, s->p, anchors, work + PDW_WORK_KIN);
 }
 
-static inline void pdw_sim_contact(const pdw_sim *s, double *work)
+/* pdw_sim_kinematics of s->x with s's discrete state for pdw_update_flags_trig (on a shaped
+ * ground pdw_terrain_flag_kinematics: the values its rules and the stages after it read). */
+static inline void pdw_sim_flag_kinematics(const pdw_sim *s, double *work)
 {
     if (s->ground)
+        pdw_terrain_flag_kinematics(s->kernel, s->ground, s->x, work + PDW_WORK_TRIG, s->p,
+                                    s->disc.anchors, s->disc.flags, s->opt.fall_depth,
+                                    work + PDW_WORK_KIN, work + PDW_WORK_GROUND,
+                                    work + PDW_WORK_GROUND_CELL);
+    else s->kernel->kinematics(s->x, work + PDW_WORK_TRIG, s->p, s->disc.anchors,
+                               work + PDW_WORK_KIN);
+}
+
+static inline void pdw_sim_contact(const pdw_sim *s, double *work)
+{
+    if (s->ground && s->ground->n_patches > 0)
         pdw_terrain_contact(s->kernel, s->ground, work + PDW_WORK_KIN, s->disc.flags, s->p,
                             work + PDW_WORK_CONTACT, 0);
     else s->kernel->contact(work + PDW_WORK_KIN, s->disc.flags, s->p, work + PDW_WORK_CONTACT);
+    /* (a ground without patches: the kernel's own stage, as pdw_terrain_contact calls it) */
 }
 
 static inline void pdw_sim_rhs(const pdw_sim *s, const double *x, double *xdot, double *work)

@@ -23,6 +23,13 @@
 #define INVN_C4 0.2734375
 #define INVN_C5 (-0.24609375)
 
+/* For q <= INVN_Q4MAX (|h'| <= 2^-7) the series' last sum adds nothing: r = (1 + c1 q) +
+ * q^2 (c2 + c3 q) lies in [1 - 2^-15, 1] (its ulp below 1 is 2^-53) and the last term
+ * |q^4 (c4 + c5 q)| <= 2^-56 * 0.274 < 2^-54, below half an ulp of r, so r + that term rounds
+ * to r (round to nearest, no tie): the same bits without its two levels of latency
+ * (tests/core/test_terrain_invn.py checks it against the full series' floating-point sums). */
+#define INVN_Q4MAX 0x1p-14
+
 static inline double inv_norm_series(double q)
 {
     const double q2 = q*q, q4 = q2*q2;
@@ -32,6 +39,7 @@ static inline double inv_norm_series(double q)
 static inline double inv_norm(double dh)
 {
     const double q = dh*dh;
+    if (q <= INVN_Q4MAX) return (1.0 + INVN_C1*q) + (q*q)*(INVN_C2 + INVN_C3*q);
     return q <= INVN_QMAX ? inv_norm_series(q) : 1.0 / sqrt(1.0 + q);
 }
 
@@ -41,6 +49,16 @@ static inline void inv_normals(double dh0, double dh1, double *n0, double *n1)
 {
 #if defined(__SSE2__)
     const __m128d d = _mm_set_pd(dh1, dh0), q = _mm_mul_pd(d, d);
+    if (_mm_movemask_pd(_mm_cmple_pd(q, _mm_set1_pd(INVN_Q4MAX))) == 3) {
+        /* both in inv_norm's short range: its sums, the bits of the full series */
+        const __m128d q2 = _mm_mul_pd(q, q);
+        const __m128d p01 = _mm_add_pd(_mm_set1_pd(1.0), _mm_mul_pd(_mm_set1_pd(INVN_C1), q));
+        const __m128d p23 = _mm_add_pd(_mm_set1_pd(INVN_C2), _mm_mul_pd(_mm_set1_pd(INVN_C3), q));
+        const __m128d r = _mm_add_pd(p01, _mm_mul_pd(q2, p23));
+        *n0 = _mm_cvtsd_f64(r);
+        *n1 = _mm_cvtsd_f64(_mm_unpackhi_pd(r, r));
+        return;
+    }
     if (_mm_movemask_pd(_mm_cmple_pd(q, _mm_set1_pd(INVN_QMAX))) == 3) {
         const __m128d q2 = _mm_mul_pd(q, q), q4 = _mm_mul_pd(q2, q2);
         const __m128d p01 = _mm_add_pd(_mm_set1_pd(1.0), _mm_mul_pd(_mm_set1_pd(INVN_C1), q));
@@ -92,17 +110,20 @@ static inline double load_fresh(const double *src)
     return v;
 }
 
-/* One foot's ground at s: h, h', h'' (out[0..2]) of its cell (the hint updated). A level cell
- * (finite s) gives exactly pdw_ground_eval_cell's values (pdw_ground.h), known before s is (the
- * time loop's chain skips the quintic). */
-static inline void sample_foot(const pdw_ground *g, double s, double *hint, double *out)
+/* One foot's ground at s: h, h', h'' (out[0..2]; with ddh = 0 only h, h', out[2] := NaN) of its
+ * cell (the hint updated). A level cell (finite s) gives exactly pdw_ground_eval_cell's values
+ * (pdw_ground.h), known before s is (the time loop's chain skips the quintic). */
+static inline void sample_foot(const pdw_ground *g, double s, double *hint, double *out, int ddh)
 {
     const long c = pdw_ground_cell_hint(g, s, hint);
     if (pdw_ground_cell_level(g, c) && s - s == 0.0) {
         out[0] = g->cells[c*PDW_NGCELL + PDW_GCELL_A0] + 0.0;
         out[1] = out[2] = 0.0;
-    } else {
+    } else if (ddh) {
         pdw_ground_eval_cell(g, c, s, out);
+    } else {
+        pdw_ground_eval_cell_dh(g, c, s, out);
+        out[2] = NAN;
     }
 }
 
@@ -118,20 +139,110 @@ static inline void put_ground(double *gi, const double *e, double sigma, double 
     gi[PDW_GROUND_S_N] = e[1] * c;      /* h'/N: the forces' coefficient */
 }
 
-/* Straight-line code on local arrays with constant indices (the feet written out, the generated
- * kinematics inline): the compiler keeps the ground values in registers, where a loop over the
- * feet passed them through memory on the time loop's chain; gnd is stored field by field (for
- * the forces and the Jacobian), never read back here. */
-void pdw_terrain_kinematics(const pdw_kernel *k, const pdw_ground *g, const double *x,
-                            const double *trig, const double *p, const double *anchors,
-                            double *kin, double *gnd, double *cell)
+/* Is every rule of pdw_update_flags_trig for swing foot i decided without its ground, the other
+ * foot j being a support foot (its kinematics exact)? With the ground's bounds (pdw_ground.h:
+ * h <= h_top, |h'| <= dh_max, 1/N >= inv_n_min over the extent, s_A inside it), foot i's gap
+ * g_i = (y_A - h)/N - r >= lb, lb = u/N_max - r (u >= 0) or u - r (u < 0), u = y_A - h_top,
+ * and its contact point x_D = s_A + r h'/N lies within r dh_max of s_A (so does foot j's).
+ * Decided:
+ *   behind: s_Ai + 2 r dh_max + m < s_Aj, so x_Di <= x_Dj: disarmed and no touch-down whatever
+ *           g_i; and lb > -fall_depth + m (pdw_check_feet passes);
+ *   ahead:  s_Ai - 2 r dh_max - m > s_Aj, so x_Di > x_Dj, and lb > m: g_i > 0, armed, no
+ *           touch-down;
+ * m = 1e-9 m (+ 1e-15 |s|) covers every rounding of the evaluated expressions (relative 1e-16
+ * of quantities of order 1 m). *lb := lb. NaN anywhere: not decided. */
+static inline int swing_decided(const pdw_ground *g, const double *x, double cos_th,
+                                const double *p, double s_i, double s_j, double fall_depth,
+                                double *lb_out)
+{
+    if (!(s_i >= g->s_min && s_i <= g->s_max)) return 0;
+    const double r = p[PDW_P_R];
+    const double mx = 2.0 * r * g->dh_max + 1e-9 + 1e-15 * fabs(s_j);
+    const double u = (x[PDW_X_Y_O] - cos_th * (p[PDW_P_L] - r)) - g->h_top;
+    const double lb = (u >= 0.0 ? u * g->inv_n_min : u) - r;
+    *lb_out = lb;
+    if (s_i + mx < s_j) return lb > -fall_depth + 1e-9;
+    return s_i - mx > s_j && lb > 1e-9;
+}
+
+/* The flag update's kinematics with support foot j (a constant) and swing foot i = 1 - j: 0 if
+ * foot i's rules need its ground (e_j, foot j's sample, is then set for the caller), else 1
+ * with kin and gnd written: foot j's exactly as pdw_terrain_kinematics writes them (the same
+ * generated expressions: the two-foot kinematics, whose outputs for foot i are overwritten
+ * at once, so the compiler drops foot i's arithmetic), foot i's as a swing foot the
+ * rules read the same way (x_D = s_A, g = lb, no rate, no slip) on level ground (h' = +0,
+ * 1/N = 1, h'/N = +0: the forces of its zero contact forces are +0, as with its own ground). */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline int one_support(const pdw_kernel *k, const pdw_ground *g, const double *x,
+                              const double *trig, const double *p, const double *anchors,
+                              double fall_depth, const double *sA, int j, double *kin,
+                              double *gnd, double *cell, double *e_j)
+{
+    const int i = 1 - j, consistent = k->variant == 1;
+    double lb;
+    sample_foot(g, sA[j], cell + j, e_j, 0);
+    if (!((consistent || e_j[1] != 0.0)     /* else the level path may be the exact one */
+          && swing_decided(g, x, trig[i ? PDW_TRIG_COS_THETA2 : PDW_TRIG_COS_THETA1], p, sA[i],
+                           sA[j], fall_depth, &lb)))
+        return 0;
+    const double level[3] = {g->h_top, 0.0, NAN};
+    double gl[2*PDW_NGROUND];
+    const double c = inv_norm(e_j[1]);      /* inv_normals' bits for foot j */
+    double sig = 0.0, al = 0.0;
+    if (consistent) { sig = pdw_ground_arc(g, sA[j]); al = atan(e_j[1]); }
+    put_ground(gl + j*PDW_NGROUND, e_j, sig, al, c);
+    put_ground(gl + i*PDW_NGROUND, level, 0.0, 0.0, 1.0);
+    if (consistent) pdw_consistent_ground_kinematics(x, trig, p, anchors, gl, kin);
+    else pdw_paper_ground_kinematics(x, trig, p, anchors, gl, kin);
+    double *ki = kin + i*PDW_NKIN;      /* foot i's values overwritten (its stores are dead) */
+    ki[PDW_KIN_X_D] = sA[i];
+    ki[PDW_KIN_Y_D] = lb;
+    ki[PDW_KIN_V_X] = ki[PDW_KIN_V_Y] = ki[PDW_KIN_S] = ki[PDW_KIN_XI] = 0.0;
+    ki[PDW_KIN_V_IN] = anchors[PDW_ANCHOR_V_IN1 + i];
+    put_ground(gnd + j*PDW_NGROUND, e_j, sig, al, c);
+    put_ground(gnd + i*PDW_NGROUND, level, 0.0, 0.0, 1.0);
+    const int z = k->nx > PDW_NX;
+    kin[PDW_KIN_Z] = z ? x[PDW_X_Z1] : 0.0;
+    kin[PDW_NKIN + PDW_KIN_Z] = z ? x[PDW_X_Z1 + 1] : 0.0;
+    return 1;
+}
+
+/* pdw_terrain_kinematics (full: flags == NULL) and pdw_terrain_flag_kinematics (flags given:
+ * no h'' (NaN in gnd), and with one support foot a swing foot whose rules the bounds decide is
+ * not sampled: one_support). Straight-line code on local arrays with constant indices (the
+ * feet written out, the generated kinematics inline): the compiler keeps the ground values in
+ * registers, where a loop over the feet passed them through memory on the time loop's chain;
+ * gnd is stored field by field (for the forces and the Jacobian), never read back here. */
+#if defined(__GNUC__)
+__attribute__((always_inline))  /* specialized in each of the two entries below */
+#endif
+static inline void terrain_kinematics(const pdw_kernel *k, const pdw_ground *g, const double *x,
+                                      const double *trig, const double *p, const double *anchors,
+                                      const int *flags, double fall_depth, double *kin,
+                                      double *gnd, double *cell)
 {
     double sA[2], e0[3], e1[3], c0, c1, gl[2*PDW_NGROUND];
     double sig0 = 0.0, sig1 = 0.0, al0 = 0.0, al1 = 0.0;
-    pdw_ground_points(x, trig, p, sA);
-    sample_foot(g, sA[0], cell, e0);
-    sample_foot(g, sA[1], cell + 1, e1);
+    const int full = flags == NULL;
     const int consistent = k->variant == 1;
+    pdw_ground_points(x, trig, p, sA);
+    if (!full && g->bounded && flags[0] != flags[1]) {
+        /* one support foot: its swing partner sampled only when its rules need it */
+        if (flags[1]) {
+            if (one_support(k, g, x, trig, p, anchors, fall_depth, sA, 1, kin, gnd, cell, e1))
+                return;
+            sample_foot(g, sA[0], cell, e0, 0);
+        } else {
+            if (one_support(k, g, x, trig, p, anchors, fall_depth, sA, 0, kin, gnd, cell, e0))
+                return;
+            sample_foot(g, sA[1], cell + 1, e1, 0);
+        }
+    } else {
+        sample_foot(g, sA[0], cell, e0, full);
+        sample_foot(g, sA[1], cell + 1, e1, full);
+    }
     if (!consistent && e0[1] == 0.0 && e1[1] == 0.0) {
         /* h' = 0 under both feet (level cells: a plane on the slope, the flat parts of steps,
          * a flat ground with patches): the tangent lines are level, 1/N = 1, and the paper
@@ -164,11 +275,30 @@ void pdw_terrain_kinematics(const pdw_kernel *k, const pdw_ground *g, const doub
     kin[PDW_NKIN + PDW_KIN_Z] = z ? x[PDW_X_Z1 + 1] : 0.0;
 }
 
+void pdw_terrain_kinematics(const pdw_kernel *k, const pdw_ground *g, const double *x,
+                            const double *trig, const double *p, const double *anchors,
+                            double *kin, double *gnd, double *cell)
+{
+    terrain_kinematics(k, g, x, trig, p, anchors, NULL, 0.0, kin, gnd, cell);
+}
+
+void pdw_terrain_flag_kinematics(const pdw_kernel *k, const pdw_ground *g, const double *x,
+                                 const double *trig, const double *p, const double *anchors,
+                                 const int *flags, double fall_depth, double *kin, double *gnd,
+                                 double *cell)
+{
+    terrain_kinematics(k, g, x, trig, p, anchors, flags, fall_depth, kin, gnd, cell);
+}
+
 void pdw_terrain_contact(const pdw_kernel *k, const pdw_ground *g, const double *kin,
                          const int *flags, const double *p, double *contact, int partials)
 {
     void (*stage)(const double *, const int *, const double *, double *) =
         partials ? k->contact_partials : k->contact;
+    if (g->n_patches == 0) {            /* no patches: the run's parameters (the common case) */
+        stage(kin, flags, p, contact);
+        return;
+    }
     /* Every contact stage writes 0.0 for a foot that is not a penetrating support foot,
      * whatever p (derive/emit.py _contact_function): no penetrating foot, or one that no patch
      * reaches, takes the run's parameters; with one penetrating foot, one call with that foot's
@@ -205,8 +335,11 @@ void pdw_terrain_contact(const pdw_kernel *k, const pdw_ground *g, const double 
     }
 }
 
-void pdw_terrain_forces(const double *contact, const double *gnd, const double *p, double *cw,
-                        double *moment)
+#if defined(__GNUC__)
+__attribute__((always_inline))  /* inline in pdw_terrain_cdm_terms, the time loop's */
+#endif
+static inline void terrain_forces(const double *contact, const double *gnd, const double *p,
+                                  double *cw, double *moment)
 {
     double gf[2*PDW_NGFORCE], cf[2*PDW_NCONTACT], gd[2*PDW_NGROUND];
     for (int i = 0; i < 2; ++i) {       /* the inputs, one load each (load_fresh) */
@@ -240,6 +373,12 @@ void pdw_terrain_forces(const double *contact, const double *gnd, const double *
         cw[i*PDW_NCONTACT + PDW_CONTACT_F_T] = gf[i*PDW_NGFORCE + PDW_GFORCE_F_X];
         moment[i] = gf[i*PDW_NGFORCE + PDW_GFORCE_M_THETA];
     }
+}
+
+void pdw_terrain_forces(const double *contact, const double *gnd, const double *p, double *cw,
+                        double *moment)
+{
+    terrain_forces(contact, gnd, p, cw, moment);
 }
 
 void pdw_terrain_rhs(const pdw_kernel *k, const pdw_ground *g, const double *x, const double *p,
@@ -308,12 +447,21 @@ void pdw_terrain_jacobian(const pdw_kernel *k, const pdw_ground *g, const double
     pdw_terrain_rhs(k, g, x, p, flags, anchors, fp, work);
 }
 
+void pdw_terrain_cdm_terms_split(const pdw_kernel *k, const double *x, const double *trig,
+                                 const double *p, const double *contact, const double *gnd,
+                                 double *M, double *C, double *QmG, double *moment)
+{
+    double cw[2*PDW_NCONTACT];
+    terrain_forces(contact, gnd, p, cw, moment);
+    k->cdm_terms(x, trig, p, cw, M, C, QmG);
+}
+
 void pdw_terrain_cdm_terms(const pdw_kernel *k, const double *x, const double *trig,
                            const double *p, const double *contact, const double *gnd, double *M,
                            double *C, double *QmG)
 {
     double cw[2*PDW_NCONTACT], moment[2];
-    pdw_terrain_forces(contact, gnd, p, cw, moment);
+    terrain_forces(contact, gnd, p, cw, moment);
     k->cdm_terms(x, trig, p, cw, M, C, QmG);
     QmG[PDW_X_THETA1] += moment[0];
     QmG[PDW_X_THETA2] += moment[1];

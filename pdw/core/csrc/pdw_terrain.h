@@ -17,6 +17,19 @@ void pdw_terrain_kinematics(const pdw_kernel *k, const pdw_ground *g, const doub
                             const double *trig, const double *p, const double *anchors,
                             double *kin, double *gnd, double *cell);
 
+/* pdw_terrain_kinematics for the flag update of the time loops (pdw_update_flags_trig, flags:
+ * the support flags the update starts from; fall_depth: its pdw_check_feet limit [m]): the
+ * same kin for every foot whose values the update's rules, pdw_check_feet, the events, the
+ * contact stage and the forces read; gnd without h'' (NaN: only the Jacobian reads it, after
+ * its own pdw_terrain_rhs). A swing foot whose rules the ground's bounds decide (pdw_terrain.c
+ * swing_decided: far behind the support foot, or ahead of it and clear of the ground) is not
+ * sampled: its kin are those of a level ground at the ground's top bound, which decide the
+ * rules the same way, and its contact stage writes 0.0 whatever its kin. */
+void pdw_terrain_flag_kinematics(const pdw_kernel *k, const pdw_ground *g, const double *x,
+                                 const double *trig, const double *p, const double *anchors,
+                                 const int *flags, double fall_depth, double *kin, double *gnd,
+                                 double *cell);
+
 /* 1/N = 1/sqrt(1 + h'^2) of dh[0..n) as the kinematics computes it (in pairs, as the two feet;
  * an odd last one paired with 0), for tests. */
 void pdw_terrain_inv_normals(long n, const double *dh, double *inv_n);
@@ -45,5 +58,12 @@ void pdw_terrain_jacobian(const pdw_kernel *k, const pdw_ground *g, const double
 void pdw_terrain_cdm_terms(const pdw_kernel *k, const double *x, const double *trig,
                            const double *p, const double *contact, const double *gnd, double *M,
                            double *C, double *QmG);
+
+/* pdw_terrain_cdm_terms with the moments moment[0..1] returned, not added: QmG holds Q_f - G
+ * of the slope-frame forces, and QmG[theta_i] + moment[i] is pdw_terrain_cdm_terms's QmG (the
+ * central difference update adds them where it uses them: pdw_cdm.c). */
+void pdw_terrain_cdm_terms_split(const pdw_kernel *k, const double *x, const double *trig,
+                                 const double *p, const double *contact, const double *gnd,
+                                 double *M, double *C, double *QmG, double *moment);
 
 #endif /* PDW_TERRAIN_H */
