@@ -83,6 +83,7 @@ bench: $(STAMP) $(BARE_CDM)
 	$(PY) benchmarks/bench_monodromy.py $(UPDATE_DOCS)
 	$(PY) benchmarks/work_precision.py $(UPDATE_DOCS)
 	$(PY) benchmarks/bench_terrain.py $(UPDATE_DOCS)
+	$(PY) benchmarks/terrain_call_overhead.py
 	$(PY) benchmarks/bench_mfpt.py $(UPDATE_DOCS)
 	$(PY) benchmarks/continuation.py codim2 fold_kn $(UPDATE_DOCS)
 

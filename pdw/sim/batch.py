@@ -563,7 +563,7 @@ def _compiled_grounds(grounds):
             out.append(None)
             continue
         if id(g) not in made:
-            made[id(g)] = _batch.CGround(g.table())
+            made[id(g)] = g.compiled(_batch.CGround)
         out.append(made[id(g)])
     return out
 

@@ -475,7 +475,7 @@ def simulate(x0: ArrayLike | SceneLike = X0_PAPER, t_end: float | None = None,
                           fall_depth=depth)
     raw = _core.run(k, METHODS.index(method), x, p, f0[0], f0[1], opts,
                     record_contact=bool(record_forces), buffers=buffers, approach_speeds0=v_in0,
-                    ground=None if ground.is_flat else _core.CGround(ground.table()))
+                    ground=None if ground.is_flat else ground.compiled(_core.CGround))
     wall = time.perf_counter() - start
     energies = None
     if record_energies and raw["interrupted"] is None:

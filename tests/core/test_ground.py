@@ -131,3 +131,46 @@ def test_patch_table():
 def test_bad_input_names_the_field(make, field):
     with pytest.raises(pdw.InvalidInputError, match=field):
         make()
+
+
+def test_replace_gives_a_ground_with_its_own_table():
+    """dataclasses.replace must not hand the new ground the old one's cached table (the cache
+    was an init field: the replaced ground ran on the original's shape)."""
+    import dataclasses
+    g = Ground.sine(0.001, 0.8)
+    t = g.table()
+    g2 = dataclasses.replace(g, offset=0.01)
+    assert g2.table() is not t
+    assert np.allclose(g2.table().cells[:, 2] - t.cells[:, 2], 0.01, rtol=0, atol=1e-15)
+    a = pdw.simulate(params=pdw.Params.paper_steady(), t_end=0.05, ground=g2,
+                     record=pdw.Record(every=0))
+    b = pdw.simulate(params=pdw.Params.paper_steady(), t_end=0.05,
+                     ground=Ground.sine(0.001, 0.8, offset=0.01), record=pdw.Record(every=0))
+    assert np.array_equal(a.x_final, b.x_final)
+
+
+def test_compiled_ground_is_made_once_per_ground_and_maker():
+    from pdw.core import _core
+    g = Ground.random(0.0005, 0.1, seed=1, extent=(-1.0, 5.0))
+    c = g.compiled(_core.CGround)
+    assert g.compiled(_core.CGround) is c
+    assert Ground.random(0.0005, 0.1, seed=2, extent=(-1.0, 5.0)).compiled(_core.CGround) is not c
+    # a cached struct gives the same run as a fresh one
+    P = pdw.Params.paper_steady()
+    r1 = pdw.simulate(params=P, t_end=0.3, ground=g, record=pdw.Record(every=0))
+    r2 = pdw.simulate(params=P, t_end=0.3, ground=g, record=pdw.Record(every=0))
+    r3 = pdw.simulate(params=P, t_end=0.3, record=pdw.Record(every=0),
+                      ground=Ground.random(0.0005, 0.1, seed=1, extent=(-1.0, 5.0)))
+    assert np.array_equal(r1.x_final, r2.x_final) and np.array_equal(r1.x_final, r3.x_final)
+
+
+def test_a_ground_with_its_compiled_struct_pickles():
+    import pickle
+
+    from pdw.core import _core
+    g = Ground.sine(0.001, 0.8)
+    g.compiled(_core.CGround)
+    g2 = pickle.loads(pickle.dumps(g))
+    assert g2 == g and "table" in g2._cache
+    assert not any(isinstance(k, tuple) for k in g2._cache)
+    assert g2.compiled(_core.CGround) is not g.compiled(_core.CGround)
