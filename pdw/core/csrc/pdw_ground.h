@@ -83,23 +83,9 @@ static inline int pdw_ground_cell_level(const pdw_ground *g, long k)
     return bits == 0;
 }
 
-/* h, h', h'' at s in cell k into out[0..2]. */
-static inline void pdw_ground_eval_cell(const pdw_ground *g, long k, double s, double *out)
-{
-    const double *c = g->cells + k*PDW_NGCELL;
-    const double d = s - c[PDW_GCELL_S];
-    const double *a = c + PDW_GCELL_A0;
-    /* Estrin's scheme in d itself: short dependency chains (the time loops wait on h', and no
-     * scaling u = d/w sits before it or after it); the derivative's coefficients (2 a_2, ...)
-     * need only the cell, not s */
-    const double d2 = d*d, d4 = d2*d2;
-    out[0] = (a[0] + a[1]*d) + d2*(a[2] + a[3]*d) + d4*(a[4] + a[5]*d);
-    out[1] = (a[1] + 2.0*a[2]*d) + d2*(3.0*a[3] + 4.0*a[4]*d) + d4*(5.0*a[5]);
-    out[2] = (2.0*a[2] + 6.0*a[3]*d) + d2*(12.0*a[4] + 20.0*a[5]*d);
-}
-
-/* h, h' at s in cell k into out[0..1]: pdw_ground_eval_cell's expressions (the same bits)
- * without h'', which only the Jacobian reads. */
+/* h, h' at s in cell k into out[0..1]. Estrin's scheme in d itself: short dependency chains
+ * (the time loops wait on h', and no scaling u = d/w sits before it or after it); the
+ * derivative's coefficients (2 a_2, ...) need only the cell, not s. */
 static inline void pdw_ground_eval_cell_dh(const pdw_ground *g, long k, double s, double *out)
 {
     const double *c = g->cells + k*PDW_NGCELL;
@@ -108,6 +94,16 @@ static inline void pdw_ground_eval_cell_dh(const pdw_ground *g, long k, double s
     const double d2 = d*d, d4 = d2*d2;
     out[0] = (a[0] + a[1]*d) + d2*(a[2] + a[3]*d) + d4*(a[4] + a[5]*d);
     out[1] = (a[1] + 2.0*a[2]*d) + d2*(3.0*a[3] + 4.0*a[4]*d) + d4*(5.0*a[5]);
+}
+
+/* h, h', h'' at s in cell k into out[0..2] (h, h': pdw_ground_eval_cell_dh's, the same bits;
+ * h'' only the Jacobian reads). */
+static inline void pdw_ground_eval_cell(const pdw_ground *g, long k, double s, double *out)
+{
+    pdw_ground_eval_cell_dh(g, k, s, out);
+    const double *a = g->cells + k*PDW_NGCELL + PDW_GCELL_A0;
+    const double d = s - g->cells[k*PDW_NGCELL + PDW_GCELL_S];
+    out[2] = (2.0*a[2] + 6.0*a[3]*d) + (d*d)*(12.0*a[4] + 20.0*a[5]*d);
 }
 
 /* Set g's bounds over the defined extent [s_min, s_max] (g->bounded = 1 when they are finite),
