@@ -27,8 +27,8 @@ Every evaluation also returns the gait's descriptors and its *admissibility* fun
 quantities that must stay positive for the gait to exist as modelled (the end of a family when
 one crosses zero), see `HybridProblem.ADMISSIBLE` and `ContinuousProblem.ADMISSIBLE`.
 
-Over 500 lines: the two problems share the parameter handling of `_Problem`, and the
-continuous one's three ways to its Jacobians (differences, the exact step, the cross-check)
+Why this module is long (about 570 lines): the two problems share the parameter handling of
+`_Problem`, and the continuous one's three ways to its Jacobians (differences, the exact step, the cross-check)
 read the same options and descriptors.
 """
 from __future__ import annotations

@@ -1,6 +1,9 @@
 """The exact monodromy of the continuous walker's step map: variational equations with saltation
 matrices (issue #24 item 2; a Python/SciPy version over the compiled rhs and Jacobian).
 
+Why this module is long (about 640 lines): Eq. 18's flag rules, the saltations and the event
+loop that both engines share belong together (split, each part would read the others' state).
+
 One step of the touch-down map (`pdw.analysis.stepmap.poincare.step`) from section point z:
 
     x0 = E(z)          (`section.embed`: leg 2's contact point at the origin, flags (1, 1))
@@ -75,9 +78,6 @@ descriptors, `step_summary`) then costs one variational step, 0.6-0.7 x the diff
 the default law and 0.2-0.3 x for the laws the ensemble engine does not run (docs/continuation.md).
 Not the continuation's default (its documented branches are the differences'); it is the
 cross-check of `GaitMap.crosscheck` and of a user's doubts near a kink.
-
-Over 500 lines: Eq. 18's flag rules, the saltations and the event loop that both engines share
-belong together (split, each part would read the others' state).
 """
 from __future__ import annotations
 
