@@ -311,8 +311,8 @@ def simulate_batch(x0: ArrayLike, t_end: float | None = None, dt: float | None =
         Threads (GIL released), W lanes each, sharing the batch (each lane takes the next
         walker); default: os.cpu_count().
     lanes : int, optional
-        Walkers per block advanced in lockstep by one thread (1 ... 64; default `LANES` = 16
-        for cdm, `LANES_OTHER` = 8 for the other methods; a thread's share of a smaller batch
+        Walkers per block advanced in lockstep by one thread (1 ... 64; default ``LANES`` = 16
+        for cdm, ``LANES_OTHER`` = 8 for the other methods; a thread's share of a smaller batch
         takes fewer). Speed only: no walker's result depends on it, nor on ``threads``.
     vector : bool
         False (default): the scalar libm sin/cos, so that every walker is bitwise its

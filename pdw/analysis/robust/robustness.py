@@ -346,7 +346,7 @@ def gait_sensitivity(params=None, *, indicators=("step_time",), model="hybrid", 
         the heel strike, the impact map's derivative: ``pdw.core._hybrid.step_sens``), checked
         against central differences. ``"continuous"``: the touch-down map's variational
         equations with the ground heights under the trailing and the landing foot as
-        parameters (`pdw.analysis.stepmap.variational_ground`), in the section coordinates
+        parameters (``pdw.analysis.stepmap.variational_ground``), in the section coordinates
         augmented by the previous step's floor change (docs/robustness.md, "The compliant
         model"); indicators step_time, step_length, speed.
     gait : Gait, optional
@@ -361,7 +361,7 @@ def gait_sensitivity(params=None, *, indicators=("step_time",), model="hybrid", 
         ``robustness_continuous.REL_CHECK`` = 1e-3).
     options
         Hybrid step-map options (default rtol = atol = 1e-12 here); continuous: options of
-        `pdw.analysis.stepmap.poincare.step` (the differences' map; ``contact`` and
+        ``pdw.analysis.stepmap.poincare.step`` (the differences' map; ``contact`` and
         ``variant`` also the exact one's: the paper variant, Coulomb friction).
 
     Returns
